@@ -1,0 +1,142 @@
+#include "textile/fit/profile.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "textile/sim/error.h"
+
+namespace textile {
+namespace {
+
+// How far above the platform's top a mid-line point may lie: half a thickness of the thickest
+// fabrics plus extraction noise. Beyond that the strip "rises above the platform".
+constexpr double kMaxRiseM = 3e-3;
+// How far x may run backwards before we call it folding back (noise on a vertical tail).
+constexpr double kFoldBackM = 1e-3;
+
+std::string Trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r\n");
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(" \t\r\n") - b + 1);
+}
+
+std::vector<std::string> SplitComma(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  std::string cell;
+  while (std::getline(ss, cell, ',')) out.push_back(Trim(cell));
+  if (!line.empty() && line.back() == ',') out.push_back("");
+  return out;
+}
+
+}  // namespace
+
+Profile ParseProfileCsv(const std::string& text, const std::string& source) {
+  Profile p;
+  p.source = source;
+  std::stringstream in(text);
+  std::string line;
+  int line_no = 0;
+  bool header_seen = false;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const std::string t = Trim(line);
+    if (t.empty() || t[0] == '#') continue;
+    const auto where = [&] { return source + ":" + std::to_string(line_no) + ": "; };
+    if (!header_seen) {
+      std::string h;
+      for (char c : t) if (c != ' ' && c != '\t') h += c;
+      if (h.rfind("\xEF\xBB\xBF", 0) == 0) h = h.substr(3);  // UTF-8 byte-order mark
+      if (h != "s_mm,x_mm,y_mm") {
+        throw InputError(where() + "expected the header 's_mm,x_mm,y_mm', got '" +
+                         t.substr(0, 60) + "'");
+      }
+      header_seen = true;
+      continue;
+    }
+    const auto cells = SplitComma(t);
+    if (cells.size() != 3) {
+      throw InputError(where() + "expected 3 values (s_mm,x_mm,y_mm), got " +
+                       std::to_string(cells.size()));
+    }
+    double v[3];
+    for (int k = 0; k < 3; ++k) {
+      const char* c = cells[k].c_str();
+      char* end = nullptr;
+      v[k] = std::strtod(c, &end);
+      if (cells[k].empty() || end == c || *end != '\0') {
+        throw InputError(where() + "'" + cells[k].substr(0, 30) + "' is not a number");
+      }
+      if (!std::isfinite(v[k])) throw InputError(where() + "value is NaN or infinite");
+      if (std::abs(v[k]) > 1e5) {
+        throw InputError(where() + "|" + cells[k] + "| mm is implausibly large for a cantilever");
+      }
+    }
+    p.s.push_back(v[0] * 1e-3);
+    p.x.push_back(v[1] * 1e-3);
+    p.y.push_back(v[2] * 1e-3);
+  }
+  if (!header_seen) throw InputError(source + ": empty profile (no header 's_mm,x_mm,y_mm')");
+  CheckProfile(p);
+  return p;
+}
+
+Profile ReadProfileCsv(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw InputError(path + ": cannot open profile");
+  std::stringstream buffer;
+  buffer << f.rdbuf();
+  if (f.bad()) throw InputError(path + ": cannot read profile");
+  return ParseProfileCsv(buffer.str(), path);
+}
+
+void CheckProfile(const Profile& p) {
+  const std::string& src = p.source;
+  if (p.x.size() != p.s.size() || p.y.size() != p.s.size()) {
+    throw InputError(src + ": s, x and y differ in length");
+  }
+  if (p.size() < static_cast<size_t>(kMinProfilePoints)) {
+    throw InputError(src + ": " + std::to_string(p.size()) + " points, at least " +
+                     std::to_string(kMinProfilePoints) + " are needed");
+  }
+  double max_x = -1e300;
+  for (size_t i = 0; i < p.size(); ++i) {
+    const std::string row = "point " + std::to_string(i + 1);
+    if (!std::isfinite(p.s[i]) || !std::isfinite(p.x[i]) || !std::isfinite(p.y[i])) {
+      throw InputError(src + ": " + row + " is NaN or infinite");
+    }
+    if (i > 0 && !(p.s[i] > p.s[i - 1])) {
+      throw InputError(src + ": " + row + ": arc length s_mm must increase strictly (" +
+                       std::to_string(p.s[i - 1] * 1e3) + " then " + std::to_string(p.s[i] * 1e3) +
+                       ")");
+    }
+    if (p.y[i] > kMaxRiseM) {
+      throw InputError(src + ": " + row + " lies " + std::to_string(p.y[i] * 1e3) +
+                       " mm above the platform; a hanging strip has y_mm <= 0 (is y pointing down?)");
+    }
+    if (p.x[i] < max_x - kFoldBackM) {
+      throw InputError(src + ": " + row + ": the profile folds back (x_mm decreases from " +
+                       std::to_string(max_x * 1e3) + " to " + std::to_string(p.x[i] * 1e3) + ")");
+    }
+    max_x = std::max(max_x, p.x[i]);
+  }
+  if (p.s.front() < -kFoldBackM) {
+    throw InputError(src + ": arc length starts at " + std::to_string(p.s.front() * 1e3) +
+                     " mm; s_mm is measured from the platform edge and must be >= 0");
+  }
+}
+
+std::string ProfileToCsv(const Profile& p) {
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(6);
+  out << "s_mm,x_mm,y_mm\n";
+  for (size_t i = 0; i < p.size(); ++i) {
+    out << p.s[i] * 1e3 << ',' << p.x[i] * 1e3 << ',' << p.y[i] * 1e3 << '\n';
+  }
+  return out.str();
+}
+
+}  // namespace textile

@@ -1,0 +1,25 @@
+#ifndef TEXTILE_SIM_ERROR_H_
+#define TEXTILE_SIM_ERROR_H_
+
+#include <stdexcept>
+#include <string>
+
+namespace textile {
+
+// Bad user input (a file, a flag, a value out of range). The message is one line that names
+// the source and the problem; the CLI prints it as "error: <message>" and exits with 2.
+class InputError : public std::runtime_error {
+ public:
+  explicit InputError(const std::string& message) : std::runtime_error(message) {}
+};
+
+// A computation that could not produce a trustworthy result (no convergence, nothing detected).
+// The CLI prints it as "error: <message>" and exits with 3.
+class ComputeError : public std::runtime_error {
+ public:
+  explicit ComputeError(const std::string& message) : std::runtime_error(message) {}
+};
+
+}  // namespace textile
+
+#endif  // TEXTILE_SIM_ERROR_H_

@@ -1,0 +1,76 @@
+#include "common/atomic_file.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "textile/sim/error.h"
+
+namespace fs = std::filesystem;
+
+namespace textile {
+namespace {
+
+std::string Slurp(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+fs::path ScratchDir(const std::string& name) {
+  const fs::path d = fs::path(TEXTILE_BINARY_DIR) / "test_scratch" / name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+TEST(AtomicFile, WritesAndReplaces) {
+  const fs::path d = ScratchDir("atomic_writes");
+  const std::string p = (d / "a.json").string();
+  WriteFileAtomically(p, "first");
+  WriteFileAtomically(p, "second");
+  EXPECT_EQ(Slurp(p), "second");
+  EXPECT_EQ(std::distance(fs::directory_iterator(d), fs::directory_iterator{}), 1);
+}
+
+TEST(AtomicFile, UncommittedLeavesOldFileAndNoTemp) {
+  const fs::path d = ScratchDir("atomic_abort");
+  const std::string p = (d / "a.json").string();
+  WriteFileAtomically(p, "good");
+  {
+    AtomicFile out(p);
+    std::ofstream(out.temp_path()) << "half";
+    // destroyed without Commit: as if the computation threw
+  }
+  EXPECT_EQ(Slurp(p), "good");
+  EXPECT_EQ(std::distance(fs::directory_iterator(d), fs::directory_iterator{}), 1);
+}
+
+TEST(AtomicFile, TempKeepsExtensionForFormatWriters) {
+  const fs::path d = ScratchDir("atomic_ext");
+  AtomicFile out((d / "plot.png").string());
+  EXPECT_EQ(fs::path(out.temp_path()).extension(), ".png");
+  EXPECT_EQ(fs::path(out.temp_path()).parent_path(), d);
+}
+
+TEST(AtomicFile, RefusesMissingFolder) {
+  try {
+    AtomicFile out("/nonexistent-textile-dir/x.json");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("does not exist"), std::string::npos) << e.what();
+  }
+}
+
+TEST(AtomicFile, CommitWithoutContentThrows) {
+  const fs::path d = ScratchDir("atomic_empty");
+  AtomicFile out((d / "x.json").string());
+  EXPECT_THROW(out.Commit(), InputError);
+  EXPECT_FALSE(fs::exists(d / "x.json"));
+}
+
+}  // namespace
+}  // namespace textile

@@ -1,0 +1,73 @@
+#include "common/atomic_file.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "textile/sim/error.h"
+
+namespace fs = std::filesystem;
+
+namespace textile {
+
+AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
+  if (path_.empty()) throw InputError("output path is empty");
+  const fs::path target(path_);
+  fs::path dir = target.parent_path();
+  if (dir.empty()) dir = ".";
+  std::error_code ec;
+  if (fs::is_directory(target, ec)) throw InputError(path_ + ": is a directory, expected a file");
+  if (!fs::is_directory(dir, ec)) {
+    throw InputError(path_ + ": output folder " + dir.string() + " does not exist");
+  }
+  if (::access(dir.c_str(), W_OK) != 0) {
+    throw InputError(path_ + ": output folder " + dir.string() + " is not writable");
+  }
+  std::random_device rd;
+  const std::string tag = std::to_string(::getpid()) + "-" + std::to_string(rd() % 1000000);
+  temp_ = (dir / ("." + target.stem().string() + ".tmp-" + tag + target.extension().string()))
+              .string();
+}
+
+AtomicFile::~AtomicFile() {
+  if (!committed_) {
+    std::error_code ec;
+    fs::remove(temp_, ec);
+  }
+}
+
+void AtomicFile::Commit() {
+  std::error_code ec;
+  if (!fs::exists(temp_, ec) || fs::file_size(temp_, ec) == 0) {
+    throw InputError(path_ + ": writing failed (nothing was written)");
+  }
+  fs::rename(temp_, path_, ec);
+  if (ec) throw InputError(path_ + ": cannot move output into place: " + ec.message());
+  committed_ = true;
+}
+
+void WriteFileAtomically(const std::string& path, std::string_view text) {
+  AtomicFile out(path);
+  {
+    std::ofstream f(out.temp_path(), std::ios::binary);
+    f.write(text.data(), static_cast<std::streamsize>(text.size()));
+    f.flush();
+    if (!f) throw InputError(path + ": write failed");
+  }
+  out.Commit();
+}
+
+void EnsureDirectory(const std::string& dir) {
+  std::error_code ec;
+  if (dir.empty()) throw InputError("output folder is empty");
+  if (fs::is_directory(dir, ec)) {
+    if (::access(dir.c_str(), W_OK) != 0) throw InputError(dir + ": output folder is not writable");
+    return;
+  }
+  fs::create_directories(dir, ec);
+  if (ec) throw InputError(dir + ": cannot create output folder: " + ec.message());
+}
+
+}  // namespace textile

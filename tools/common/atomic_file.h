@@ -1,0 +1,45 @@
+#ifndef TEXTILE_TOOLS_COMMON_ATOMIC_FILE_H_
+#define TEXTILE_TOOLS_COMMON_ATOMIC_FILE_H_
+
+// Every file the CLI writes goes through here: the content lands in a temporary file next to
+// the target and is renamed over it only when complete, so a failed run leaves no
+// half-written file and never replaces a good one with garbage (cli.md).
+//
+//   textile::AtomicFile out("fit.json");        // throws InputError if the folder is unusable
+//   std::ofstream(out.temp_path()) << text;      // or let a library write to temp_path()
+//   out.Commit();                                // rename; without it the temp file is removed
+
+#include <string>
+#include <string_view>
+
+namespace textile {
+
+class AtomicFile {
+ public:
+  // path: the final file. Checks that its folder exists and is writable.
+  explicit AtomicFile(std::string path);
+  ~AtomicFile();  // removes the temporary file unless committed
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+
+  const std::string& path() const { return path_; }
+  // Where to write; same folder and extension as path() so writers that go by the
+  // extension (OpenCV, Cairo) pick the right format.
+  const std::string& temp_path() const { return temp_; }
+  // Moves the finished temporary file into place. Throws InputError if it is missing/empty.
+  void Commit();
+
+ private:
+  std::string path_, temp_;
+  bool committed_ = false;
+};
+
+// Writes text to path atomically. Throws InputError naming the path on failure.
+void WriteFileAtomically(const std::string& path, std::string_view text);
+
+// Creates a directory (and parents) for outputs; throws InputError naming it on failure.
+void EnsureDirectory(const std::string& dir);
+
+}  // namespace textile
+
+#endif  // TEXTILE_TOOLS_COMMON_ATOMIC_FILE_H_

@@ -1,0 +1,49 @@
+#ifndef TEXTILE_SIM_MATERIAL_H_
+#define TEXTILE_SIM_MATERIAL_H_
+
+// A fabric as the simulators see it, read from and written to the material JSON of cli.md.
+//
+//   textile::Material m = textile::ReadMaterial("samples/materials/pabst-fig8.json");
+//   textile::BendingLaw law = m.EffectiveLaw();   // β applied; SI inside
+//   double rho = m.areal_density;                  // [kg/m²]
+//
+// Files carry lab units ("kes": b in gf·cm, c1 in gf·cm²; or "si"); areal density in g/m².
+// Every problem in a file is an InputError "<file>: <field>: <problem>", one line.
+
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "textile/sim/bending_law.h"
+
+namespace textile {
+
+struct Material {
+  std::string name;                          // free text
+  double areal_density = 0.0;                // ρ [kg/m²]
+  BendingLaw bending = BendingLaw::FromKes(0.1, 0.1, 0.0);  // warp law (or the only law)
+  std::optional<BendingLaw> bending_weft;    // weft law, when anisotropic
+  double beta = 1.0;                         // linear bending stiffness factor β (section 3.4)
+  double stretch_stiffness = 1000.0;         // membrane stiffness [N/m] (physics.md default)
+  double poisson = 0.3;                      // Poisson ratio [-]
+  double friction = 0.3;                     // Coulomb coefficient against supports [-]
+  nlohmann::json fit;                        // the `fit` report when a fit made this file
+  nlohmann::json extra;                      // "notes"/"assumptions"/"source", carried through
+
+  // The warp law with β applied (M_β = β M), which every simulation uses.
+  BendingLaw EffectiveLaw() const { return bending.Scaled(beta); }
+  // The weft law with β applied, or the warp law when the material is isotropic.
+  BendingLaw EffectiveWeftLaw() const { return (bending_weft ? *bending_weft : bending).Scaled(beta); }
+};
+
+// Parses material JSON text; `source` names the file in messages. Throws InputError.
+Material ParseMaterialJson(const std::string& text, const std::string& source);
+// Reads a material file. Throws InputError (unreadable file or any invalid field).
+Material ReadMaterial(const std::string& path);
+// The material as JSON in the file format, bending constants in KES units.
+nlohmann::json MaterialToJson(const Material& material);
+
+}  // namespace textile
+
+#endif  // TEXTILE_SIM_MATERIAL_H_

@@ -1,0 +1,204 @@
+#include "textile/sim/material.h"
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "textile/sim/error.h"
+#include "textile/sim/units.h"
+
+namespace textile {
+namespace {
+
+using nlohmann::json;
+
+// Plausibility bounds. Outside them a value is far more likely a unit mix-up (an "si" file
+// written in KES numbers, mm for m) than a fabric, so the file is refused with a hint.
+// Bending stiffness of textiles spans about 1e-4 gf·cm (fine silk) to ~100 gf·cm (stiff
+// technical fabrics); see docs/materials.md.
+constexpr double kMinBKes = 1e-5, kMaxBKes = 1e3;   // [gf·cm]
+constexpr double kMaxAbsC1Kes = 1e4;               // [gf·cm²]
+constexpr double kMinGsm = 1.0, kMaxGsm = 1e4;     // [g/m²]
+constexpr double kMinBeta = 1e-3, kMaxBeta = 1e3;  // [-]
+
+class Reader {
+ public:
+  explicit Reader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void Fail(const std::string& field, const std::string& problem) const {
+    throw InputError(source_ + ": " + field + ": " + problem);
+  }
+
+  double Number(const json& obj, const std::string& key, const std::string& field) const {
+    const json& v = obj.at(key);
+    if (!v.is_number()) Fail(field, "must be a number, got " + Brief(v));
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) Fail(field, "must be finite, got " + Brief(v));
+    return d;
+  }
+
+  static std::string Brief(const json& v) {
+    std::string s = v.dump();
+    return s.size() > 40 ? s.substr(0, 37) + "..." : s;
+  }
+
+  void CheckKeys(const json& obj, const std::string& where, const std::set<std::string>& known) const {
+    for (const auto& [key, value] : obj.items()) {
+      if (!known.count(key)) {
+        std::string list;
+        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+        Fail(where.empty() ? key : where + "." + key, "unknown field (known: " + list + ")");
+      }
+    }
+  }
+
+  BendingLaw Law(const json& root, const std::string& key) const {
+    const json& b = root.at(key);
+    if (!b.is_object()) Fail(key, "must be an object {\"units\", \"b1\", \"b2\", \"c1\"}");
+    CheckKeys(b, key, {"units", "b1", "b2", "c1"});
+    for (const char* k : {"units", "b1", "b2", "c1"}) {
+      if (!b.contains(k)) Fail(key + "." + k, "missing");
+    }
+    if (!b.at("units").is_string()) Fail(key + ".units", "must be \"kes\" or \"si\"");
+    const std::string units = b.at("units").get<std::string>();
+    if (units != "kes" && units != "si") {
+      Fail(key + ".units", "unknown units '" + units + "' (use \"kes\": gf·cm, gf·cm²; or \"si\": N·m, N·m²)");
+    }
+    const bool kes = units == "kes";
+    double v[3];
+    const char* names[3] = {"b1", "b2", "c1"};
+    for (int i = 0; i < 3; ++i) v[i] = Number(b, names[i], key + "." + names[i]);
+    // Everything below in KES, which is how people read these numbers.
+    const double b1 = kes ? v[0] : units::SiStiffnessToKes(v[0]);
+    const double b2 = kes ? v[1] : units::SiStiffnessToKes(v[1]);
+    const double c1 = kes ? v[2] : units::SiQuadraticToKes(v[2]);
+    const std::string unit_hint = kes ? " (units: kes)" : " (units: si; is this file in kes?)";
+    for (int i = 0; i < 2; ++i) {
+      const double bk = i == 0 ? b1 : b2;
+      if (bk <= 0.0) Fail(key + "." + names[i], "must be > 0, got " + Brief(b.at(names[i])));
+      if (bk < kMinBKes || bk > kMaxBKes) {
+        std::ostringstream s;
+        s << "suspicious magnitude " << bk << " gf·cm, outside the textile range " << kMinBKes
+          << " .. " << kMaxBKes << " gf·cm" << unit_hint;
+        Fail(key + "." + names[i], s.str());
+      }
+    }
+    if (std::abs(c1) > kMaxAbsC1Kes) {
+      std::ostringstream s;
+      s << "suspicious magnitude " << c1 << " gf·cm², |c1| above " << kMaxAbsC1Kes << " gf·cm²"
+        << unit_hint;
+      Fail(key + ".c1", s.str());
+    }
+    const double sb1 = units::KesStiffnessToSi(b1), sb2 = units::KesStiffnessToSi(b2);
+    const double sc1 = units::KesQuadraticToSi(c1);
+    if (std::string why = BendingLaw::Invalidity(sb1, sb2, sc1); !why.empty()) Fail(key, why);
+    return BendingLaw::FromSi(sb1, sb2, sc1);
+  }
+
+ private:
+  std::string source_;
+};
+
+}  // namespace
+
+Material ParseMaterialJson(const std::string& text, const std::string& source) {
+  Reader r(source);
+  json root;
+  try {
+    root = json::parse(text);
+  } catch (const json::exception& e) {  // parse_error, or out_of_range for 1e999
+    // nlohmann's message carries the line and column; keep it to one line.
+    std::string what = e.what();
+    if (auto p = what.find("]"); p != std::string::npos) what = what.substr(p + 2);
+    throw InputError(source + ": not valid JSON: " + what);
+  }
+  if (!root.is_object()) r.Fail("(top level)", "must be a JSON object");
+  r.CheckKeys(root, "", {"name", "areal_density_gsm", "bending", "bending_weft", "beta", "stretch",
+                         "friction", "fit", "notes", "assumptions", "source"});
+  Material m;
+  if (root.contains("name")) {
+    if (!root["name"].is_string()) r.Fail("name", "must be a string");
+    m.name = root["name"].get<std::string>();
+  }
+  if (!root.contains("areal_density_gsm")) r.Fail("areal_density_gsm", "missing (g/m², required)");
+  const double gsm = r.Number(root, "areal_density_gsm", "areal_density_gsm");
+  if (gsm <= 0.0) r.Fail("areal_density_gsm", "must be > 0 g/m², got " + Reader::Brief(root["areal_density_gsm"]));
+  if (gsm < kMinGsm || gsm > kMaxGsm) {
+    std::ostringstream s;
+    s << "suspicious areal density " << gsm << " g/m², outside " << kMinGsm << " .. " << kMaxGsm
+      << " g/m² (the unit is g/m², not kg/m²)";
+    r.Fail("areal_density_gsm", s.str());
+  }
+  m.areal_density = units::GsmToSi(gsm);
+  if (!root.contains("bending")) r.Fail("bending", "missing (required: {\"units\", \"b1\", \"b2\", \"c1\"})");
+  m.bending = r.Law(root, "bending");
+  if (root.contains("bending_weft")) m.bending_weft = r.Law(root, "bending_weft");
+  if (root.contains("beta")) {
+    m.beta = r.Number(root, "beta", "beta");
+    if (m.beta <= 0.0) r.Fail("beta", "must be > 0, got " + Reader::Brief(root["beta"]));
+    if (m.beta < kMinBeta || m.beta > kMaxBeta) {
+      r.Fail("beta", "suspicious factor " + Reader::Brief(root["beta"]) + ", outside 0.001 .. 1000");
+    }
+  }
+  if (root.contains("stretch")) {
+    const json& st = root["stretch"];
+    if (!st.is_object()) r.Fail("stretch", "must be an object {\"stiffness_N_per_m\", \"poisson\"}");
+    r.CheckKeys(st, "stretch", {"stiffness_N_per_m", "poisson"});
+    if (st.contains("stiffness_N_per_m")) {
+      m.stretch_stiffness = r.Number(st, "stiffness_N_per_m", "stretch.stiffness_N_per_m");
+      if (m.stretch_stiffness <= 0.0) r.Fail("stretch.stiffness_N_per_m", "must be > 0 N/m");
+      if (m.stretch_stiffness > 1e7) r.Fail("stretch.stiffness_N_per_m", "suspicious magnitude, above 1e7 N/m");
+    }
+    if (st.contains("poisson")) {
+      m.poisson = r.Number(st, "poisson", "stretch.poisson");
+      if (m.poisson < 0.0 || m.poisson >= 0.5) r.Fail("stretch.poisson", "must lie in [0, 0.5)");
+    }
+  }
+  if (root.contains("friction")) {
+    m.friction = r.Number(root, "friction", "friction");
+    if (m.friction < 0.0 || m.friction > 10.0) r.Fail("friction", "must lie in [0, 10]");
+  }
+  if (root.contains("fit")) {
+    if (!root["fit"].is_object()) r.Fail("fit", "must be an object");
+    m.fit = root["fit"];
+  }
+  for (const char* k : {"notes", "assumptions", "source"}) {
+    if (root.contains(k)) m.extra[k] = root[k];
+  }
+  return m;
+}
+
+Material ReadMaterial(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw InputError(path + ": cannot open material file");
+  std::stringstream buffer;
+  buffer << f.rdbuf();
+  if (f.bad()) throw InputError(path + ": cannot read material file");
+  if (buffer.str().find_first_not_of(" \t\r\n") == std::string::npos) {
+    throw InputError(path + ": empty material file");
+  }
+  return ParseMaterialJson(buffer.str(), path);
+}
+
+namespace {
+nlohmann::json LawToJson(const BendingLaw& law) {
+  return {{"units", "kes"}, {"b1", law.b1_kes()}, {"b2", law.b2_kes()}, {"c1", law.c1_kes()}};
+}
+}  // namespace
+
+nlohmann::json MaterialToJson(const Material& m) {
+  nlohmann::json j;
+  if (!m.name.empty()) j["name"] = m.name;
+  j["areal_density_gsm"] = units::SiToGsm(m.areal_density);
+  j["bending"] = LawToJson(m.bending);
+  if (m.bending_weft) j["bending_weft"] = LawToJson(*m.bending_weft);
+  j["beta"] = m.beta;
+  j["stretch"] = {{"stiffness_N_per_m", m.stretch_stiffness}, {"poisson", m.poisson}};
+  j["friction"] = m.friction;
+  for (const auto& [k, v] : m.extra.items()) j[k] = v;
+  if (!m.fit.is_null()) j["fit"] = m.fit;
+  return j;
+}
+
+}  // namespace textile

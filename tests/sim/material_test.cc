@@ -1,0 +1,133 @@
+#include "textile/sim/material.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "textile/sim/error.h"
+#include "textile/sim/units.h"
+
+namespace textile {
+namespace {
+
+const std::string kSamples = std::string(TEXTILE_SOURCE_DIR) + "/samples/materials/";
+const std::string kBad = std::string(TEXTILE_SOURCE_DIR) + "/tests/data/materials/";
+
+TEST(Material, ReadsThePapersFabrics) {
+  const Material fig8 = ReadMaterial(kSamples + "pabst-fig8.json");
+  EXPECT_DOUBLE_EQ(fig8.areal_density, 0.2);
+  EXPECT_NEAR(fig8.bending.b1_kes(), 0.1, 1e-15);
+  EXPECT_NEAR(fig8.bending.b2_kes(), 0.0892, 1e-15);
+  EXPECT_NEAR(fig8.bending.c1_kes(), -0.0092, 1e-15);
+  const Material dress = ReadMaterial(kSamples + "pabst-dress.json");
+  EXPECT_EQ(dress.bending.kappa0(), 0.0);
+  const Material inter = ReadMaterial(kSamples + "pabst-interlining.json");
+  EXPECT_NEAR(units::SiCurvatureToKes(inter.bending.kappa0()), (1.8856 - 0.5168) / (2 * 2.2683),
+              1e-12);
+}
+
+TEST(Material, SiAndKesUnitsAgree) {
+  const Material kes = ParseMaterialJson(
+      R"({"areal_density_gsm": 180, "bending": {"units": "kes", "b1": 0.1, "b2": 0.0892, "c1": -0.0092}})",
+      "kes");
+  const Material si = ParseMaterialJson(
+      R"({"areal_density_gsm": 180, "bending": {"units": "si", "b1": 9.80665e-6, "b2": 8.7475318e-6, "c1": -9.022118e-9}})",
+      "si");
+  EXPECT_NEAR(si.bending.b1(), kes.bending.b1(), 1e-15);
+  EXPECT_NEAR(si.bending.b2(), kes.bending.b2(), 1e-13);
+  EXPECT_NEAR(si.bending.c1(), kes.bending.c1(), 1e-15);
+}
+
+TEST(Material, DefaultsAndOptionalFields) {
+  const Material m = ParseMaterialJson(
+      R"({"areal_density_gsm": 180, "bending": {"units": "kes", "b1": 0.1, "b2": 0.0892, "c1": -0.0092},
+          "bending_weft": {"units": "kes", "b1": 0.08, "b2": 0.07, "c1": -0.006}, "beta": 1.5,
+          "stretch": {"stiffness_N_per_m": 2000}, "friction": 0.5})",
+      "opt");
+  ASSERT_TRUE(m.bending_weft.has_value());
+  EXPECT_NEAR(m.bending_weft->b1_kes(), 0.08, 1e-15);
+  EXPECT_DOUBLE_EQ(m.beta, 1.5);
+  EXPECT_NEAR(m.EffectiveLaw().b1(), 1.5 * m.bending.b1(), 1e-18);
+  EXPECT_DOUBLE_EQ(m.stretch_stiffness, 2000.0);
+  EXPECT_DOUBLE_EQ(m.poisson, 0.3);
+  EXPECT_DOUBLE_EQ(m.friction, 0.5);
+}
+
+TEST(Material, JsonRoundTrip) {
+  const Material a = ReadMaterial(kSamples + "pabst-interlining.json");
+  const Material b = ParseMaterialJson(MaterialToJson(a).dump(), "round trip");
+  EXPECT_NEAR(b.bending.b1(), a.bending.b1(), 1e-18);
+  EXPECT_NEAR(b.bending.b2(), a.bending.b2(), 1e-18);
+  EXPECT_NEAR(b.bending.c1(), a.bending.c1(), 1e-20);
+  EXPECT_DOUBLE_EQ(b.areal_density, a.areal_density);
+  EXPECT_EQ(b.name, a.name);
+  EXPECT_EQ(b.extra, a.extra);
+}
+
+struct BadCase {
+  const char* file;
+  const char* field;    // must appear in the message
+  const char* problem;  // must appear in the message
+};
+
+class BadMaterial : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadMaterial, IsRejectedWithFileFieldAndProblem) {
+  const BadCase& c = GetParam();
+  const std::string path = kBad + c.file;
+  try {
+    ReadMaterial(path);
+    FAIL() << c.file << " was accepted";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "one line: " << what;
+    EXPECT_NE(what.find(path), std::string::npos) << what;
+    EXPECT_NE(what.find(c.field), std::string::npos) << what;
+    EXPECT_NE(what.find(c.problem), std::string::npos) << what;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Material, BadMaterial,
+    ::testing::Values(
+        BadCase{"empty.json", "", "empty material file"},
+        BadCase{"not-json.json", "", "not valid JSON"},
+        BadCase{"truncated.json", "", "not valid JSON"},
+        BadCase{"array.json", "(top level)", "JSON object"},
+        BadCase{"missing-gsm.json", "areal_density_gsm", "missing"},
+        BadCase{"missing-bending.json", "bending", "missing"},
+        BadCase{"missing-b2.json", "bending.b2", "missing"},
+        BadCase{"unknown-units.json", "bending.units", "unknown units 'mN'"},
+        BadCase{"nan.json", "", "not valid JSON"},
+        BadCase{"inf.json", "", "number overflow parsing '1e999'"},
+        BadCase{"string-number.json", "areal_density_gsm", "must be a number"},
+        BadCase{"b1-zero.json", "bending.b1", "must be > 0"},
+        BadCase{"b2-negative.json", "bending.b2", "must be > 0"},
+        BadCase{"kappa0-negative.json", "bending", "kappa0 = (b2 - b1)/(2 c1) < 0"},
+        BadCase{"gsm-zero.json", "areal_density_gsm", "must be > 0"},
+        BadCase{"gsm-negative.json", "areal_density_gsm", "must be > 0"},
+        BadCase{"gsm-absurd.json", "areal_density_gsm", "suspicious"},
+        BadCase{"beta-zero.json", "beta", "must be > 0"},
+        BadCase{"beta-negative.json", "beta", "must be > 0"},
+        BadCase{"si-with-kes-numbers.json", "bending.b1", "is this file in kes?"},
+        BadCase{"b-absurdly-small.json", "bending.b1", "suspicious"},
+        BadCase{"c1-absurd.json", "bending.c1", "suspicious"},
+        BadCase{"unknown-field.json", "bendng", "unknown field"},
+        BadCase{"weft-invalid.json", "bending_weft", "kappa0"},
+        BadCase{"poisson-bad.json", "stretch.poisson", "[0, 0.5)"},
+        BadCase{"stretch-negative.json", "stretch.stiffness_N_per_m", "must be > 0"},
+        BadCase{"friction-negative.json", "friction", "[0, 10]"},
+        BadCase{"bending-not-object.json", "bending", "must be an object"}),
+    [](const auto& info) {
+      std::string n = info.param.file;
+      n = n.substr(0, n.find('.'));
+      for (char& ch : n) if (ch == '-') ch = '_';
+      return n;
+    });
+
+TEST(Material, MissingFileIsInputError) {
+  EXPECT_THROW(ReadMaterial(kBad + "does-not-exist.json"), InputError);
+}
+
+}  // namespace
+}  // namespace textile

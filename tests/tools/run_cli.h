@@ -1,0 +1,60 @@
+#ifndef TEXTILE_TESTS_TOOLS_RUN_CLI_H_
+#define TEXTILE_TESTS_TOOLS_RUN_CLI_H_
+
+// Runs the real `textile` executable and captures what a user would see.
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace textile::testing {
+
+struct CliResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+inline std::string ReadAll(const std::filesystem::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// A fresh scratch folder under the build tree, unique per test name.
+inline std::filesystem::path Scratch(const std::string& name) {
+  const auto d = std::filesystem::path(TEXTILE_BINARY_DIR) / "test_scratch" / name;
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+// args: everything after `textile`, already shell-quoted where needed. Runs from the source
+// root so that sample paths read as in the README.
+inline CliResult RunTextile(const std::string& args, const std::string& tag = "run") {
+  const auto d = std::filesystem::path(TEXTILE_BINARY_DIR) / "test_scratch" / "cli_io";
+  std::filesystem::create_directories(d);
+  const std::string out = (d / (tag + ".out")).string(), err = (d / (tag + ".err")).string();
+  const std::string cmd = std::string("cd '") + TEXTILE_SOURCE_DIR + "' && timeout 120 '" +
+                          TEXTILE_EXE + "' " + args + " > '" + out + "' 2> '" + err + "' < /dev/null";
+  const int status = std::system(cmd.c_str());
+  CliResult r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = ReadAll(out);
+  r.err = ReadAll(err);
+  return r;
+}
+
+inline int CountLines(const std::string& s) {
+  int n = 0;
+  for (char c : s) n += c == '\n';
+  return n;
+}
+
+}  // namespace textile::testing
+
+#endif  // TEXTILE_TESTS_TOOLS_RUN_CLI_H_

@@ -1,0 +1,183 @@
+// textile law: inspect a material's bending law (κ0, M0, M and B at given curvatures) and
+// plot M-κ and B-κ.
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <optional>
+
+#include "common/atomic_file.h"
+#include "common/chart.h"
+#include "common/cli.h"
+#include "textile/sim/error.h"
+#include "textile/sim/material.h"
+#include "textile/sim/units.h"
+
+namespace textile::cli {
+namespace {
+
+struct LawArgs {
+  std::string material;
+  std::vector<double> kappa;     // as given, in kappa_unit
+  std::string kappa_unit = "cm";  // "cm": 1/cm (KES); "m": 1/m
+  std::string plot;
+  bool json = false;
+};
+
+nlohmann::json PointJson(const BendingLaw& law, double k) {
+  return {{"kappa_per_m", k},
+          {"kappa_per_cm", units::SiCurvatureToKes(k)},
+          {"M_N", law.Moment(k)},
+          {"M_gfcm_per_cm", units::SiMomentToKes(law.Moment(k))},
+          {"B_Nm", law.Stiffness(k)},
+          {"B_gfcm", units::SiStiffnessToKes(law.Stiffness(k))},
+          {"branch", std::abs(k) <= law.kappa0() ? "quadratic" : "linear"}};
+}
+
+nlohmann::json LawJson(const BendingLaw& law, const std::vector<double>& kappas) {
+  nlohmann::json j = {
+      {"b1_gfcm", law.b1_kes()}, {"b2_gfcm", law.b2_kes()}, {"c1_gfcm2", law.c1_kes()},
+      {"b1_Nm", law.b1()}, {"b2_Nm", law.b2()}, {"c1_Nm2", law.c1()},
+      // JSON has no infinity: κ0 = ∞ (c1 = 0) is written as null with a flag.
+      {"kappa0_per_m", std::isfinite(law.kappa0()) ? nlohmann::json(law.kappa0()) : nlohmann::json()},
+      {"kappa0_per_cm", std::isfinite(law.kappa0())
+                            ? nlohmann::json(units::SiCurvatureToKes(law.kappa0()))
+                            : nlohmann::json()},
+      {"kappa0_infinite", std::isinf(law.kappa0())},
+      {"M0_N", law.moment0()},
+      {"M0_gfcm_per_cm", units::SiMomentToKes(law.moment0())}};
+  j["points"] = nlohmann::json::array();
+  for (double k : kappas) j["points"].push_back(PointJson(law, k));
+  return j;
+}
+
+void PrintLawText(const std::string& title, const BendingLaw& law, const std::vector<double>& kappas) {
+  std::cout << title << ": b1 = " << Num(law.b1_kes()) << " gf·cm, b2 = " << Num(law.b2_kes())
+            << " gf·cm, c1 = " << Num(law.c1_kes()) << " gf·cm²   (SI: " << Num(law.b1()) << ", "
+            << Num(law.b2()) << " N·m, " << Num(law.c1()) << " N·m²)\n";
+  if (law.kappa0() == 0.0) {
+    std::cout << "  kappa0 = 0 (b1 = b2): linear law M = b2 kappa\n";
+  } else if (std::isinf(law.kappa0())) {
+    std::cout << "  kappa0 = inf (c1 = 0): linear law M = b1 kappa\n";
+  } else {
+    std::cout << "  kappa0 = " << Num(units::SiCurvatureToKes(law.kappa0())) << " /cm ("
+              << Num(law.kappa0()) << " /m), M0 = " << Num(units::SiMomentToKes(law.moment0()))
+              << " gf·cm/cm (" << Num(law.moment0()) << " N)\n";
+  }
+  std::printf("  %10s %10s %14s %12s %12s %12s  %s\n", "κ [1/cm]", "κ [1/m]", "M [gf·cm/cm]",
+              "M [N]", "B [gf·cm]", "B [N·m]", "branch");
+  for (double k : kappas) {
+    std::printf("  %10.4g %10.4g %14.6g %12.5g %12.6g %12.5g  %s\n", units::SiCurvatureToKes(k), k,
+                units::SiMomentToKes(law.Moment(k)), law.Moment(k),
+                units::SiStiffnessToKes(law.Stiffness(k)), law.Stiffness(k),
+                std::abs(k) <= law.kappa0() ? "quadratic" : "linear");
+  }
+  std::cout.flush();
+}
+
+void Plot(const Material& m, double kappa_max, const std::string& path) {
+  namespace chart = textile::chart;
+  chart::Panel mk{.title = "Moment-curvature", .x_label = "κ [1/cm]", .y_label = "M [gf·cm/cm]"};
+  chart::Panel bk{.title = "Bending stiffness", .x_label = "κ [1/cm]", .y_label = "B = dM/dκ [gf·cm]"};
+  std::vector<std::pair<std::string, BendingLaw>> laws = {
+      {m.bending_weft ? "warp" : "law", m.EffectiveLaw()}};
+  if (m.bending_weft) laws.emplace_back("weft", m.EffectiveWeftLaw());
+  constexpr int kSamples = 400;
+  for (const auto& [label, law] : laws) {
+    chart::Series sm{.label = label}, sb{.label = label};
+    for (int i = 0; i <= kSamples; ++i) {
+      const double k = kappa_max * i / kSamples;
+      sm.x.push_back(units::SiCurvatureToKes(k));
+      sm.y.push_back(units::SiMomentToKes(law.Moment(k)));
+      sb.x.push_back(units::SiCurvatureToKes(k));
+      sb.y.push_back(units::SiStiffnessToKes(law.Stiffness(k)));
+    }
+    const auto color = chart::PaletteColor(static_cast<int>(mk.series.size() / 2));
+    sm.color = sb.color = color;
+    mk.series.push_back(sm);
+    bk.series.push_back(sb);
+    if (law.kappa0() > 0.0 && law.kappa0() <= kappa_max) {
+      const double k0 = law.kappa0();
+      chart::Series p{.label = "κ0 (" + label + ")",
+                      .x = {units::SiCurvatureToKes(k0)},
+                      .y = {units::SiMomentToKes(law.Moment(k0))},
+                      .style = chart::Series::Style::kMarkers,
+                      .color = color};
+      mk.series.push_back(p);
+      p.y = {units::SiStiffnessToKes(law.Stiffness(k0))};
+      bk.series.push_back(p);
+    }
+    mk.notes.push_back(label + ": b1 = " + Num(law.b1_kes(), 4) + ", b2 = " + Num(law.b2_kes(), 4) +
+                       " gf·cm, c1 = " + Num(law.c1_kes(), 4) + " gf·cm²");
+  }
+  if (m.beta != 1.0) mk.notes.push_back("β = " + Num(m.beta) + " applied");
+  bk.y_range = chart::Range{0.0, 0.0};  // set below: B from 0 so that ratios read true
+  double b_max = 0.0;
+  for (const auto& s : bk.series)
+    for (double v : s.y) b_max = std::max(b_max, v);
+  bk.y_range = chart::Range{0.0, 1.15 * b_max};
+  chart::WritePng({.title = (m.name.empty() ? "Bending law" : m.name) + "  (" +
+                            Num(units::SiToGsm(m.areal_density)) + " g/m²)",
+                   .width_px = 1200,
+                   .height_px = 560,
+                   .columns = 2,
+                   .panels = {mk, bk}},
+                  path);
+}
+
+void Run(const LawArgs& a) {
+  const Material m = ReadMaterial(a.material);
+  std::vector<double> kappas;
+  for (double k : a.kappa) {
+    if (!std::isfinite(k)) throw InputError("--kappa: values must be finite numbers");
+    if (std::abs(k) > 1e6) throw InputError("--kappa: " + Num(k) + " is beyond any textile curvature");
+    kappas.push_back(a.kappa_unit == "cm" ? units::KesCurvatureToSi(k) : k);
+  }
+  const BendingLaw law = m.EffectiveLaw();
+  if (kappas.empty()) {
+    for (double k : {0.25, 0.5, 1.0, 2.0}) kappas.push_back(units::KesCurvatureToSi(k));
+    if (law.kappa0() > 0.0 && std::isfinite(law.kappa0())) kappas.push_back(law.kappa0());
+    std::sort(kappas.begin(), kappas.end());
+  }
+  double kappa_max = units::KesCurvatureToSi(2.0);
+  for (double k : kappas) kappa_max = std::max(kappa_max, std::abs(k));
+  if (std::isfinite(law.kappa0())) kappa_max = std::max(kappa_max, 1.5 * law.kappa0());
+
+  if (!a.plot.empty()) Plot(m, kappa_max, a.plot);
+
+  if (a.json) {
+    nlohmann::json j = {{"material", a.material},
+                        {"name", m.name},
+                        {"areal_density_gsm", units::SiToGsm(m.areal_density)},
+                        {"beta", m.beta},
+                        {"law", LawJson(law, kappas)}};
+    if (m.bending_weft) j["law_weft"] = LawJson(m.EffectiveWeftLaw(), kappas);
+    if (!a.plot.empty()) j["plot"] = a.plot;
+    PrintJson(j);
+    return;
+  }
+  std::cout << "material: " << (m.name.empty() ? a.material : m.name) << "  [" << a.material
+            << "]\nareal density: " << Num(units::SiToGsm(m.areal_density)) << " g/m²"
+            << (m.beta != 1.0 ? ", beta = " + Num(m.beta) + " (applied below)" : "") << "\n";
+  PrintLawText(m.bending_weft ? "warp law" : "law", law, kappas);
+  if (m.bending_weft) PrintLawText("weft law", m.EffectiveWeftLaw(), kappas);
+  if (!a.plot.empty()) std::cout << "plot: " << a.plot << "\n";
+}
+
+}  // namespace
+
+void RegisterLaw(CLI::App& app) {
+  auto args = std::make_shared<LawArgs>();
+  CLI::App* sub = AddSubcommand(
+      app, "law", "Inspect a material's moment-curvature law: kappa0, M0, M and B; plot M-κ and B-κ",
+      "textile law --material samples/materials/pabst-fig8.json --kappa 0.5 1 2 --plot law.png");
+  sub->add_option("-m,--material", args->material, "Material JSON file (cli.md format)")->required();
+  sub->add_option("-k,--kappa", args->kappa, "Curvatures to evaluate (default 0.25 0.5 1 2 /cm and kappa0)");
+  sub->add_option("--kappa-unit", args->kappa_unit, "Unit of --kappa: cm (1/cm, KES; default) or m (1/m)")
+      ->check(CLI::IsMember({"cm", "m"}));
+  sub->add_option("--plot", args->plot, "Write an M-κ / B-κ chart to this PNG file");
+  sub->add_flag("--json", args->json, "Print one JSON object instead of text");
+  sub->callback([args] { Run(*args); });
+}
+
+}  // namespace textile::cli

@@ -1,0 +1,40 @@
+#ifndef TEXTILE_TOOLS_COMMON_CLI_H_
+#define TEXTILE_TOOLS_COMMON_CLI_H_
+
+// What every subcommand shares: registration, the --json flag, printing, exit codes.
+// Conventions (cli.md): human-readable text on stdout, or one JSON object with --json;
+// errors are one line "error: ..." on stderr with exit 2 (bad input, usage) or 3 (a
+// computation failed). Subcommands throw InputError / ComputeError; main() maps them.
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace textile::cli {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitBadInput = 2;
+inline constexpr int kExitComputeFailed = 3;
+
+// Adds a subcommand with a one-line description and an example for --help.
+CLI::App* AddSubcommand(CLI::App& app, const std::string& name, const std::string& description,
+                        const std::string& example);
+
+// Prints one JSON object on stdout (pretty, newline-terminated).
+void PrintJson(const nlohmann::json& j);
+
+// Compact number for people: 6 significant digits, no trailing zeros.
+std::string Num(double v, int digits = 6);
+
+// Progress/info line on stderr (never on stdout, which may carry JSON).
+void Info(const std::string& line);
+
+// Each subcommand registers itself here (one file each: tools/cmd_<name>.cc).
+void RegisterLaw(CLI::App& app);
+void RegisterFit(CLI::App& app);
+void RegisterBench(CLI::App& app);
+void RegisterSynth(CLI::App& app);
+
+}  // namespace textile::cli
+
+#endif  // TEXTILE_TOOLS_COMMON_CLI_H_

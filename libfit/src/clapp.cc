@@ -168,9 +168,10 @@ ClappProfileFit FitClappProfile(const Profile& profile, double areal_density,
   Eigen::VectorXd rhs(n);
   for (int i = 0; i < n; ++i) {
     const double t = r[i] / r_tip;
+    const double w = options.weighting == ClappWeighting::kRadius ? t : 1.0;
     double power = 1.0;
-    for (int k = 0; k <= order; ++k, power *= t) vandermonde(i, k) = power;
-    rhs(i) = phi[i];
+    for (int k = 0; k <= order; ++k, power *= t) vandermonde(i, k) = w * power;
+    rhs(i) = w * phi[i];
   }
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(vandermonde);
   if (qr.rank() < order + 1) {
@@ -258,11 +259,15 @@ ClappResult FitClapp(const std::vector<Profile>& profiles, double areal_density,
     sum_kk += p.kappa * p.kappa;
   }
   const double linear_stiffness = sum_kk > 0.0 ? sum_km / sum_kk : 0.0;  // M ≈ B κ [N·m]
-  if (!(moment_max > 0.0) || !(result.kappa_max > 0.0) || !(linear_stiffness > 0.0) ||
-      !std::isfinite(linear_stiffness)) {
-    result.message = "Clapp fit: the profiles show no usable bending (largest curvature " +
-                     std::to_string(units::SiCurvatureToKes(result.kappa_max)) +
-                     " /cm); no law fitted";
+  if (!(moment_max > 0.0) || !(result.kappa_max > 0.0)) {
+    result.message = "Clapp fit: the profiles show no bending; no law fitted";
+    return result;
+  }
+  if (!(linear_stiffness > 0.0) || !std::isfinite(linear_stiffness)) {
+    result.message =
+        "Clapp fit: moment and curvature of the polynomial curves do not increase together "
+        "(the polynomial does not follow the strip; noisy points near the edge? see "
+        "ClappOptions::min_radius); no law fitted";
     return result;
   }
 
@@ -304,6 +309,17 @@ ClappResult FitClapp(const std::vector<Profile>& profiles, double areal_density,
   solver_options.parameter_tolerance = 1e-12;
   solver_options.logging_type = ceres::SILENT;
 
+  // Bounds: κ0 where a law differs from its limits (law_parameters.h); b1, b2 within 1e6 of
+  // the linear fit either way, far outside any plausible answer but keeping exp() finite.
+  const double log_b = std::log(linear_stiffness), log_range = std::log(1e6);
+  const std::array<double, 3> lower = {log_b - log_range, log_b - log_range,
+                                       std::log(internal::kMinKappa0)};
+  const std::array<double, 3> upper = {log_b + log_range, log_b + log_range,
+                                       std::log(internal::kMaxKappa0)};
+  for (auto& start : starts) {
+    for (int k = 0; k < 3; ++k) start[k] = std::clamp(start[k], lower[k], upper[k]);
+  }
+
   std::array<double, 3> best{};
   double best_cost = std::numeric_limits<double>::infinity();
   std::string last_failure;
@@ -319,13 +335,16 @@ ClappResult FitClapp(const std::vector<Profile>& profiles, double areal_density,
               new internal::ClappLawCost(pt.kappa, pt.moment, moment_max)),
           loss, p.data());
     }
-    // κ0 stays where a law with that κ0 differs from its limits (law_parameters.h).
-    problem.SetParameterLowerBound(p.data(), 2, std::log(internal::kMinKappa0));
-    problem.SetParameterUpperBound(p.data(), 2, std::log(internal::kMaxKappa0));
+    for (int k = 0; k < 3; ++k) {
+      problem.SetParameterLowerBound(p.data(), k, lower[k]);
+      problem.SetParameterUpperBound(p.data(), k, upper[k]);
+    }
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
     const bool finite = std::all_of(p.begin(), p.end(), [](double v) { return std::isfinite(v); });
-    if (!summary.IsSolutionUsable() || !finite) {
+    // A start that runs out of iterations is not trusted (max_iterations is generous for
+    // three parameters); another start usually converges.
+    if (summary.termination_type != ceres::CONVERGENCE || !finite) {
       last_failure = summary.message;
       continue;
     }
@@ -353,26 +372,34 @@ ClappResult FitClapp(const std::vector<Profile>& profiles, double areal_density,
   result.b2_observed = law.kappa0() < result.kappa_max;
 
   // Covariance of p from (JᵀJ)⁻¹ scaled by the residual variance (the pairs carry no
-  // individual uncertainties), then first-order propagation to {b1, b2, c1}.
+  // individual uncertainties), then first-order propagation to {b1, b2, c1}. Three
+  // parameters: J comes from the same functor on Jets, and a near-singular JᵀJ (a constant
+  // the data do not determine) or a parameter on its bound means "unavailable".
   result.sd_b1 = result.sd_b2 = result.sd_c1 = kNaN;
   {
-    std::array<double, 3> p = best;
-    ceres::Problem problem;
+    using Jet = ceres::Jet<double, 3>;
+    const Jet p_jet[3] = {Jet(best[0], 0), Jet(best[1], 1), Jet(best[2], 2)};
+    Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
     for (const ClappPoint& pt : result.points) {
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<internal::ClappLawCost, 1, 3>(
-                                   new internal::ClappLawCost(pt.kappa, pt.moment, moment_max)),
-                               nullptr, p.data());
+      Jet residual;
+      internal::ClappLawCost(pt.kappa, pt.moment, moment_max)(p_jet, &residual);
+      jtj += residual.v * residual.v.transpose();
     }
-    ceres::Covariance::Options cov_options;
-    cov_options.algorithm_type = ceres::DENSE_SVD;
-    ceres::Covariance covariance(cov_options);
-    std::vector<std::pair<const double*, const double*>> blocks = {{p.data(), p.data()}};
-    Eigen::Matrix3d cov_p;
-    if (num_points > 3 && covariance.Compute(blocks, &problem) &&
-        covariance.GetCovarianceBlock(p.data(), p.data(), cov_p.data())) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(jtj);
+    const Eigen::Vector3d lambda = eigen.eigenvalues();  // ascending
+    bool on_bound = false;
+    for (int k = 0; k < 3; ++k) {
+      on_bound = on_bound || best[k] <= lower[k] + 1e-9 || best[k] >= upper[k] - 1e-9;
+    }
+    // Reciprocal condition of JᵀJ: below 1e-12 the standard deviations would exceed the
+    // values by orders of magnitude and mean nothing.
+    constexpr double kMinReciprocalCondition = 1e-12;
+    if (num_points > 3 && !on_bound && lambda(0) > kMinReciprocalCondition * lambda(2)) {
       const double variance = Sq(result.moment_rms / moment_max) * num_points / (num_points - 3);
-      cov_p *= variance;
-      const double b1 = law.b1(), b2 = law.b2(), k0 = std::exp(p[2]);
+      const Eigen::Matrix3d cov_p = variance * eigen.eigenvectors() *
+                                    lambda.cwiseInverse().asDiagonal() *
+                                    eigen.eigenvectors().transpose();
+      const double b1 = law.b1(), b2 = law.b2(), k0 = std::exp(best[2]);
       const Eigen::Vector3d grad_b1(b1, 0.0, 0.0), grad_b2(0.0, b2, 0.0);
       // c1 = (e^{p1} - e^{p0}) / (2 e^{p2}).
       const Eigen::Vector3d grad_c1(-b1 / (2.0 * k0), b2 / (2.0 * k0), -(b2 - b1) / (2.0 * k0));

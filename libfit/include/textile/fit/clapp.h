@@ -35,9 +35,18 @@ namespace textile {
 // Robust loss on the moment residuals. Clapp et al. used ordinary least squares (kNone).
 enum class ClappLoss { kNone, kHuber, kCauchy };
 
+// Weights of the digitised points in the least-squares polynomial φ(r).
+//   kUniform: every point's angle residual φ_i - φ(r_i) counts alike ("standard least
+//             squares", Pabst et al. 3.1), so a position error σ weighs σ / r near the edge.
+//   kRadius:  residuals r_i (φ_i - φ(r_i)), i.e. the distance across the curve; the same
+//             polynomial family, weighted as position noise actually is. Not Clapp's.
+enum class ClappWeighting { kUniform, kRadius };
+
 struct ClappOptions {
   // Order of the polynomial φ(r) [-]; Clapp et al. used 5.
   int polynomial_order = 5;
+  // Weights of the polynomial fit (see ClappWeighting); Clapp et al.: uniform.
+  ClappWeighting weighting = ClappWeighting::kUniform;
   // (κ, M) pairs taken per profile, evenly spaced in arc length along the smooth curve from
   // the edge (s = 0) to the end of the evaluated range [-]; ≥ 3.
   int points_per_profile = 50;
@@ -46,9 +55,11 @@ struct ClappOptions {
   // curve: nothing in the method's published summary says Clapp et al. dropped the tip.
   double tip_exclusion = 0.0;
   // Digitised points closer to the edge than this are not used for the polynomial [m], ≥ 0.
-  // The polar angle is undefined at r = 0 (such points are always dropped) and a position
-  // error σ becomes an angle error σ / r close to the edge.
-  double min_radius = 0.0;
+  // The polar angle is undefined at r = 0 (such points are always dropped), and a position
+  // error σ becomes an angle error σ / r near the edge: with uniform weights, 0.1 mm of noise
+  // on points within 1 mm of the edge ruins the whole fit (docs/clapp.md). A hand digitiser
+  // would not pick points there either; 3 mm was the best of 0-5 mm in our study.
+  double min_radius = 3e-3;
   // Robust loss on the (scaled) moment residuals, and its scale as a fraction of the largest
   // observed moment (> 0; ignored for kNone).
   ClappLoss loss = ClappLoss::kNone;

@@ -1,5 +1,8 @@
 #include "textile/fit/clapp.h"
 
+#include <ceres/ceres.h>
+
+#include <Eigen/Dense>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -7,9 +10,6 @@
 #include <limits>
 #include <memory>
 #include <sstream>
-
-#include <Eigen/Dense>
-#include <ceres/ceres.h>
 
 #include "cost_functions/clapp_law_cost.h"
 #include "law_parameters.h"
@@ -38,9 +38,9 @@ class PolarCurve {
       : c_(std::move(coefficients)), r_scale_(r_scale) {}
 
   struct Point {
-    double x, y;    // position [m]
-    double speed;   // ds/dr [-]
-    double kappa;   // curvature [1/m], positive when turning downwards (clockwise)
+    double x, y;   // position [m]
+    double speed;  // ds/dr [-]
+    double kappa;  // curvature [1/m], positive when turning downwards (clockwise)
   };
 
   // φ and its first two derivatives with respect to r, by Horner's rule in t = r / r_scale.
@@ -211,10 +211,11 @@ ClappProfileFit FitClappProfile(const Profile& profile, double areal_density,
   if (points != nullptr) points->clear();
   for (int j = 0; j < count; ++j) {
     const double s_target = s_end * j / (count - 1);
-    const int k = std::clamp(
-        static_cast<int>(std::upper_bound(panel_s.begin(), panel_s.end(), s_target) -
-                         panel_s.begin()) - 1,
-        0, kPanels - 1);
+    const int k =
+        std::clamp(static_cast<int>(std::upper_bound(panel_s.begin(), panel_s.end(), s_target) -
+                                    panel_s.begin()) -
+                       1,
+                   0, kPanels - 1);
     // Newton on s(r) = s_target inside panel k (s is increasing, ds/dr = speed ≥ 1).
     const double a = panel_r[k], b = panel_r[k + 1];
     double rj = a + (b - a) * (s_target - panel_s[k]) / (panel_s[k + 1] - panel_s[k]);
@@ -330,10 +331,9 @@ ClappResult FitClapp(const std::vector<Profile>& profiles, double areal_density,
       ceres::LossFunction* loss = nullptr;
       if (options.loss == ClappLoss::kHuber) loss = new ceres::HuberLoss(options.loss_scale);
       if (options.loss == ClappLoss::kCauchy) loss = new ceres::CauchyLoss(options.loss_scale);
-      problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<internal::ClappLawCost, 1, 3>(
-              new internal::ClappLawCost(pt.kappa, pt.moment, moment_max)),
-          loss, p.data());
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<internal::ClappLawCost, 1, 3>(
+                                   new internal::ClappLawCost(pt.kappa, pt.moment, moment_max)),
+                               loss, p.data());
     }
     for (int k = 0; k < 3; ++k) {
       problem.SetParameterLowerBound(p.data(), k, lower[k]);
@@ -354,8 +354,8 @@ ClappResult FitClapp(const std::vector<Profile>& profiles, double areal_density,
     }
   }
   if (!std::isfinite(best_cost)) {
-    result.message = "Clapp fit: the regression of eq. 1 failed from every start (" +
-                     last_failure + ")";
+    result.message =
+        "Clapp fit: the regression of eq. 1 failed from every start (" + last_failure + ")";
     return result;
   }
   try {
@@ -435,8 +435,7 @@ std::string ClappResult::BriefReport() const {
   for (const ClappProfileFit& p : profiles) {
     out << "  " << p.source << ": order-" << (p.coefficients.size() - 1) << " polynomial on "
         << p.points_used << " points, RMS " << units::MToMm(p.residual_rms) << " mm, length "
-        << units::MToMm(p.curve_length) << " mm (data " << units::MToMm(p.data_length)
-        << " mm)\n";
+        << units::MToMm(p.curve_length) << " mm (data " << units::MToMm(p.data_length) << " mm)\n";
   }
   if (!success || !law) {
     out << "  no law: " << message;

@@ -44,7 +44,8 @@ Profile SyntheticProfile(const BendingLaw& law, double areal_density, double ove
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   for (int i = 0; i < n; ++i) {
     double s = spacing * i;
-    if (i > 0 && i < n - 1 && options.arc_jitter > 0.0) s += options.arc_jitter * spacing * unit(rng);
+    if (i > 0 && i < n - 1 && options.arc_jitter > 0.0)
+      s += options.arc_jitter * spacing * unit(rng);
     elastica_options.arc_lengths[i] = s;
   }
   elastica_options.arc_lengths.back() = overhang;
@@ -77,8 +78,8 @@ Profile SyntheticProfile(const BendingLaw& law, double areal_density, double ove
   if (options.chord_arc_length) {
     profile.s[0] = 0.0;
     for (int i = 1; i < n; ++i) {
-      profile.s[i] = profile.s[i - 1] + std::hypot(profile.x[i] - profile.x[i - 1],
-                                                   profile.y[i] - profile.y[i - 1]);
+      profile.s[i] = profile.s[i - 1] +
+                     std::hypot(profile.x[i] - profile.x[i - 1], profile.y[i] - profile.y[i - 1]);
     }
   }
   return profile;

@@ -3,10 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdint>
-#include <string>
 #include <cmath>
+#include <cstdint>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "textile/fit/law_error.h"
@@ -64,7 +64,8 @@ TEST(ClappPolynomial, RecoversExactPolarPolynomial) {
   EXPECT_NEAR(fit.kappa_at_edge, 2.0 * c[1] / r_max, 1e-9);
   EXPECT_EQ(points.size(), 50u);
   // The default min_radius (3 mm) drops r = 0.83, 1.7 and 2.5 mm; the curve is the same.
-  const ClappProfileFit near_dropped = FitClappProfile(PolarProfile(phi, r_max, 60), kRho, {}, nullptr);
+  const ClappProfileFit near_dropped =
+      FitClappProfile(PolarProfile(phi, r_max, 60), kRho, {}, nullptr);
   EXPECT_EQ(near_dropped.points_used, 57);
   for (size_t k = 0; k < c.size(); ++k) {
     EXPECT_NEAR(near_dropped.coefficients[k], c[k], kCoefficientTol);
@@ -95,9 +96,9 @@ TEST(ClappPolynomial, CircularArcGivesItsCurvatureAndMoment) {
   // φ(r) = asin(r / 2a) is not a polynomial: up to r = a the order-5 fit leaves ~1e-5 rad.
   const double a = 0.05, r_max = 0.05;
   std::vector<ClappPoint> points;
-  const ClappProfileFit fit = FitClappProfile(
-      PolarProfile([&](double r) { return std::asin(r / (2 * a)); }, r_max, 100), kRho, {},
-      &points);
+  const ClappProfileFit fit =
+      FitClappProfile(PolarProfile([&](double r) { return std::asin(r / (2 * a)); }, r_max, 100),
+                      kRho, {}, &points);
   const double length = 2.0 * a * std::asin(r_max / (2 * a));
   const double kLengthTol = 5e-6;     // relative; the polynomial's angle error, measured 1.2e-6
   const double kCurvatureTol = 5e-3;  // relative; order-5 fit of asin, measured 1.9e-3 at the ends
@@ -105,7 +106,8 @@ TEST(ClappPolynomial, CircularArcGivesItsCurvatureAndMoment) {
   EXPECT_NEAR(fit.curve_length, length, kLengthTol * length);
   const double w = kRho * units::kGravity;
   const auto moment = [&](double s) {
-    return w * (a * a * (std::cos(s / a) - std::cos(length / a)) - a * std::sin(s / a) * (length - s));
+    return w *
+           (a * a * (std::cos(s / a) - std::cos(length / a)) - a * std::sin(s / a) * (length - s));
   };
   for (const ClappPoint& p : points) {
     EXPECT_NEAR(p.kappa, 1.0 / a, kCurvatureTol / a) << "at s = " << p.s;
@@ -174,8 +176,7 @@ TEST(ClappFit, PaperFig8NoiseFree) {
   ASSERT_TRUE(r.success) << r.message;
   ExpectValidOrAbsent(r);
   const double kFig8NoiseFreeTol = 0.015;
-  EXPECT_LT(MomentCurveError(*r.law, law, TrueKappaMax(law)), kFig8NoiseFreeTol)
-      << r.BriefReport();
+  EXPECT_LT(MomentCurveError(*r.law, law, TrueKappaMax(law)), kFig8NoiseFreeTol) << r.BriefReport();
   ASSERT_EQ(r.points.size(), 150u);  // 3 profiles × 50 pairs, pooled in order
   EXPECT_EQ(r.points.front().profile, 0);
   EXPECT_EQ(r.points.back().profile, 2);

@@ -28,9 +28,9 @@ TEST(MomentCurveError, ScaledLinearLawHasClosedForm) {
 TEST(MomentCurveError, MatchesDenseSamplingAcrossKinks) {
   // Both laws have κ0 inside [0, κmax]; a fine midpoint rule (error O(h²) ~ 1e-9 at 2e5
   // cells, worse at the kinks) checks the piecewise Gauss-Legendre.
-  const auto truth = BendingLaw::FromKes(0.1, 0.0892, -0.0092);   // κ0 = 0.587 /cm
-  const auto fit = BendingLaw::FromKes(0.11, 0.085, -0.02);       // κ0 = 0.625 /cm
-  const double kappa_max = 150.0;                                  // 1.5 /cm
+  const auto truth = BendingLaw::FromKes(0.1, 0.0892, -0.0092);  // κ0 = 0.587 /cm
+  const auto fit = BendingLaw::FromKes(0.11, 0.085, -0.02);      // κ0 = 0.625 /cm
+  const double kappa_max = 150.0;                                // 1.5 /cm
   const int cells = 200000;
   double sum = 0.0;
   for (int i = 0; i < cells; ++i) {

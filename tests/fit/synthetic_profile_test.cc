@@ -11,8 +11,8 @@
 namespace textile {
 namespace {
 
-constexpr double kRho = 0.2;         // 200 g/m² [kg/m²]
-constexpr double kOverhang = 0.06;   // [m]
+constexpr double kRho = 0.2;        // 200 g/m² [kg/m²]
+constexpr double kOverhang = 0.06;  // [m]
 const BendingLaw kFig8 = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
 
 TEST(SyntheticProfile, NoiseFreeMatchesElastica) {

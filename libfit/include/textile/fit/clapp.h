@@ -58,7 +58,7 @@ struct ClappOptions {
   // The polar angle is undefined at r = 0 (such points are always dropped), and a position
   // error σ becomes an angle error σ / r near the edge: with uniform weights, 0.1 mm of noise
   // on points within 1 mm of the edge ruins the whole fit (docs/clapp.md). A hand digitiser
-  // would not pick points there either; 3 mm was the best of 0-5 mm in our study.
+  // would not pick points there either; 3 and 5 mm did best of 0-5 mm in our study.
   double min_radius = 3e-3;
   // Robust loss on the (scaled) moment residuals, and its scale as a fraction of the largest
   // observed moment (> 0; ignored for kNone).
@@ -84,14 +84,14 @@ struct ClappPoint {
 
 // The smooth curve of one profile: φ(r) = Σ_k coefficients[k] (r / r_scale)^k [rad].
 struct ClappProfileFit {
-  std::string source;                 // Profile::source, for messages
-  std::vector<double> coefficients;   // #(order + 1) polynomial coefficients [rad], in r / r_scale
-  double r_scale = 0.0;               // distance of the tip (last point) from the edge [m]
-  int points_used = 0;                // digitised points that entered the polynomial
-  double residual_rms = 0.0;          // RMS of r_i (φ_i - φ(r_i)), data vs curve [m]
-  double curve_length = 0.0;          // arc length of the smooth curve to r_scale [m]
-  double data_length = 0.0;           // the profile's last s [m], for comparison
-  double kappa_at_edge = 0.0;         // curvature of the smooth curve at r = 0 [1/m]
+  std::string source;                // Profile::source, for messages
+  std::vector<double> coefficients;  // #(order + 1) polynomial coefficients [rad], in r / r_scale
+  double r_scale = 0.0;              // distance of the tip (last point) from the edge [m]
+  int points_used = 0;               // digitised points that entered the polynomial
+  double residual_rms = 0.0;         // RMS of r_i (φ_i - φ(r_i)), data vs curve [m]
+  double curve_length = 0.0;         // arc length of the smooth curve to r_scale [m]
+  double data_length = 0.0;          // the profile's last s [m], for comparison
+  double kappa_at_edge = 0.0;        // curvature of the smooth curve at r = 0 [1/m]
 
   // φ(r) [rad] at distance r [m] from the edge.
   double Phi(double r) const;
@@ -99,8 +99,8 @@ struct ClappProfileFit {
 
 struct ClappResult {
   bool success = false;
-  std::string message;                // what went wrong, or notes on a successful fit
-  std::optional<BendingLaw> law;      // the fitted law; set iff success
+  std::string message;            // what went wrong, or notes on a successful fit
+  std::optional<BendingLaw> law;  // the fitted law; set iff success
   // 1-σ standard deviations of b1, b2 [N·m] and c1 [N·m²], propagated from the covariance of
   // (ln b1, ln b2, ln κ0) scaled by the residual variance. NaN when unavailable (rank
   // deficient: e.g. a linear law, or κ0 beyond the data); then covariance_available = false.
@@ -112,8 +112,8 @@ struct ClappResult {
   double kappa_max = 0.0;
   // True when κ0 < kappa_max, i.e. the data reach the linear branch and constrain b2.
   bool b2_observed = false;
-  double moment_rms = 0.0;            // RMS of M_law(κ_i) - M_i over the pairs [N]
-  std::vector<ClappPoint> points;     // the pooled (κ, M) pairs, profile by profile
+  double moment_rms = 0.0;                // RMS of M_law(κ_i) - M_i over the pairs [N]
+  std::vector<ClappPoint> points;         // the pooled (κ, M) pairs, profile by profile
   std::vector<ClappProfileFit> profiles;  // one per input profile, same order
 
   // A few lines for people: constants in KES units with 1-σ, κ range, residuals.

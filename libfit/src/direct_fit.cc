@@ -1,0 +1,338 @@
+#include "textile/fit/direct_fit.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+#include <sstream>
+
+#include "cost_functions/profile_model.h"
+#include "law_parameters.h"
+#include "textile/sim/error.h"
+#include "textile/sim/units.h"
+
+namespace textile {
+namespace {
+
+using internal::ProfileModel;
+
+// A constant whose 1-σ exceeds this fraction of its value is "not determined by the data".
+constexpr double kUndeterminedRelSd = 0.5;
+
+// Weight of the prior [mm per unit of ln b or ln κ0].
+constexpr double kPriorWeight = 1e-2;
+
+class LawPrior : public ceres::SizedCostFunction<2, 3> {
+ public:
+  LawPrior(double weight, double log_kappa_ref) : w_(weight), log_kappa_ref_(log_kappa_ref) {}
+  bool Evaluate(double const* const* p, double* r, double** jac) const override {
+    r[0] = w_ * (p[0][1] - p[0][0]);
+    r[1] = w_ * (p[0][2] - log_kappa_ref_);
+    if (jac && jac[0]) {
+      const double j[6] = {-w_, w_, 0.0, 0.0, 0.0, w_};
+      std::copy(j, j + 6, jac[0]);
+    }
+    return true;
+  }
+
+ private:
+  double w_, log_kappa_ref_;
+};
+
+[[maybe_unused]] double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string Mm(double m) {
+  std::ostringstream s;
+  s.precision(3);
+  s << std::fixed << m * 1e3 << " mm";
+  return s.str();
+}
+
+}  // namespace
+
+bool DirectFitOptions::Check(std::string* why) const {
+  const auto fail = [&](const std::string& w) {
+    if (why) *why = w;
+    return false;
+  };
+  if (!std::isfinite(offset) || std::abs(offset) > 0.01) return fail("offset must be finite and within ±10 mm");
+  if (!(robust_scale >= 0.0) || !std::isfinite(robust_scale)) return fail("robust_scale must be >= 0");
+  if (curve_samples < 11 || curve_samples > 10001) return fail("curve_samples must lie in [11, 10001]");
+  if (!(elastica_tol >= 1e-14 && elastica_tol <= 1e-4)) return fail("elastica_tol must lie in [1e-14, 1e-4]");
+  if (max_iterations < 1) return fail("max_iterations must be >= 1");
+  if (!(max_seconds > 0.0)) return fail("max_seconds must be > 0");
+  if (!(outlier_profile_rms > 0.0)) return fail("outlier_profile_rms must be > 0");
+  return true;
+}
+
+double PeirceStiffnessEstimate(const Profile& p, double areal_density) {
+  // Peirce (1930): c = L (cos(θc/2) / (8 tan θc))^(1/3), θc the chord angle to the tip;
+  // G = ρ g c³. Only a starting point, so the angle is kept where the formula is sane.
+  const double chord = std::atan2(-(p.y.back() - p.y.front()), p.x.back() - p.x.front());
+  const double th = std::clamp(chord, 0.02, 1.45);
+  const double L = p.s.back() - p.s.front();
+  const double c = L * std::cbrt(std::cos(th / 2) / (8 * std::tan(th)));
+  return areal_density * units::kGravity * c * c * c;
+}
+
+std::string DirectFitSummary::BriefReport() const {
+  std::ostringstream s;
+  s.precision(4);
+  if (!converged || !law) return "direct fit failed: " + message;
+  s << "direct fit: b1 = " << law->b1_kes() << " ± " << units::SiStiffnessToKes(b1_sd)
+    << " gf·cm, b2 = " << law->b2_kes() << " ± " << units::SiStiffnessToKes(b2_sd)
+    << " gf·cm, c1 = " << law->c1_kes() << " ± " << units::SiQuadraticToKes(c1_sd)
+    << " gf·cm²; rms " << Mm(rms) << " over " << profiles.size() << " profile(s), "
+    << iterations << " iterations, " << seconds * 1e3 << " ms. " << observability;
+  return s.str();
+}
+
+DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_density,
+                           const DirectFitOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string why;
+  if (!options.Check(&why)) throw InputError("direct fit options: " + why);
+  if (profiles.empty()) throw InputError("direct fit: no profiles given");
+  if (!(areal_density > 0.0) || !std::isfinite(areal_density)) {
+    throw InputError("direct fit: areal density must be a finite number > 0");
+  }
+  for (const Profile& p : profiles) CheckProfile(p);
+
+  // Start: a linear law from Peirce's formula (geometric mean over profiles), κ0 at the
+  // curvature scale 1/c of that law, overhangs from the data.
+  double log_b = 0.0;
+  for (const Profile& p : profiles) log_b += std::log(PeirceStiffnessEstimate(p, areal_density));
+  const double b0 = std::exp(log_b / profiles.size());
+  const double c0 = std::cbrt(b0 / (areal_density * units::kGravity));
+  std::array<double, 3> law_p = {std::log(b0), std::log(b0), std::log(1.0 / c0)};
+  std::vector<double> lengths;
+  for (const Profile& p : profiles) lengths.push_back(p.s.back());
+  std::array<double, 2> rig = {options.fit_offset ? 0.0 : options.offset, 0.0};
+
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  std::vector<std::unique_ptr<ProfileModel>> models;
+  for (size_t i = 0; i < profiles.size(); ++i) {
+    models.push_back(std::make_unique<ProfileModel>(profiles[i], areal_density,
+                                                    options.curve_samples, options.elastica_tol));
+    ProfileModel* m = models.back().get();
+    for (int j = 0; j < m->num_points(); ++j) {
+      ceres::LossFunction* loss = options.robust_scale > 0.0
+                                      ? new ceres::CauchyLoss(options.robust_scale * 1e3)
+                                      : nullptr;
+      problem.AddResidualBlock(new internal::PointResidual(m, j), loss, law_p.data(),
+                               &lengths[i], rig.data());
+    }
+    problem.AddResidualBlock(new internal::TipResidual(m), nullptr, law_p.data(), &lengths[i],
+                             rig.data());
+    problem.SetParameterLowerBound(&lengths[i], 0, 0.2 * profiles[i].s.back());
+    problem.SetParameterUpperBound(&lengths[i], 0, 2.0 * profiles[i].s.back());
+  }
+  // Bounds: b1, b2 within a factor 100 of the start and inside the textile range that material
+  // files accept (1e-5 .. 1e3 gf·cm), κ0 within a factor 1000 of the curvature scale. Without
+  // them, data that no law explains (mixed strips) drive b2 towards 0, a plastic hinge.
+  const double lo_b = std::log(std::max(b0 / 100.0, units::KesStiffnessToSi(1e-5)));
+  const double hi_b = std::log(std::min(b0 * 100.0, units::KesStiffnessToSi(1e3)));
+  for (int k = 0; k < 2; ++k) {
+    law_p[k] = std::clamp(law_p[k], lo_b, hi_b);
+    problem.SetParameterLowerBound(law_p.data(), k, lo_b);
+    problem.SetParameterUpperBound(law_p.data(), k, hi_b);
+  }
+  problem.SetParameterLowerBound(law_p.data(), 2, law_p[2] - std::log(1000.0));
+  problem.SetParameterUpperBound(law_p.data(), 2, law_p[2] + std::log(1000.0));
+  // A weak prior towards a linear law with κ0 at the data's curvature scale: it settles the
+  // directions the data leave free (b1 = b2 makes κ0 free; κ0 beyond the data makes b2 free)
+  // and is negligible elsewhere (1e-2 mm per unit of ln, against hundreds of points whose
+  // residuals move millimetres per unit of ln).
+  problem.AddResidualBlock(new LawPrior(kPriorWeight, law_p[2]), nullptr, law_p.data());
+  if (!options.fit_offset && !options.fit_rotation) {
+    problem.SetParameterBlockConstant(rig.data());
+  } else if (!options.fit_offset || !options.fit_rotation) {
+    problem.SetManifold(rig.data(), new ceres::SubsetManifold(2, {options.fit_offset ? 1 : 0}));
+  }
+
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.max_solver_time_in_seconds = options.max_seconds;
+  solver_options.function_tolerance = 1e-12;
+  solver_options.parameter_tolerance = 1e-12;
+  solver_options.gradient_tolerance = 1e-14;
+  const bool debug = std::getenv("TEXTILE_DEBUG_FIT") != nullptr;
+  solver_options.logging_type = debug ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+  solver_options.minimizer_progress_to_stdout = debug;
+  ceres::Solver::Summary solver_summary;
+  ceres::Solve(solver_options, &problem, &solver_summary);
+
+  DirectFitSummary out;
+  out.iterations = static_cast<int>(solver_summary.iterations.size());
+  const auto finish = [&] {
+    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return out;
+  };
+  if (!solver_summary.IsSolutionUsable() ||
+      solver_summary.termination_type == ceres::NO_CONVERGENCE) {
+    out.message = "the fit did not converge (" + solver_summary.message + ")";
+    return finish();
+  }
+  // Final state, with jacobians, for reports and the covariance.
+  for (size_t i = 0; i < models.size(); ++i) {
+    if (!models[i]->Update(law_p.data(), &lengths[i], rig.data(), true)) {
+      out.message = "the elastica failed at the fitted constants";
+      return finish();
+    }
+  }
+  BendingLaw law = internal::LawFromParameters(law_p.data());
+
+  // Residual statistics per profile (normal distances only).
+  double sum2 = 0.0;
+  int count = 0;
+  std::vector<double> rms_each;
+  for (size_t i = 0; i < models.size(); ++i) {
+    const ProfileModel& m = *models[i];
+    ProfileFitReport r;
+    r.source = profiles[i].source;
+    r.overhang = lengths[i];
+    r.data_length = profiles[i].s.back();
+    double s2 = 0.0;
+    for (int j = 0; j < m.num_points(); ++j) {
+      const double d = m.residual(j) * 1e-3;
+      s2 += d * d;
+      r.max = std::max(r.max, std::abs(d));
+    }
+    sum2 += s2;
+    count += m.num_points();
+    r.rms = std::sqrt(s2 / m.num_points());
+    r.clamp_curvature = m.solution().clamp_curvature;
+    out.kappa_max = std::max(out.kappa_max, r.clamp_curvature);
+    rms_each.push_back(r.rms);
+    out.profiles.push_back(r);
+  }
+  out.rms = std::sqrt(sum2 / count);
+  out.offset = rig[0];
+  out.rotation = rig[1];
+
+  // One law for several profiles that fits badly, while each profile alone fits well, means
+  // the profiles are not of one strip (or one is a bad extraction): refuse rather than average.
+  if (profiles.size() >= 2 && out.rms > options.outlier_profile_rms) {
+    const size_t worst = std::max_element(rms_each.begin(), rms_each.end()) - rms_each.begin();
+    std::vector<double> alone;
+    for (const Profile& p : profiles) {
+      const DirectFitSummary single = FitDirect({p}, areal_density, options);
+      alone.push_back(single.converged ? single.rms : std::numeric_limits<double>::infinity());
+    }
+    if (*std::max_element(alone.begin(), alone.end()) < out.rms / 3.0) {
+      throw InputError(profiles[worst].source + ": the profiles do not fit one law (rms " +
+                       Mm(out.rms) + " together, at most " +
+                       Mm(*std::max_element(alone.begin(), alone.end())) +
+                       " each alone): profiles of different strips, or a bad extraction?");
+    }
+  }
+
+  // Covariance: (JᵀJ)⁺ σ̂² over all free parameters, from the unrobustified Jacobian, with
+  // σ̂² = Σr² / (N - n). Pseudo-inverse, so that an undetermined direction (b1 = b2 makes κ0
+  // free; κ0 beyond the data makes b2 free) shows up as an infinite variance, not a crash.
+  {
+    std::vector<double*> blocks = {law_p.data(), rig.data()};
+    for (double& L : lengths) blocks.push_back(&L);
+    const int n_res = count + 2 * static_cast<int>(models.size());
+    const int n_par = 3 + 2 + static_cast<int>(lengths.size());
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(n_res, n_par);
+    int row = 0;
+    std::vector<int> free_cols = {0, 1, 2};
+    if (options.fit_offset) free_cols.push_back(3);
+    if (options.fit_rotation) free_cols.push_back(4);
+    for (size_t i = 0; i < models.size(); ++i) {
+      free_cols.push_back(5 + static_cast<int>(i));
+      const auto put = [&](const std::array<double, 6>& g) {
+        for (int k = 0; k < 3; ++k) J(row, k) = g[k];
+        J(row, 3) = g[4];
+        J(row, 4) = g[5];
+        J(row, 5 + static_cast<int>(i)) = g[3];
+        ++row;
+      };
+      for (int j = 0; j < models[i]->num_points(); ++j) put(models[i]->gradient(j));
+      put(models[i]->tip_gradient()[0]);
+      put(models[i]->tip_gradient()[1]);
+    }
+    Eigen::MatrixXd Jf(n_res, free_cols.size());
+    for (size_t k = 0; k < free_cols.size(); ++k) Jf.col(k) = J.col(free_cols[k]);
+    const int dof = std::max(1, n_res - static_cast<int>(free_cols.size()));
+    const double sigma2 = sum2 * 1e6 / dof;  // [mm²]: residuals are in mm
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(Jf, Eigen::ComputeThinV);
+    const auto& sv = svd.singularValues();
+    const double cutoff = 1e-8 * sv(0);
+    Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(free_cols.size(), free_cols.size());
+    Eigen::VectorXd null_weight = Eigen::VectorXd::Zero(free_cols.size());
+    for (int k = 0; k < sv.size(); ++k) {
+      const Eigen::VectorXd v = svd.matrixV().col(k);
+      if (sv(k) > cutoff) cov += v * v.transpose() / (sv(k) * sv(k));
+      else null_weight += v.cwiseAbs2();
+    }
+    cov *= sigma2;
+    const Eigen::Matrix3d cov_p = cov.topLeftCorner<3, 3>();
+    const double b1 = law.b1(), b2 = law.b2(), k0 = std::exp(law_p[2]), c1 = law.c1();
+    Eigen::Matrix3d D;  // ∂(b1, b2, c1)/∂(ln b1, ln b2, ln κ0)
+    D << b1, 0, 0, 0, b2, 0, -b1 / (2 * k0), b2 / (2 * k0), -c1;
+    out.covariance = D * cov_p * D.transpose();
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    out.b1_sd = null_weight(0) > 0.5 ? nan : std::sqrt(out.covariance(0, 0));
+    out.b2_sd = null_weight(1) > 0.5 ? nan : std::sqrt(out.covariance(1, 1));
+    out.c1_sd = null_weight(2) > 0.5 && c1 != 0.0 ? nan : std::sqrt(out.covariance(2, 2));
+  }
+
+  // Observability (cantilever.md): which constants the data determine.
+  const double k0 = law.kappa0();
+  const auto undetermined = [](double sd, double v) {
+    return !std::isfinite(sd) || sd > kUndeterminedRelSd * std::abs(v);
+  };
+  out.b2_observed = k0 < out.kappa_max && !undetermined(out.b2_sd, law.b2());
+  out.b1_observed = k0 > 0.02 * out.kappa_max && !undetermined(out.b1_sd, law.b1());
+  out.c1_observed = out.b1_observed && !undetermined(out.c1_sd, law.c1());
+  std::ostringstream obs;
+  obs.precision(4);
+  const double kmax_cm = units::SiCurvatureToKes(out.kappa_max);
+  if (k0 >= out.kappa_max) {
+    // The linear branch is never reached: report the quadratic up to the data's reach and its
+    // last slope beyond, not an invented b2.
+    const double b2_at_max = law.b1() + 2.0 * law.c1() * out.kappa_max;
+    if (b2_at_max > 0.0) {
+      const double raw_b2 = law.b2();
+      law = BendingLaw::FromSi(law.b1(), b2_at_max, law.c1());
+      obs << "b2 is not observed: kappa0 (" << units::SiCurvatureToKes(k0)
+          << " /cm) lies beyond the largest curvature in the data (" << kmax_cm
+          << " /cm); b2 is set to the slope there, " << law.b2_kes() << " gf·cm (the optimiser's "
+          << units::SiStiffnessToKes(raw_b2) << " is arbitrary). ";
+    }
+    out.b2_observed = false;
+    out.b2_sd = std::numeric_limits<double>::quiet_NaN();
+  }
+  if (!out.c1_observed && out.b2_observed) {
+    obs << "The quadratic branch is not resolved (kappa0 " << units::SiCurvatureToKes(k0)
+        << " /cm, b1 = b2 within the data): the data determine M ≈ M0 + b2 κ. ";
+  } else if (!out.b1_observed || !out.c1_observed) {
+    obs << "b1/c1 are poorly determined. ";
+  }
+  if (out.b1_observed && out.b2_observed && out.c1_observed) {
+    obs << "All three constants are determined by the data (curvatures up to " << kmax_cm
+        << " /cm). ";
+  }
+  obs << "The moment curve M(κ) is determined for 0 ≤ κ ≤ " << kmax_cm << " /cm.";
+  out.observability = obs.str();
+  out.law = law;
+  out.converged = true;
+  out.message = "converged (" + solver_summary.message + ")";
+  return finish();
+}
+
+}  // namespace textile

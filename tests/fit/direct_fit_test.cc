@@ -1,0 +1,191 @@
+#include "textile/fit/direct_fit.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "cost_functions/profile_model.h"
+#include "law_parameters.h"
+#include "textile/fit/law_error.h"
+#include "textile/sim/elastica.h"
+#include "textile/sim/error.h"
+#include "textile/sim/units.h"
+
+namespace textile {
+namespace {
+
+// A profile as an extractor would give it: elastica points, optional noise and offset, arc
+// length recomputed from the (noisy) points.
+Profile MakeProfile(const BendingLaw& law, double rho, double L, double noise, double offset,
+                    unsigned seed, int n = 80) {
+  ElasticaOptions o;
+  o.num_samples = n;
+  const ElasticaProfile e = SolveHeavyElastica(law, rho, L, o);
+  EXPECT_TRUE(e.converged) << e.message;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g(0.0, noise);
+  Profile p;
+  p.source = "synthetic L=" + std::to_string(L * 1e3) + "mm";
+  for (int i = 0; i < n; ++i) {
+    p.x.push_back(e.x[i] + (noise > 0 ? g(rng) : 0.0));
+    p.y.push_back(e.y[i] + offset + (noise > 0 ? g(rng) : 0.0));
+    p.s.push_back(i == 0 ? 0.0
+                         : p.s.back() + std::hypot(p.x[i] - p.x[i - 1], p.y[i] - p.y[i - 1]));
+  }
+  return p;
+}
+
+struct Fabric {
+  const char* name;
+  double b1, b2, c1, gsm;
+};
+const Fabric kFig8{"fig8", 0.1, 0.0892, -0.0092, 200};
+const Fabric kDress{"dress", 0.0973, 0.0973, 0.0453, 130};
+const Fabric kInterlining{"interlining", 0.5168, 1.8856, 2.2683, 250};
+
+BendingLaw LawOf(const Fabric& f) { return BendingLaw::FromKes(f.b1, f.b2, f.c1); }
+
+TEST(ProfileModel, JacobianMatchesFiniteDifferences) {
+  const BendingLaw truth = LawOf(kFig8);
+  const Profile data = MakeProfile(truth, 0.2, 0.07, 0.2e-3, 0.4e-3, 3, 40);
+  internal::ProfileModel model(data, 0.2, 121, 1e-11);
+  // Evaluate away from the optimum, with a rotated rig, so that every term matters.
+  const BendingLaw start = BendingLaw::FromKes(0.12, 0.07, -0.02);
+  const auto p0 = internal::ParametersFromLaw(start);
+  double x[6] = {p0[0], p0[1], p0[2], 0.068, 0.2e-3, 0.01};
+  ASSERT_TRUE(model.Update(x, x + 3, x + 4, true));
+  std::vector<double> r0;
+  std::vector<std::array<double, 6>> g0;
+  for (int j = 0; j < model.num_points(); ++j) r0.push_back(model.residual(j)), g0.push_back(model.gradient(j));
+  const auto tip0 = model.tip_residual();
+  const auto tipg = model.tip_gradient();
+  const double steps[6] = {1e-5, 1e-5, 1e-5, 1e-7, 1e-7, 1e-6};
+  for (int k = 0; k < 6; ++k) {
+    double xp[6], xm[6];
+    std::copy(x, x + 6, xp);
+    std::copy(x, x + 6, xm);
+    xp[k] += steps[k];
+    xm[k] -= steps[k];
+    std::vector<double> rp, rm;
+    ASSERT_TRUE(model.Update(xp, xp + 3, xp + 4, false));
+    for (int j = 0; j < model.num_points(); ++j) rp.push_back(model.residual(j));
+    const auto tp = model.tip_residual();
+    ASSERT_TRUE(model.Update(xm, xm + 3, xm + 4, false));
+    for (int j = 0; j < model.num_points(); ++j) rm.push_back(model.residual(j));
+    const auto tm = model.tip_residual();
+    double scale = 0.0;
+    for (int j = 0; j < model.num_points(); ++j) scale = std::max(scale, std::abs(g0[j][k]));
+    for (int j = 0; j < model.num_points(); ++j) {
+      const double fd = (rp[j] - rm[j]) / (2 * steps[k]);
+      // Interpolated sensitivities and central differences agree to ~1e-4 of the largest
+      // entry of the column (sample spacing L/120).
+      EXPECT_NEAR(g0[j][k], fd, 2e-3 * scale) << "param " << k << " point " << j;
+    }
+    for (int c = 0; c < 2; ++c) {
+      const double fd = ((c ? tp[1] : tp[0]) - (c ? tm[1] : tm[0])) / (2 * steps[k]);
+      EXPECT_NEAR(tipg[c][k], fd, 1e-4 * (std::abs(fd) + scale)) << "tip " << c << " param " << k;
+    }
+  }
+  (void)tip0;
+}
+
+TEST(DirectFit, RecoversPaperFabricsNoiseFree) {
+  for (const Fabric& f : {kFig8, kDress, kInterlining}) {
+    const BendingLaw truth = LawOf(f);
+    const double rho = units::GsmToSi(f.gsm);
+    std::vector<Profile> data;
+    for (double L : {0.04, 0.06, 0.08}) data.push_back(MakeProfile(truth, rho, L, 0.0, 0.0, 1));
+    const DirectFitSummary fit = FitDirect(data, rho);
+    ASSERT_TRUE(fit.converged) << f.name << ": " << fit.message;
+    // Noise-free data: the curve is recovered to the model's interpolation accuracy.
+    EXPECT_LT(MomentCurveError(*fit.law, truth, fit.kappa_max), 1e-3) << f.name << " " << fit.BriefReport();
+    EXPECT_LT(fit.rms, 2e-6) << f.name;
+    EXPECT_NEAR(fit.offset, 0.0, 1e-5) << f.name;
+    for (size_t i = 0; i < data.size(); ++i) {
+      EXPECT_NEAR(fit.profiles[i].overhang, data[i].s.back(), 1e-5) << f.name;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace textile
+
+namespace textile {
+namespace {
+
+TEST(DirectFit, FindsTheMidlineOffsetAndRotation) {
+  const BendingLaw truth = LawOf(kFig8);
+  std::vector<Profile> data;
+  for (double L : {0.05, 0.07}) data.push_back(MakeProfile(truth, 0.2, L, 0.0, 0.3e-3, 2));
+  DirectFitOptions o;
+  o.fit_rotation = true;
+  const DirectFitSummary fit = FitDirect(data, 0.2, o);
+  ASSERT_TRUE(fit.converged) << fit.message;
+  EXPECT_NEAR(fit.offset, 0.3e-3, 2e-6);
+  EXPECT_NEAR(fit.rotation, 0.0, 1e-4);
+  EXPECT_LT(MomentCurveError(*fit.law, truth, fit.kappa_max), 2e-3) << fit.BriefReport();
+}
+
+TEST(DirectFit, NoisyProfilesRecoverTheCurveAndHonestSigmas) {
+  // σ = 0.1 mm on 80 points per profile, three overhangs: the target is 0.5 % on the
+  // curve (median over fabrics); one seed of one fabric gets a 1 % bound here.
+  const BendingLaw truth = LawOf(kFig8);
+  std::vector<Profile> data;
+  for (double L : {0.04, 0.06, 0.08}) data.push_back(MakeProfile(truth, 0.2, L, 0.1e-3, 0.0, 7));
+  const DirectFitSummary fit = FitDirect(data, 0.2);
+  ASSERT_TRUE(fit.converged) << fit.message;
+  EXPECT_LT(MomentCurveError(*fit.law, truth, fit.kappa_max), 0.01) << fit.BriefReport();
+  EXPECT_NEAR(fit.rms, 0.1e-3, 0.02e-3);  // residuals ≈ the noise: nothing left unexplained
+  // The true b1 lies within 4 σ of the estimate (a loose check that σ is not absurdly small).
+  ASSERT_TRUE(std::isfinite(fit.b1_sd));
+  EXPECT_LT(std::abs(fit.law->b1() - truth.b1()), 4 * fit.b1_sd + 1e-3 * truth.b1());
+}
+
+TEST(DirectFit, FlagsB2AsUnobservedWhenKappa0IsBeyondTheData) {
+  // Interlining has κ0 = 0.30 /cm; one short overhang bends less than that at the clamp.
+  const BendingLaw truth = LawOf(kInterlining);
+  std::vector<Profile> data = {MakeProfile(truth, 0.25, 0.03, 0.0, 0.0, 1)};
+  const DirectFitSummary fit = FitDirect(data, 0.25);
+  ASSERT_TRUE(fit.converged) << fit.message;
+  ASSERT_LT(fit.kappa_max, truth.kappa0());
+  EXPECT_FALSE(fit.b2_observed) << fit.BriefReport();
+  EXPECT_NE(fit.observability.find("b2 is not observed"), std::string::npos);
+  // What is reported still matches the truth where there are data.
+  EXPECT_LT(MomentCurveError(*fit.law, truth, fit.kappa_max), 5e-3);
+}
+
+TEST(DirectFit, RefusesProfilesOfDifferentStrips) {
+  std::vector<Profile> data;
+  for (double L : {0.05, 0.07}) data.push_back(MakeProfile(LawOf(kFig8), 0.2, L, 0.05e-3, 0.0, 4));
+  data.push_back(MakeProfile(LawOf(kInterlining), 0.2, 0.06, 0.05e-3, 0.0, 5));
+  try {
+    FitDirect(data, 0.2);
+    FAIL() << "mixed strips were fitted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("different strips"), std::string::npos) << e.what();
+  }
+}
+
+TEST(DirectFit, RejectsBadArguments) {
+  std::vector<Profile> data = {MakeProfile(LawOf(kFig8), 0.2, 0.05, 0.0, 0.0, 1)};
+  EXPECT_THROW(FitDirect({}, 0.2), InputError);
+  EXPECT_THROW(FitDirect(data, 0.0), InputError);
+  EXPECT_THROW(FitDirect(data, NAN), InputError);
+  DirectFitOptions o;
+  o.curve_samples = 3;
+  EXPECT_THROW(FitDirect(data, 0.2, o), InputError);
+}
+
+TEST(DirectFit, IterationCapReportsNotConvergedWithoutALaw) {
+  std::vector<Profile> data = {MakeProfile(LawOf(kInterlining), 0.25, 0.08, 0.0, 0.0, 1)};
+  DirectFitOptions o;
+  o.max_iterations = 1;
+  const DirectFitSummary fit = FitDirect(data, 0.25, o);
+  EXPECT_FALSE(fit.converged);
+  EXPECT_FALSE(fit.law.has_value());
+  EXPECT_NE(fit.message.find("did not converge"), std::string::npos) << fit.message;
+}
+
+}  // namespace
+}  // namespace textile

@@ -118,15 +118,17 @@ int DirectRhs(double t, const double y[], double f[], void* params) {
   return GSL_SUCCESS;
 }
 
-// sin(φ)/φ and cos φ - sin(φ)/φ without cancellation for small φ.
-inline void Sinc(double phi, double* sinc, double* cos_minus_sinc) {
+// sin(φ)/φ and cos φ - sin(φ)/φ without cancellation for small φ (Taylor series to φ⁸,
+// truncation < 1e-17 relative below 0.1), given sin φ and cos φ.
+inline void Sinc(double phi, double sin_phi, double cos_phi, double* sinc,
+                 double* cos_minus_sinc) {
   if (phi < 0.1) {
     const double q = phi * phi;
     *sinc = 1.0 - q / 6.0 * (1.0 - q / 20.0 * (1.0 - q / 42.0 * (1.0 - q / 72.0)));
     *cos_minus_sinc = -q / 3.0 * (1.0 - q / 10.0 * (1.0 - q / 28.0 * (1.0 - q / 54.0)));
   } else {
-    *sinc = std::sin(phi) / phi;
-    *cos_minus_sinc = std::cos(phi) - *sinc;
+    *sinc = sin_phi / phi;
+    *cos_minus_sinc = cos_phi - *sinc;
   }
 }
 
@@ -145,10 +147,10 @@ int LogRhs(double t, const double y[], double f[], void* params) {
     kappa = m * ratio;
   }
   const double r = p.load * ratio;
-  double sinc, cos_minus_sinc;
-  Sinc(phi, &sinc, &cos_minus_sinc);
-  const double dpsi = r * mu;  // = L κ / φ
   const double sphi = std::sin(phi), cphi = std::cos(phi);
+  double sinc, cos_minus_sinc;
+  Sinc(phi, sphi, cphi, &sinc, &cos_minus_sinc);
+  const double dpsi = r * mu;  // = L κ / φ
   f[0] = dpsi;
   f[1] = t * sinc - dpsi * mu;
   f[2] = sphi;  // cos θ

@@ -1,0 +1,283 @@
+// textile fit: cantilever profiles -> the bending law {b1, b2, c1}, by the direct elastica fit
+// (default) or by Clapp et al.'s method; writes a material file with a `fit` report.
+
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+
+#include "common/atomic_file.h"
+#include "common/chart.h"
+#include "common/cli.h"
+#include "textile/fit/clapp.h"
+#include "textile/fit/direct_fit.h"
+#include "textile/fit/profile.h"
+#include "textile/fit/profile_compare.h"
+#include "textile/sim/cantilever_outputs.h"
+#include "textile/sim/error.h"
+#include "textile/sim/material.h"
+#include "textile/sim/units.h"
+
+namespace textile::cli {
+namespace {
+
+struct FitArgs {
+  std::vector<std::string> inputs;
+  double gsm = 0.0;
+  std::string method = "direct";
+  std::string out, plot, name;
+  double thickness_mm = -1.0;  // < 0: fit the offset
+  bool no_offset = false, fit_rotation = false, json = false;
+  double robust_mm = 0.5;
+};
+
+// JSON null for a value that is not available (an undetermined constant's σ).
+nlohmann::json OrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+
+struct Outcome {
+  BendingLaw law = BendingLaw::FromKes(1, 1, 0);
+  nlohmann::json report;
+  std::vector<ProfileComparison> comparisons;  // per profile, for the plot
+  double offset = 0.0;
+  double kappa_max = 0.0;
+  std::string brief;
+};
+
+Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double rho) {
+  DirectFitOptions o;
+  o.fit_offset = a.thickness_mm < 0.0 && !a.no_offset;
+  o.offset = a.thickness_mm > 0.0 ? units::MmToM(a.thickness_mm) / 2.0 : 0.0;
+  o.fit_rotation = a.fit_rotation;
+  o.robust_scale = units::MmToM(a.robust_mm);
+  const DirectFitSummary fit = FitDirect(profiles, rho, o);
+  if (!fit.converged) throw ComputeError("fit: " + fit.message);
+  Outcome out;
+  out.law = *fit.law;
+  out.offset = fit.offset;
+  out.kappa_max = fit.kappa_max;
+  out.brief = fit.BriefReport();
+  nlohmann::json per = nlohmann::json::array();
+  for (size_t i = 0; i < profiles.size(); ++i) {
+    const auto& r = fit.profiles[i];
+    per.push_back({{"source", r.source}, {"overhang_mm", r.overhang * 1e3},
+                   {"data_length_mm", r.data_length * 1e3}, {"rms_mm", r.rms * 1e3},
+                   {"max_mm", r.max * 1e3},
+                   {"clamp_curvature_per_cm", units::SiCurvatureToKes(r.clamp_curvature)}});
+    out.comparisons.push_back(CompareWithElastica(out.law, rho, profiles[i], r.overhang, fit.offset));
+  }
+  out.report = {{"method", "direct"},
+                {"b1_sd", OrNull(units::SiStiffnessToKes(fit.b1_sd))},
+                {"b2_sd", OrNull(units::SiStiffnessToKes(fit.b2_sd))},
+                {"c1_sd", OrNull(units::SiQuadraticToKes(fit.c1_sd))},
+                {"sd_units", "kes"},
+                {"rms_mm", fit.rms * 1e3},
+                {"b1_observed", fit.b1_observed},
+                {"b2_observed", fit.b2_observed},
+                {"c1_observed", fit.c1_observed},
+                {"observability", fit.observability},
+                {"kappa_max_per_cm", units::SiCurvatureToKes(fit.kappa_max)},
+                {"offset_mm", fit.offset * 1e3},
+                {"offset_fitted", o.fit_offset},
+                {"rotation_deg", fit.rotation * 180.0 / M_PI},
+                {"robust_scale_mm", a.robust_mm},
+                {"iterations", fit.iterations},
+                {"seconds", fit.seconds},
+                {"profiles", per}};
+  return out;
+}
+
+Outcome RunClapp(const std::vector<Profile>& profiles, double rho) {
+  const ClappResult fit = FitClapp(profiles, rho);
+  if (!fit.success || !fit.law) throw ComputeError("fit (clapp): " + fit.message);
+  Outcome out;
+  out.law = *fit.law;
+  out.kappa_max = fit.kappa_max;
+  out.brief = fit.BriefReport();
+  nlohmann::json per = nlohmann::json::array();
+  double s2 = 0.0;
+  int n = 0;
+  for (size_t i = 0; i < profiles.size(); ++i) {
+    // Graded like the direct fit: the strip re-simulated with the fitted law at the length of
+    // Clapp's smooth curve, through the origin (Clapp's method has no offset).
+    const double L = fit.profiles[i].curve_length;
+    const ProfileComparison c = CompareWithElastica(out.law, rho, profiles[i], L, 0.0);
+    s2 += c.rms * c.rms * profiles[i].size();
+    n += static_cast<int>(profiles[i].size());
+    per.push_back({{"source", profiles[i].source}, {"overhang_mm", L * 1e3},
+                   {"data_length_mm", profiles[i].s.back() * 1e3}, {"rms_mm", c.rms * 1e3},
+                   {"max_mm", c.max * 1e3},
+                   {"polynomial_rms_mm", fit.profiles[i].residual_rms * 1e3}});
+    out.comparisons.push_back(c);
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  out.report = {
+      {"method", "clapp"},
+      {"b1_sd", OrNull(fit.covariance_available ? units::SiStiffnessToKes(fit.sd_b1) : nan)},
+      {"b2_sd", OrNull(fit.covariance_available ? units::SiStiffnessToKes(fit.sd_b2) : nan)},
+      {"c1_sd", OrNull(fit.covariance_available ? units::SiQuadraticToKes(fit.sd_c1) : nan)},
+      {"sd_units", "kes"},
+      {"rms_mm", std::sqrt(s2 / n) * 1e3},
+      {"b2_observed", fit.b2_observed},
+      {"kappa_max_per_cm", units::SiCurvatureToKes(fit.kappa_max)},
+      {"moment_rms_gfcm_per_cm", units::SiMomentToKes(fit.moment_rms)},
+      {"profiles", per}};
+  return out;
+}
+
+// Classic outputs of the fitted law (cantilever.md): what the 41.5° test would report for
+// this material, and how that G relates to b1 and b2.
+void AddClassicOutputs(const BendingLaw& law, double rho, nlohmann::json* report) {
+  const BarrierCrossing x = FindBarrierCrossing(law, rho);
+  if (!x.converged) {
+    (*report)["classic_note"] = "no 41.5° crossing: " + x.message;
+    return;
+  }
+  const ClassicOutputs c = ComputeClassicOutputs(rho, x.overhang);
+  (*report)["crossing_overhang_mm"] = x.overhang * 1e3;
+  (*report)["bending_length_mm"] = c.bending_length * 1e3;
+  (*report)["flexural_rigidity_uNm"] = c.rigidity_micro_nm();
+  (*report)["flexural_rigidity_mgcm"] = c.rigidity_mg_cm();
+  (*report)["flexural_rigidity_gfcm"] = c.rigidity_gf_cm();
+  (*report)["G_over_b1"] = c.flexural_rigidity / law.b1();
+  (*report)["G_over_b2"] = c.flexural_rigidity / law.b2();
+  (*report)["classic_note"] = c.RelationToLaw(law);
+}
+
+void Plot(const FitArgs& a, const std::vector<Profile>& profiles, const Outcome& o, double rho,
+          const std::optional<ClappResult>& clapp) {
+  namespace chart = textile::chart;
+  chart::Panel prof{.title = "Profiles: measured and fitted",
+                    .x_label = "x [mm]", .y_label = "y [mm]", .equal_aspect = true};
+  std::vector<chart::Series> models;
+  for (size_t i = 0; i < profiles.size(); ++i) {
+    const auto color = chart::PaletteColor(static_cast<int>(i));
+    chart::Series data{.label = std::filesystem::path(profiles[i].source).filename().string(),
+                       .style = chart::Series::Style::kMarkers, .color = color};
+    for (size_t j = 0; j < profiles[i].size(); ++j) {
+      data.x.push_back(profiles[i].x[j] * 1e3);
+      data.y.push_back(profiles[i].y[j] * 1e3);
+    }
+    // Thin dark lines on top of the dots, so that the fit is visible through the data.
+    chart::Series model{.label = i == 0 ? "fitted elastica" : "",
+                        .color = chart::Rgb{0.1, 0.1, 0.1}, .line_width = 1.2};
+    for (size_t j = 0; j < o.comparisons[i].model_x.size(); ++j) {
+      model.x.push_back(o.comparisons[i].model_x[j] * 1e3);
+      model.y.push_back(o.comparisons[i].model_y[j] * 1e3);
+    }
+    prof.series.push_back(data);
+    models.push_back(model);
+  }
+  for (auto& m : models) prof.series.push_back(std::move(m));
+  prof.notes = {"rms " + Num(o.report["rms_mm"].get<double>(), 3) + " mm"};
+
+  chart::Panel mk{.title = "Moment-curvature", .x_label = "κ [1/cm]", .y_label = "M [gf·cm/cm]"};
+  const double kmax = o.kappa_max;
+  const auto curve = [&](const BendingLaw& law, const std::string& label, bool dashed) {
+    chart::Series s{.label = label, .dashed = dashed};
+    for (int i = 0; i <= 200; ++i) {
+      const double k = kmax * i / 200.0;
+      s.x.push_back(units::SiCurvatureToKes(k));
+      s.y.push_back(units::SiMomentToKes(law.Moment(k)));
+    }
+    return s;
+  };
+  mk.series.push_back(curve(o.law, a.method == "direct" ? "direct fit" : "Clapp fit", false));
+  if (clapp && clapp->law) {
+    chart::Series pts{.label = "Clapp (κ, M) points", .style = chart::Series::Style::kMarkers,
+                      .color = chart::Rgb{0.6, 0.6, 0.6}};
+    for (const auto& p : clapp->points) {
+      pts.x.push_back(units::SiCurvatureToKes(p.kappa));
+      pts.y.push_back(units::SiMomentToKes(p.moment));
+    }
+    mk.series.push_back(pts);
+    if (a.method == "direct") mk.series.push_back(curve(*clapp->law, "Clapp's law", true));
+  }
+  mk.notes = {"b1 = " + Num(o.law.b1_kes(), 4) + " gf·cm", "b2 = " + Num(o.law.b2_kes(), 4) + " gf·cm",
+              "c1 = " + Num(o.law.c1_kes(), 4) + " gf·cm²",
+              "κ0 = " + Num(units::SiCurvatureToKes(o.law.kappa0()), 4) + " /cm"};
+  chart::WritePng({.title = "textile fit (" + a.method + "), " + Num(a.gsm) + " g/m²",
+                   .width_px = 1300, .height_px = 600, .columns = 2, .panels = {prof, mk}},
+                  a.plot);
+  (void)rho;
+}
+
+void Run(const FitArgs& a) {
+  if (!std::isfinite(a.gsm) || a.gsm <= 0.0) throw InputError("--gsm must be a number > 0 (g/m²)");
+  if (a.gsm < 1.0 || a.gsm > 1e4) throw InputError("--gsm " + Num(a.gsm) + " g/m² is implausible (1 .. 10000)");
+  if (!std::isfinite(a.robust_mm) || a.robust_mm < 0.0) throw InputError("--robust-mm must be >= 0");
+  if (a.thickness_mm >= 0.0 && (a.thickness_mm == 0.0 || a.thickness_mm > 20.0 || !std::isfinite(a.thickness_mm)))
+    throw InputError("--thickness-mm must lie in (0, 20] mm");
+  const double rho = units::GsmToSi(a.gsm);
+  std::vector<Profile> profiles;
+  for (const auto& path : a.inputs) profiles.push_back(ReadProfileCsv(path));
+  // Check outputs before the work, so that a bad path fails fast.
+  AtomicFile material_file(a.out);
+  std::optional<AtomicFile> plot_file;
+  if (!a.plot.empty()) plot_file.emplace(a.plot);
+
+  Outcome o = a.method == "direct" ? RunDirect(a, profiles, rho) : RunClapp(profiles, rho);
+  AddClassicOutputs(o.law, rho, &o.report);
+  o.report["inputs"] = a.inputs;
+  o.report["areal_density_gsm"] = a.gsm;
+
+  std::optional<ClappResult> clapp;
+  if (!a.plot.empty()) {
+    try {
+      clapp = FitClapp(profiles, rho);
+    } catch (const InputError&) {
+      // Clapp's points are only decoration here; a profile it cannot use is not an error.
+    }
+    Plot(a, profiles, o, rho, clapp);
+  }
+
+  Material m;
+  m.name = a.name.empty() ? "fitted from " + std::filesystem::path(a.inputs.front()).stem().string() : a.name;
+  m.areal_density = rho;
+  m.bending = o.law;
+  m.fit = o.report;
+  WriteFileAtomically(a.out, MaterialToJson(m).dump(2) + "\n");
+  (void)material_file;
+
+  if (a.json) {
+    PrintJson({{"material_file", a.out}, {"material", MaterialToJson(m)}});
+    return;
+  }
+  std::cout << o.brief << "\n";
+  std::cout << "law: b1 = " << Num(o.law.b1_kes(), 5) << " gf·cm, b2 = " << Num(o.law.b2_kes(), 5)
+            << " gf·cm, c1 = " << Num(o.law.c1_kes(), 5) << " gf·cm²  (kappa0 = "
+            << Num(units::SiCurvatureToKes(o.law.kappa0()), 4) << " /cm)\n";
+  std::cout << "profile rms: " << Num(o.report["rms_mm"].get<double>(), 3) << " mm\n";
+  if (o.report.contains("bending_length_mm")) {
+    std::cout << "classic 41.5° test of this law: c = " << Num(o.report["bending_length_mm"].get<double>(), 4)
+              << " mm, G = " << Num(o.report["flexural_rigidity_uNm"].get<double>(), 4) << " µN·m = "
+              << Num(o.report["flexural_rigidity_mgcm"].get<double>(), 4) << " mg·cm (G/b1 = "
+              << Num(o.report["G_over_b1"].get<double>(), 3) << ")\n";
+  }
+  std::cout << "wrote " << a.out << (a.plot.empty() ? "" : " and " + a.plot) << "\n";
+}
+
+}  // namespace
+
+void RegisterFit(CLI::App& app) {
+  auto a = std::make_shared<FitArgs>();
+  CLI::App* sub = AddSubcommand(
+      app, "fit", "Fit the bending law {b1, b2, c1} to cantilever profiles of one strip",
+      "textile fit out/profiles/*.profile.csv --gsm 200 -o fitted.json --plot fit.png");
+  sub->add_option("inputs", a->inputs, "Profile CSV files (s_mm,x_mm,y_mm) of the same strip")
+      ->required();
+  sub->add_option("--gsm", a->gsm, "Areal density of the fabric [g/m²]")->required();
+  sub->add_option("--method", a->method, "direct (elastica fit, default) or clapp (Clapp et al. 1990)")
+      ->check(CLI::IsMember({"direct", "clapp"}));
+  sub->add_option("-o,--out", a->out, "Material JSON to write (with the fit report)")->required();
+  sub->add_option("--plot", a->plot, "Write measured vs fitted profiles and the M-κ curve to a PNG");
+  sub->add_option("--name", a->name, "Material name to store");
+  sub->add_option("--thickness-mm", a->thickness_mm,
+                  "Measured strip thickness [mm]: fixes the mid-line offset to t/2 (default: fitted)");
+  sub->add_flag("--no-offset", a->no_offset, "Force the curve through the edge (offset 0)");
+  sub->add_flag("--fit-rotation", a->fit_rotation, "Also fit a small rig rotation");
+  sub->add_option("--robust-mm", a->robust_mm, "Cauchy loss scale per point [mm]; 0 = plain least squares (default 0.5)");
+  sub->add_flag("--json", a->json, "Print one JSON object instead of text");
+  sub->callback([a] { Run(*a); });
+}
+
+}  // namespace textile::cli

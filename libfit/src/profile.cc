@@ -1,5 +1,6 @@
 #include "textile/fit/profile.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -101,6 +102,20 @@ void CheckProfile(const Profile& p) {
     throw InputError(src + ": " + std::to_string(p.size()) + " points, at least " +
                      std::to_string(kMinProfilePoints) + " are needed");
   }
+  // Folding back means x running backwards by more than noise can explain: the threshold is
+  // kFoldBackM or 8σ of the point noise, whichever is larger, σ estimated robustly from second
+  // differences (1.4826 × median |Δ²x| / √6 for white noise).
+  std::vector<double> d2;
+  for (size_t i = 1; i + 1 < p.size(); ++i) {
+    const double v = std::abs(p.x[i + 1] - 2 * p.x[i] + p.x[i - 1]);
+    if (std::isfinite(v)) d2.push_back(v);  // non-finite points are refused below
+  }
+  double fold_back = kFoldBackM;
+  if (!d2.empty()) {
+    std::nth_element(d2.begin(), d2.begin() + d2.size() / 2, d2.end());
+    const double sigma = 1.4826 * d2[d2.size() / 2] / std::sqrt(6.0);
+    if (std::isfinite(sigma)) fold_back = std::max(fold_back, 8.0 * sigma);
+  }
   double max_x = -1e300;
   for (size_t i = 0; i < p.size(); ++i) {
     const std::string row = "point " + std::to_string(i + 1);
@@ -116,7 +131,7 @@ void CheckProfile(const Profile& p) {
       throw InputError(src + ": " + row + " lies " + std::to_string(p.y[i] * 1e3) +
                        " mm above the platform; a hanging strip has y_mm <= 0 (is y pointing down?)");
     }
-    if (p.x[i] < max_x - kFoldBackM) {
+    if (p.x[i] < max_x - fold_back) {
       throw InputError(src + ": " + row + ": the profile folds back (x_mm decreases from " +
                        std::to_string(max_x * 1e3) + " to " + std::to_string(p.x[i] * 1e3) + ")");
     }

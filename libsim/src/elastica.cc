@@ -196,6 +196,7 @@ struct GslDeleter {
 // The absolute tolerance is scaled per component to its expected size (index 0: direct form,
 // 1: log form), so that small deflections keep their relative accuracy.
 struct Integrator {
+  using Control = std::unique_ptr<gsl_odeiv2_control, GslDeleter>;
   // The tolerances are set per shot (gsl_odeiv2_control_init keeps the scales).
   Integrator(int dim, const double* direct_scale, const double* log_scale)
       : dim(dim),
@@ -203,7 +204,6 @@ struct Integrator {
         evolve(gsl_odeiv2_evolve_alloc(dim)),
         control{Control(gsl_odeiv2_control_scaled_new(1e-10, 1e-10, 1.0, 0.0, direct_scale, dim)),
                 Control(gsl_odeiv2_control_scaled_new(1e-10, 1e-10, 1.0, 0.0, log_scale, dim))} {}
-  using Control = std::unique_ptr<gsl_odeiv2_control, GslDeleter>;
   int dim;
   std::unique_ptr<gsl_odeiv2_step, GslDeleter> step;
   std::unique_ptr<gsl_odeiv2_evolve, GslDeleter> evolve;

@@ -54,6 +54,9 @@ bool ProfileModel::Update(const double* p, const double* length, const double* r
   options.rel_tol = tol_;
   options.num_samples = samples_;
   options.sensitivities = jacobians;
+  if (solution_.converged && std::isfinite(solution_.tip_angle)) {
+    options.tip_angle_guess = solution_.tip_angle;  // continuation: the last point is close
+  }
   try {
     const BendingLaw law = LawFromParameters(p);
     ElasticaProfile e = SolveHeavyElastica(law, areal_density_, L, options);

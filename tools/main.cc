@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   cli::RegisterLaw(app);
   cli::RegisterSynth(app);
   cli::RegisterFit(app);
+  cli::RegisterBench(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

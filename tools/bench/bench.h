@@ -1,0 +1,52 @@
+#ifndef TEXTILE_TOOLS_BENCH_BENCH_H_
+#define TEXTILE_TOOLS_BENCH_BENCH_H_
+
+// The benchmarks of ../shared/spec/benchmarks.md behind `textile bench NAME`. Each one runs its
+// study, returns rows (one JSON object per CSV row, columns as benchmarks.md names them, more
+// welcome), writes a PNG to the output folder and prints a short table on stdout (unless
+// --json). Timings are medians of repeats measured in the same run; never used by tests.
+
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace textile::bench {
+
+struct Context {
+  std::string out_dir;  // CSV + PNG go here
+  bool quick = false;   // CI-sized run
+  bool print = true;    // human-readable table on stdout
+};
+
+struct Result {
+  std::vector<std::string> columns;  // CSV column order
+  std::vector<nlohmann::json> rows;
+  std::string summary;  // a few lines for people (also stored in the JSON)
+};
+
+struct Benchmark {
+  std::string name;
+  std::string description;
+  std::function<Result(const Context&)> run;
+};
+
+// All benchmarks that exist, in the order of benchmarks.md.
+const std::vector<Benchmark>& Registry();
+
+// Writes rows as CSV (columns in order; strings quoted if needed) atomically.
+void WriteCsv(const std::string& path, const Result& result);
+// Machine, build and thread facts recorded with every result.
+nlohmann::json MachineInfo();
+// Median of a sample (copy); NaN for an empty one.
+double Median(std::vector<double> v);
+// Seconds of wall time for one call of f, as the median of `repeats` calls.
+double MedianSeconds(const std::function<void()>& f, int repeats);
+
+// Each benchmark file defines one of these.
+Benchmark ElasticaBenchmark();
+Benchmark FitAccuracyBenchmark();
+
+}  // namespace textile::bench
+
+#endif  // TEXTILE_TOOLS_BENCH_BENCH_H_

@@ -3,13 +3,31 @@
 set -euo pipefail
 textile="$(realpath "${1:?usage: demo.sh PATH/TO/textile [OUT_DIR]}")"
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-out="${2:-$here/../out/demo}"
-mkdir -p "$out"
 cd "$here/.."
+out="${2:-out/demo}"
+mkdir -p "$out"
 
-echo "== 1. The paper's three fabrics: the moment-curvature law (textile law)"
+echo "== 1. The paper's three fabrics: their moment-curvature laws (textile law)"
 for m in pabst-fig8 pabst-dress pabst-interlining; do
   "$textile" law --material "samples/materials/$m.json" --kappa 0.25 0.5 1 2 --plot "$out/$m.law.png"
   echo
 done
+
+echo "== 2. Profiles of a strip at three overhangs -> the law (textile fit)"
+echo "   samples/profiles/: the Fig. 8 fabric at 40, 60 and 80 mm, 0.1 mm of noise, mid-line 0.2 mm up"
+"$textile" fit samples/profiles/pabst-fig8_L0{40,60,80}mm.profile.csv --gsm 200 \
+  -o "$out/pabst-fig8.fitted.json" --plot "$out/pabst-fig8.fit.png"
+echo
+echo "   The paper's method (Clapp et al. 1990) on the same profiles:"
+"$textile" fit samples/profiles/pabst-fig8_L0{40,60,80}mm.profile.csv --gsm 200 --method clapp \
+  -o "$out/pabst-fig8.clapp.json" --plot "$out/pabst-fig8.clapp.png"
+echo
+
+echo "== 3. The fitted law against the truth it was made from (textile law)"
+for f in samples/materials/pabst-fig8.json "$out/pabst-fig8.fitted.json" "$out/pabst-fig8.clapp.json"; do
+  printf '%-36s' "$f:"
+  "$textile" law --material "$f" --kappa 0.5 1 1.5 --json |
+    python3 -c 'import json,sys; j=json.load(sys.stdin); print("  ".join("M(%.1f/cm) = %.5f" % (p["kappa_per_cm"], p["M_gfcm_per_cm"]) for p in j["law"]["points"]), "gf·cm/cm")'
+done
+echo
 echo "Pictures and outputs: $out"

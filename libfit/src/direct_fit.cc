@@ -319,11 +319,18 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
     out.b2_observed = false;
     out.b2_sd = std::numeric_limits<double>::quiet_NaN();
   }
-  if (!out.c1_observed && out.b2_observed) {
-    obs << "The quadratic branch is not resolved (kappa0 " << units::SiCurvatureToKes(k0)
-        << " /cm, b1 = b2 within the data): the data determine M ≈ M0 + b2 κ. ";
-  } else if (!out.b1_observed || !out.c1_observed) {
-    obs << "b1/c1 are poorly determined. ";
+  const auto pct = [](double sd, double v) {
+    std::ostringstream t;
+    t.precision(2);
+    if (std::isfinite(sd)) t << "±" << 100.0 * sd / std::abs(v) << " %";
+    else t << "undetermined";
+    return t.str();
+  };
+  if (!out.b1_observed) obs << "b1 is poorly determined (" << pct(out.b1_sd, law.b1()) << "). ";
+  if (!out.c1_observed) {
+    obs << "c1 is poorly determined (" << pct(out.c1_sd, law.c1())
+        << "): these curvatures do not resolve the quadratic branch, the data are also "
+           "consistent with a law closer to linear. ";
   }
   if (out.b1_observed && out.b2_observed && out.c1_observed) {
     obs << "All three constants are determined by the data (curvatures up to " << kmax_cm

@@ -216,6 +216,17 @@ void Run(const FitArgs& a) {
   if (!a.plot.empty()) plot_file.emplace(a.plot);
 
   Outcome o = a.method == "direct" ? RunDirect(a, profiles, rho) : RunClapp(profiles, rho);
+  // A fit can only hand out a law that a material file accepts: Clapp's regression, for one,
+  // can wander to constants no fabric has when the polynomial is poor.
+  try {
+    Material probe;
+    probe.areal_density = rho;
+    probe.bending = o.law;
+    ParseMaterialJson(MaterialToJson(probe).dump(), "fitted law");
+  } catch (const InputError& e) {
+    throw ComputeError(std::string("fit (") + a.method + ") gave an implausible law: " + e.what());
+  }
+
   AddClassicOutputs(o.law, rho, &o.report);
   o.report["inputs"] = a.inputs;
   o.report["areal_density_gsm"] = a.gsm;

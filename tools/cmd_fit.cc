@@ -26,7 +26,8 @@ struct FitArgs {
   double gsm = 0.0;
   std::string method = "direct";
   std::string out, plot, name;
-  double thickness_mm = -1.0;  // < 0: fit the offset
+  double thickness_mm = 0.0;
+  bool thickness_given = false;  // else the offset is fitted
   bool no_offset = false, fit_rotation = false, json = false;
   double robust_mm = 0.5;
 };
@@ -45,8 +46,8 @@ struct Outcome {
 
 Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double rho) {
   DirectFitOptions o;
-  o.fit_offset = a.thickness_mm < 0.0 && !a.no_offset;
-  o.offset = a.thickness_mm > 0.0 ? units::MmToM(a.thickness_mm) / 2.0 : 0.0;
+  o.fit_offset = !a.thickness_given && !a.no_offset;
+  o.offset = a.thickness_given ? units::MmToM(a.thickness_mm) / 2.0 : 0.0;
   o.fit_rotation = a.fit_rotation;
   o.robust_scale = units::MmToM(a.robust_mm);
   const DirectFitSummary fit = FitDirect(profiles, rho, o);
@@ -205,8 +206,10 @@ void Run(const FitArgs& a) {
   if (!std::isfinite(a.gsm) || a.gsm <= 0.0) throw InputError("--gsm must be a number > 0 (g/m²)");
   if (a.gsm < 1.0 || a.gsm > 1e4) throw InputError("--gsm " + Num(a.gsm) + " g/m² is implausible (1 .. 10000)");
   if (!std::isfinite(a.robust_mm) || a.robust_mm < 0.0) throw InputError("--robust-mm must be >= 0");
-  if (a.thickness_mm >= 0.0 && (a.thickness_mm == 0.0 || a.thickness_mm > 20.0 || !std::isfinite(a.thickness_mm)))
-    throw InputError("--thickness-mm must lie in (0, 20] mm");
+  if (a.thickness_given && !(a.thickness_mm > 0.0 && a.thickness_mm <= 20.0))
+    throw InputError("--thickness-mm must lie in (0, 20] mm, got " + Num(a.thickness_mm));
+  if (a.thickness_given && a.no_offset)
+    throw InputError("--thickness-mm and --no-offset contradict each other (offset t/2 vs 0)");
   const double rho = units::GsmToSi(a.gsm);
   std::vector<Profile> profiles;
   for (const auto& path : a.inputs) profiles.push_back(ReadProfileCsv(path));
@@ -288,7 +291,11 @@ void RegisterFit(CLI::App& app) {
   sub->add_flag("--fit-rotation", a->fit_rotation, "Also fit a small rig rotation");
   sub->add_option("--robust-mm", a->robust_mm, "Cauchy loss scale per point [mm]; 0 = plain least squares (default 0.5)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
-  sub->callback([a] { Run(*a); });
+  CLI::Option* thickness = sub->get_option("--thickness-mm");
+  sub->callback([a, thickness] {
+    a->thickness_given = thickness->count() > 0;
+    Run(*a);
+  });
 }
 
 }  // namespace textile::cli

@@ -1,6 +1,7 @@
 // textile synth-profile: synthetic cantilever profiles of a known material (elastica + seeded
 // noise + resampling), for trying the fits and for the samples.
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -20,7 +21,7 @@ struct SynthArgs {
   std::vector<double> overhang_mm;
   double noise_mm = 0.0, offset_mm = 0.0, rotation_deg = 0.0;
   int points = 100;
-  uint64_t seed = 1;
+  int64_t seed = 1;
   bool chord = true, json = false;
 };
 
@@ -37,22 +38,36 @@ void Run(const SynthArgs& a) {
     throw InputError("--noise-mm must lie in [0, 5] mm");
   if (!std::isfinite(a.offset_mm) || std::abs(a.offset_mm) > 5.0)
     throw InputError("--offset-mm must lie in [-5, 5] mm");
+  if (a.points < kMinProfilePoints || a.points > 100000)
+    throw InputError("--points must lie in [" + std::to_string(kMinProfilePoints) + ", 100000], got " +
+                     std::to_string(a.points));
+  if (!std::isfinite(a.rotation_deg) || std::abs(a.rotation_deg) > 10.0)
+    throw InputError("--rotation-deg must lie in [-10, 10] degrees, got " + Num(a.rotation_deg));
+  if (a.seed < 0) throw InputError("--seed must be >= 0");
   if (!o.Check(&why)) throw InputError("synth-profile: " + why);
+  // File names carry the overhang to 0.1 mm; two overhangs that share a name are refused.
+  std::vector<std::string> names;
   for (double L : a.overhang_mm) {
     if (!std::isfinite(L) || L <= 0.0 || L > 1000.0) {
       throw InputError("--overhang-mm: " + Num(L) + " is not a length in (0, 1000] mm");
     }
+    char name[64];
+    if (std::abs(L - std::round(L)) < 0.05) std::snprintf(name, sizeof name, "_L%03.0fmm.profile.csv", L);
+    else std::snprintf(name, sizeof name, "_L%05.1fmm.profile.csv", L);
+    if (std::find(names.begin(), names.end(), name) != names.end()) {
+      throw InputError("--overhang-mm: " + Num(L) + " mm repeats an overhang (same file " +
+                       std::string(name + 1) + ")");
+    }
+    names.push_back(name);
   }
   EnsureDirectory(a.out_dir);
   const std::string stem = std::filesystem::path(a.material).stem().string();
   nlohmann::json files = nlohmann::json::array();
   int k = 0;
   for (double L : a.overhang_mm) {
-    o.seed = a.seed + static_cast<uint64_t>(k++);  // independent noise per profile
+    o.seed = static_cast<uint64_t>(a.seed) + static_cast<uint64_t>(k);  // independent noise per profile
     const Profile p = SyntheticProfile(m.EffectiveLaw(), m.areal_density, units::MmToM(L), o);
-    char name[64];
-    std::snprintf(name, sizeof name, "_L%03.0fmm.profile.csv", L);
-    const std::string path = (std::filesystem::path(a.out_dir) / (stem + name)).string();
+    const std::string path = (std::filesystem::path(a.out_dir) / (stem + names[k++])).string();
     WriteFileAtomically(path, "# " + p.source + "\n" + ProfileToCsv(p));
     files.push_back({{"path", path}, {"overhang_mm", L}, {"points", p.size()}});
     if (!a.json) std::cout << path << "  (" << Num(L) << " mm overhang, " << p.size() << " points)\n";

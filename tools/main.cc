@@ -4,9 +4,19 @@
 #include <cstdio>
 #include <exception>
 #include <new>
+#include <string>
 
 #include "common/cli.h"
 #include "textile/sim/error.h"
+
+namespace {
+// Errors are one line (cli.md), whatever a library put into the message.
+std::string OneLine(const char* what) {
+  std::string s = what;
+  for (char& c : s) if (c == '\n' || c == '\r') c = ' ';
+  return s;
+}
+}  // namespace
 
 int main(int argc, char** argv) {
   namespace cli = textile::cli;
@@ -32,19 +42,19 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "error: %s (see 'textile --help')\n", e.what());
+    std::fprintf(stderr, "error: %s (see 'textile --help')\n", OneLine(e.what()).c_str());
     return cli::kExitBadInput;
   } catch (const textile::InputError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error: %s\n", OneLine(e.what()).c_str());
     return cli::kExitBadInput;
   } catch (const textile::ComputeError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error: %s\n", OneLine(e.what()).c_str());
     return cli::kExitComputeFailed;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "error: out of memory\n");
     return cli::kExitComputeFailed;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: internal: %s\n", e.what());
+    std::fprintf(stderr, "error: internal: %s\n", OneLine(e.what()).c_str());
     return cli::kExitComputeFailed;
   }
   return cli::kExitOk;

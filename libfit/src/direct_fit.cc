@@ -143,6 +143,15 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
   // them, data that no law explains (mixed strips) drive b2 towards 0, a plastic hinge.
   const double lo_b = std::log(std::max(b0 / 100.0, units::KesStiffnessToSi(1e-5)));
   const double hi_b = std::log(std::min(b0 * 100.0, units::KesStiffnessToSi(1e3)));
+  if (!(lo_b < hi_b)) {
+    DirectFitSummary out;
+    std::ostringstream m;
+    m.precision(3);
+    m << "the profiles' shape asks for a bending stiffness of about " << units::SiStiffnessToKes(b0)
+      << " gf·cm, outside any textile (1e-5 .. 1e3 gf·cm): is --gsm right, is y up?";
+    out.message = m.str();
+    return out;
+  }
   for (int k = 0; k < 2; ++k) {
     law_p[k] = std::clamp(law_p[k], lo_b, hi_b);
     problem.SetParameterLowerBound(law_p.data(), k, lo_b);
@@ -241,6 +250,21 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
     }
   }
 
+  // A law pinned to a stiffness bound is not a fit: the data do not bend (or bend without
+  // limit) within the textile range.
+  for (int k = 0; k < 2; ++k) {
+    const double lo = problem.GetParameterLowerBound(law_p.data(), k);
+    const double hi = problem.GetParameterUpperBound(law_p.data(), k);
+    if (law_p[k] - lo < 1e-6 || hi - law_p[k] < 1e-6) {
+      std::ostringstream m;
+      m.precision(3);
+      m << "the fit ran into the bound b" << k + 1 << " = " << units::SiStiffnessToKes(std::exp(law_p[k]))
+        << " gf·cm: the profiles do not determine a textile law (almost no bending, or not a "
+           "cantilever shape)";
+      out.message = m.str();
+      return finish();
+    }
+  }
   // Covariance: (JᵀJ)⁺ σ̂² over all free parameters, from the unrobustified Jacobian, with
   // σ̂² = Σr² / (N - n). Pseudo-inverse, so that an undetermined direction (b1 = b2 makes κ0
   // free; κ0 beyond the data makes b2 free) shows up as an infinite variance, not a crash.

@@ -104,16 +104,6 @@ std::vector<double> Moments(const fs::path& material, const std::vector<double>&
   return m;
 }
 
-// Expects a refusal: exit 2, one line "error: ..." containing `fragment`, nothing on stdout.
-void ExpectRefused(const testing::CliResult& r, const std::string& fragment,
-                   const std::string& what) {
-  EXPECT_EQ(r.exit_code, 2) << what << "\n" << r.err;
-  EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << what << ": " << r.err;
-  EXPECT_EQ(CountLines(r.err), 1) << what << ": " << r.err;
-  EXPECT_NE(r.err.find(fragment), std::string::npos)
-      << what << ": '" << fragment << "' not in " << r.err;
-  EXPECT_TRUE(r.out.empty()) << what << ": " << r.out;
-}
 
 // Fits the noise-free fig8 profiles with `method` and checks the material file and its report;
 // the fitted M must match the truth within `tolerance` (relative) at the given fractions of
@@ -238,7 +228,7 @@ TEST(CliFit, BadProfilesExit2NamingTheFile) {
       for (const char* method : {"direct", "clapp"}) {
         const auto r =
             Textile("fit " + inputs + " --gsm 200 --method " + method + " -o " + Quote(out));
-        ExpectRefused(r, "error: " + path, inputs + " (" + method + ")");
+        testing::ExpectRefused(r, "error: " + path, inputs + " (" + method + ")");
         EXPECT_NE(r.err.find(c.fragment), std::string::npos) << c.file << ": " << r.err;
       }
     }
@@ -264,7 +254,7 @@ TEST(CliFit, BadNumbersExit2NamingTheFlag) {
         Case{"--gsm 200 --robust-mm nan", "--robust-mm"},
         Case{"--gsm 200 --method foo", "--method"}}) {
     const auto r = Textile("fit " + profiles + c.args + " -o " + Quote(out));
-    ExpectRefused(r, c.flag, c.args);
+    testing::ExpectRefused(r, c.flag, c.args);
   }
   EXPECT_EQ(Listing(dir), std::set<std::string>{"profiles"});
 }
@@ -277,7 +267,7 @@ TEST(CliFit, NegativeOrNanThicknessIsRefused) {
   for (const char* t : {"-1", "nan", "-inf"}) {
     const auto r =
         Textile("fit " + profiles + "--gsm 200 --thickness-mm " + t + " -o " + Quote(out));
-    ExpectRefused(r, "--thickness-mm", std::string("--thickness-mm ") + t);
+    testing::ExpectRefused(r, "--thickness-mm", std::string("--thickness-mm ") + t);
     EXPECT_FALSE(fs::exists(out)) << "--thickness-mm " << t;
     fs::remove(out);
   }
@@ -292,7 +282,7 @@ TEST(CliFit, UnwritableOutputExit2AndWritesNothing) {
        {fs::path("/nonexistent-dir/fitted.json"), fs::path("/proc/forbidden.json"),
         regular / "fitted.json", dir / "profiles" /* a folder */}) {
     const auto r = Textile("fit " + profiles + "--gsm 200 -o " + Quote(out));
-    ExpectRefused(r, out.string(), out.string());
+    testing::ExpectRefused(r, out.string(), out.string());
   }
   EXPECT_EQ(ReadAll(regular), "keep me\n");
   EXPECT_EQ(Listing(dir), (std::set<std::string>{"profiles", "regular-file"}));
@@ -310,7 +300,7 @@ TEST(CliFit, UnwritablePlotExit2AndWritesNoMaterial) {
         dir / "profiles" /* a folder */}) {
     const auto r =
         Textile("fit " + profiles + "--gsm 200 -o " + Quote(material) + " --plot " + Quote(plot));
-    ExpectRefused(r, plot.string(), plot.string());
+    testing::ExpectRefused(r, plot.string(), plot.string());
     EXPECT_FALSE(fs::exists(material))
         << plot << ": the material was written although the plot failed";
   }
@@ -325,7 +315,7 @@ TEST(CliFit, DifferentStripsExit2) {
                                Synth(kInterlining, "40 60 80", dir / "profiles", "--noise-mm 0.05");
   const fs::path out = dir / "never.json";
   const auto r = Textile("fit " + profiles + "--gsm 200 -o " + Quote(out));
-  ExpectRefused(r, "different strips", "fig8 + interlining");
+  testing::ExpectRefused(r, "different strips", "fig8 + interlining");
   EXPECT_NE(r.err.find((dir / "profiles").string()), std::string::npos)
       << "names no profile: " << r.err;
   EXPECT_FALSE(fs::exists(out));

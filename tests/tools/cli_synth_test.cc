@@ -52,17 +52,6 @@ std::vector<std::string> DataLines(const fs::path& file) {
   return lines;
 }
 
-// Expects the shape of a refusal: exit 2, one line "error: ..." containing `fragment`, nothing
-// on stdout.
-void ExpectRefused(const testing::CliResult& r, const std::string& fragment,
-                   const std::string& what) {
-  EXPECT_EQ(r.exit_code, 2) << what << "\n" << r.err;
-  EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << what << ": " << r.err;
-  EXPECT_EQ(CountLines(r.err), 1) << what << ": " << r.err;
-  EXPECT_NE(r.err.find(fragment), std::string::npos)
-      << what << ": '" << fragment << "' not in " << r.err;
-  EXPECT_TRUE(r.out.empty()) << what << ": " << r.out;
-}
 
 TEST(CliSynth, WritesOneCsvPerOverhangWithHeaderAndPointCount) {
   const auto dir = Scratch("cli_synth_files") / "profiles";  // created by the command
@@ -186,7 +175,7 @@ TEST(CliSynth, BadFlagsExit2NamingTheFlag) {
     const auto dir = root / "never-created";
     const auto r =
         Textile("synth-profile --material " + kFig8 + " " + c.args + " -o " + Quote(dir));
-    ExpectRefused(r, c.fragment, c.args);
+    testing::ExpectRefused(r, c.fragment, c.args);
     EXPECT_FALSE(fs::exists(dir)) << c.args << ": the output folder was created by a refused run";
   }
 }
@@ -197,12 +186,12 @@ TEST(CliSynth, PointsAndRotationErrorsNameTheirFlag) {
   for (const char* args : {"--points 2", "--points -5"}) {
     const auto r = Textile("synth-profile --material " + kFig8 + " --overhang-mm 40 " + args +
                            " -o " + Quote(dir));
-    ExpectRefused(r, "--points", args);
+    testing::ExpectRefused(r, "--points", args);
   }
   for (const char* args : {"--rotation-deg 90", "--rotation-deg nan"}) {
     const auto r = Textile("synth-profile --material " + kFig8 + " --overhang-mm 40 " + args +
                            " -o " + Quote(dir));
-    ExpectRefused(r, "--rotation-deg", args);
+    testing::ExpectRefused(r, "--rotation-deg", args);
   }
   EXPECT_FALSE(fs::exists(dir));
 }
@@ -211,7 +200,7 @@ TEST(CliSynth, MissingOrBadMaterialExit2NamingTheFile) {
   const auto dir = Scratch("cli_synth_bad_material") / "never-created";
   {
     const auto r = Textile("synth-profile --overhang-mm 40 -o " + Quote(dir));
-    ExpectRefused(r, "--material", "no --material");
+    testing::ExpectRefused(r, "--material", "no --material");
   }
   std::vector<std::string> files = {"tests/data/materials/does-not-exist.json"};
   for (const auto& e :
@@ -221,7 +210,7 @@ TEST(CliSynth, MissingOrBadMaterialExit2NamingTheFile) {
   ASSERT_GE(files.size(), 10u);
   for (const std::string& f : files) {
     const auto r = Textile("synth-profile --material " + f + " --overhang-mm 40 -o " + Quote(dir));
-    ExpectRefused(r, "error: " + f + ": ", f);
+    testing::ExpectRefused(r, "error: " + f + ": ", f);
   }
   EXPECT_FALSE(fs::exists(dir));
 }
@@ -233,7 +222,7 @@ TEST(CliSynth, UnwritableOutputFolderExit2) {
   for (const fs::path& out : {fs::path("/proc/forbidden"), regular / "sub", regular}) {
     const auto r =
         Textile("synth-profile --material " + kFig8 + " --overhang-mm 40 -o " + Quote(out));
-    ExpectRefused(r, out.string(), out.string());
+    testing::ExpectRefused(r, out.string(), out.string());
   }
   EXPECT_EQ(ReadAll(regular), "keep me\n");
   EXPECT_EQ(Listing(root), std::set<std::string>{"regular-file"});
@@ -252,7 +241,7 @@ TEST(CliSynth, RefusedRunLeavesAnExistingFolderAlone) {
   // anything is written, so the old 40 mm profile is untouched.
   const auto bad = Textile("synth-profile --material " + kFig8 +
                            " --overhang-mm 40 2000 --noise-mm 0.3 -o " + Quote(dir));
-  ExpectRefused(bad, "--overhang-mm", "overhang 2000");
+  testing::ExpectRefused(bad, "--overhang-mm", "overhang 2000");
   EXPECT_EQ(Listing(dir), before);
   EXPECT_EQ(ReadAll(dir / *before.begin()), bytes);
 }

@@ -3,6 +3,7 @@
 
 // Runs the real `textile` executable and captures what a user would see.
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -53,6 +54,15 @@ inline int CountLines(const std::string& s) {
   int n = 0;
   for (char c : s) n += c == '\n';
   return n;
+}
+
+// Expects a refusal: exit 2, one line "error: ..." containing `fragment`, nothing on stdout.
+inline void ExpectRefused(const CliResult& r, const std::string& fragment, const std::string& what) {
+  EXPECT_EQ(r.exit_code, 2) << what << "\n" << r.err;
+  EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << what << ": " << r.err;
+  EXPECT_EQ(CountLines(r.err), 1) << what << ": " << r.err;
+  EXPECT_NE(r.err.find(fragment), std::string::npos) << what << ": '" << fragment << "' not in " << r.err;
+  EXPECT_TRUE(r.out.empty()) << what << ": " << r.out;
 }
 
 }  // namespace textile::testing

@@ -276,7 +276,7 @@ void RegisterFit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   CLI::App* sub = AddSubcommand(
       app, "fit", "Fit the bending law {b1, b2, c1} to cantilever profiles of one strip",
-      "textile fit out/profiles/*.profile.csv --gsm 200 -o fitted.json --plot fit.png");
+      "textile fit samples/profiles/pabst-fig8_L0*.profile.csv --gsm 200 -o fitted.json --plot fit.png");
   sub->add_option("inputs", a->inputs, "Profile CSV files (s_mm,x_mm,y_mm) of the same strip")
       ->required();
   sub->add_option("--gsm", a->gsm, "Areal density of the fabric [g/m²]")->required();

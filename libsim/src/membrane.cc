@@ -1,0 +1,305 @@
+#include "textile/sim/membrane.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <sstream>
+
+#include "textile/sim/error.h"
+
+namespace textile {
+namespace {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+using Mat32 = Eigen::Matrix<double, 3, 2>;
+
+std::string Num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+// Deformation gradient F = Ds Dm⁻¹ (3×2), Ds = (x1 - x0, x2 - x0).
+Mat32 DeformationGradient(const Eigen::Matrix2d& rest_inverse, const Eigen::Matrix3d& x) {
+  Mat32 ds;
+  ds.col(0) = (x.row(1) - x.row(0)).transpose();
+  ds.col(1) = (x.row(2) - x.row(0)).transpose();
+  return ds * rest_inverse;
+}
+
+// dvec(F)/d(x0, x1, x2): 6×9, vec(F) = (f1; f2) the columns of F. f_j = Σ_a c_aj x_a with
+// c_1j = B_0j, c_2j = B_1j, c_0j = -(B_0j + B_1j), B = Dm⁻¹.
+Eigen::Matrix<double, 6, 9> GradientMap(const Eigen::Matrix2d& b) {
+  Eigen::Matrix<double, 6, 9> g = Eigen::Matrix<double, 6, 9>::Zero();
+  for (int j = 0; j < 2; ++j) {
+    const double c[3] = {-(b(0, j) + b(1, j)), b(0, j), b(1, j)};
+    for (int a = 0; a < 3; ++a) g.block<3, 3>(3 * j, 3 * a) = c[a] * Eigen::Matrix3d::Identity();
+  }
+  return g;
+}
+
+Vec6 Vec(const Mat32& f) {
+  Vec6 v;
+  v << f.col(0), f.col(1);
+  return v;
+}
+
+// ---- St. Venant-Kirchhoff: ψ = μ tr(E²) + λ/2 tr(E)², E = ½(FᵀF - I).
+
+double StvkDensity(const MembraneLame& l, const Mat32& f) {
+  const Eigen::Matrix2d e = 0.5 * (f.transpose() * f - Eigen::Matrix2d::Identity());
+  return l.mu * e.squaredNorm() + 0.5 * l.lambda * e.trace() * e.trace();
+}
+
+// P = F S with the second Piola-Kirchhoff stress S = 2μE + λ tr(E) I.
+Vec6 StvkStress(const MembraneLame& l, const Mat32& f) {
+  const Eigen::Matrix2d e = 0.5 * (f.transpose() * f - Eigen::Matrix2d::Identity());
+  const Eigen::Matrix2d s = 2 * l.mu * e + l.lambda * e.trace() * Eigen::Matrix2d::Identity();
+  return Vec(f * s);
+}
+
+// ∂P_j/∂f_l = S_lj I + μ f_l f_jᵀ + μ δ_jl F Fᵀ + λ f_j f_lᵀ (3×3 blocks).
+Mat6 StvkStressDerivative(const MembraneLame& l, const Mat32& f) {
+  const Eigen::Matrix2d e = 0.5 * (f.transpose() * f - Eigen::Matrix2d::Identity());
+  const Eigen::Matrix2d s = 2 * l.mu * e + l.lambda * e.trace() * Eigen::Matrix2d::Identity();
+  const Eigen::Matrix3d fft = f * f.transpose();
+  Mat6 h;
+  for (int j = 0; j < 2; ++j) {
+    for (int k = 0; k < 2; ++k) {
+      h.block<3, 3>(3 * j, 3 * k) = s(k, j) * Eigen::Matrix3d::Identity() +
+                                    l.mu * f.col(k) * f.col(j).transpose() +
+                                    l.lambda * f.col(j) * f.col(k).transpose();
+      if (j == k) h.block<3, 3>(3 * j, 3 * k) += l.mu * fft;
+    }
+  }
+  return h;
+}
+
+// ---- Corotational linear: ψ = μ |U - I|² + λ/2 tr(U - I)², U the stretch of F = R U.
+// With the singular values σ1, σ2 of F: |U - I|² = I1 - 2 s + 2 and tr(U) = s, where
+// I1 = |F|² = σ1² + σ2², J = |f1 × f2| = σ1 σ2 and s = σ1 + σ2 = sqrt(I1 + 2 J): the energy is a
+// smooth function of F wherever the triangle has area (J > 0), no SVD needed.
+
+struct CorotationalTerms {
+  double s = 0;        // σ1 + σ2
+  double j = 0;        // σ1 σ2
+  Eigen::Vector3d n;   // unit normal of the deformed triangle
+  Vec6 grad_j;         // ∂J/∂vec(F)
+  Vec6 grad_s;         // ∂s/∂vec(F)
+};
+
+CorotationalTerms Corotational(const Mat32& f) {
+  CorotationalTerms t;
+  const Eigen::Vector3d f1 = f.col(0), f2 = f.col(1);
+  const Eigen::Vector3d cross = f1.cross(f2);
+  t.j = cross.norm();
+  const double i1 = f.squaredNorm();
+  // A collapsed triangle has no normal; any unit vector normal to its edges keeps J's gradient
+  // finite (J is not differentiable there).
+  if (t.j > 1e-14 * i1) {
+    t.n = cross / t.j;
+  } else {
+    const Eigen::Vector3d e = f1.squaredNorm() >= f2.squaredNorm() ? f1 : f2;
+    t.n = e.squaredNorm() > 0 ? e.unitOrthogonal() : Eigen::Vector3d::UnitZ();
+  }
+  t.grad_j << f2.cross(t.n), t.n.cross(f1);
+  t.s = std::sqrt(i1 + 2 * t.j);
+  t.grad_s = (Vec(f) + t.grad_j) / std::max(t.s, 1e-300);
+  return t;
+}
+
+// The same energy evaluated without cancellation: the principal strains σi - 1 come from the
+// eigenvalues ei of the Green strain as σi - 1 = 2 ei / (1 + sqrt(1 + 2 ei)), so a nearly
+// unstrained triangle stores ~k ε² A, not round-off of size k · 1e-16 · A.
+double CorotationalDensity(const MembraneLame& l, const Mat32& f) {
+  const Eigen::Matrix2d e = 0.5 * (f.transpose() * f - Eigen::Matrix2d::Identity());
+  const double mean = 0.5 * (e(0, 0) + e(1, 1));
+  const double radius = std::hypot(0.5 * (e(0, 0) - e(1, 1)), e(0, 1));
+  double strain_sq = 0, strain_sum = 0;
+  for (const double ei : {mean + radius, mean - radius}) {
+    const double c = std::max(1 + 2 * ei, 0.0);  // an eigenvalue of FᵀF, ≥ 0 up to round-off
+    const double principal = (c - 1) / (1 + std::sqrt(c));
+    strain_sq += principal * principal;
+    strain_sum += principal;
+  }
+  return l.mu * strain_sq + 0.5 * l.lambda * strain_sum * strain_sum;
+}
+
+// P = 2μ vec(F) + ψ_s ∇s, ψ_s = -2μ + λ (s - 2).
+Vec6 CorotationalStress(const MembraneLame& l, const Mat32& f) {
+  const CorotationalTerms t = Corotational(f);
+  return 2 * l.mu * Vec(f) + (-2 * l.mu + l.lambda * (t.s - 2)) * t.grad_s;
+}
+
+// ∂P/∂F = 2μ I + ψ_s ∇²s + λ ∇s ∇sᵀ, with ∇²s = (I + ∇²J - ∇s ∇sᵀ) / s (from s² = I1 + 2J) and
+// ∇²J = Aᵀ (I - n nᵀ) A / J + [[0, -[n]×], [[n]×, 0]], A = ∂(f1 × f2)/∂(f1, f2) = (-[f2]×, [f1]×).
+Mat6 CorotationalStressDerivative(const MembraneLame& l, const Mat32& f) {
+  const CorotationalTerms t = Corotational(f);
+  const Eigen::Vector3d f1 = f.col(0), f2 = f.col(1);
+  Eigen::Matrix<double, 3, 6> a;
+  a << -Skew(f2), Skew(f1);
+  Mat6 hess_j = Mat6::Zero();
+  if (t.j > 0) hess_j = a.transpose() * (Eigen::Matrix3d::Identity() - t.n * t.n.transpose()) * a / t.j;
+  hess_j.block<3, 3>(0, 3) -= Skew(t.n);
+  hess_j.block<3, 3>(3, 0) += Skew(t.n);
+  const double s = std::max(t.s, 1e-300);
+  const Mat6 hess_s = (Mat6::Identity() + hess_j - t.grad_s * t.grad_s.transpose()) / s;
+  const double psi_s = -2 * l.mu + l.lambda * (t.s - 2);
+  return 2 * l.mu * Mat6::Identity() + psi_s * hess_s + l.lambda * t.grad_s * t.grad_s.transpose();
+}
+
+// Clamps negative eigenvalues to zero (Teran et al. 2005; Sensitive Couture section 5).
+Mat6 ProjectPsd(const Mat6& h) {
+  const Mat6 sym = 0.5 * (h + h.transpose());
+  Eigen::SelfAdjointEigenSolver<Mat6> eig(sym);
+  if (eig.eigenvalues().minCoeff() >= 0) return sym;
+  return eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+}
+
+// StVK's Hessian is positive semi-definite when the Green strain is (no direction compressed)
+// and λ ≥ 0: then its projection is itself and the eigen-solve can be skipped.
+bool StvkNeedsProjection(const MembraneLame& l, const Mat32& f) {
+  const Eigen::Matrix2d e = 0.5 * (f.transpose() * f - Eigen::Matrix2d::Identity());
+  return l.lambda < 0 || e.trace() < 0 || e.determinant() < 0;
+}
+
+}  // namespace
+
+MembraneLame MembraneLame::FromStretch(double stretch_stiffness, double poisson) {
+  if (!(stretch_stiffness > 0) || !std::isfinite(stretch_stiffness)) {
+    throw InputError("membrane: stretch_stiffness must be a positive number of N/m, got " + Num(stretch_stiffness));
+  }
+  if (!(poisson > -1 && poisson < 1)) {
+    throw InputError("membrane: poisson must lie in (-1, 1) for a stable sheet, got " + Num(poisson));
+  }
+  MembraneLame l;
+  l.mu = stretch_stiffness / (2 * (1 + poisson));
+  l.lambda = stretch_stiffness * poisson / (1 - poisson * poisson);
+  return l;
+}
+
+double MembraneEnergy(MembraneModel model, const MembraneLame& lame, const Eigen::Matrix2d& rest_inverse,
+                      double rest_area, const Eigen::Matrix3d& x) {
+  const Mat32 f = DeformationGradient(rest_inverse, x);
+  const double psi = model == MembraneModel::kStVK ? StvkDensity(lame, f) : CorotationalDensity(lame, f);
+  return rest_area * psi;
+}
+
+Eigen::Matrix<double, 9, 1> MembraneGradient(MembraneModel model, const MembraneLame& lame,
+                                             const Eigen::Matrix2d& rest_inverse, double rest_area,
+                                             const Eigen::Matrix3d& x) {
+  const Mat32 f = DeformationGradient(rest_inverse, x);
+  const Vec6 p = model == MembraneModel::kStVK ? StvkStress(lame, f) : CorotationalStress(lame, f);
+  return rest_area * GradientMap(rest_inverse).transpose() * p;
+}
+
+Eigen::Matrix<double, 9, 9> MembraneHessian(MembraneModel model, const MembraneLame& lame,
+                                            const Eigen::Matrix2d& rest_inverse, double rest_area,
+                                            const Eigen::Matrix3d& x, bool project_psd) {
+  const Mat32 f = DeformationGradient(rest_inverse, x);
+  Mat6 h;
+  if (model == MembraneModel::kStVK) {
+    h = StvkStressDerivative(lame, f);
+    if (project_psd && StvkNeedsProjection(lame, f)) h = ProjectPsd(h);
+  } else {
+    h = CorotationalStressDerivative(lame, f);
+    if (project_psd) h = ProjectPsd(h);
+  }
+  const Eigen::Matrix<double, 6, 9> g = GradientMap(rest_inverse);
+  return rest_area * g.transpose() * h * g;
+}
+
+MembraneElements::MembraneElements(const TriangleMesh& rest, double stretch_stiffness, double poisson,
+                                   MembraneModel model)
+    : model_(model), lame_(MembraneLame::FromStretch(stretch_stiffness, poisson)) {
+  num_vertices_ = rest.num_vertices();
+  triangles_ = rest.triangles;
+  const int nf = rest.num_triangles();
+  rest_inverse_.resize(nf);
+  rest_area_.resize(nf);
+  for (int f = 0; f < nf; ++f) {
+    for (int c = 0; c < 3; ++c) {
+      if (triangles_(f, c) < 0 || triangles_(f, c) >= num_vertices_) {
+        throw InputError("membrane: triangle " + std::to_string(f) + " refers to vertex " +
+                         std::to_string(triangles_(f, c)) + ", outside 0.." + std::to_string(num_vertices_ - 1));
+      }
+    }
+    const Eigen::Vector3d x0 = rest.vertices.row(triangles_(f, 0)), x1 = rest.vertices.row(triangles_(f, 1)),
+                          x2 = rest.vertices.row(triangles_(f, 2));
+    // A frame of the triangle's plane: t1 along the first edge, t2 = n × t1.
+    const Eigen::Vector3d e1 = x1 - x0, e2 = x2 - x0;
+    const Eigen::Vector3d normal = e1.cross(e2);
+    const double area = 0.5 * normal.norm();
+    if (!(area > 1e-14 * std::max(e1.squaredNorm(), e2.squaredNorm())) || !std::isfinite(area)) {
+      throw InputError("membrane: rest triangle " + std::to_string(f) + " is degenerate (area " + Num(area) +
+                       " m²)");
+    }
+    const Eigen::Vector3d t1 = e1.normalized(), t2 = normal.normalized().cross(t1);
+    Eigen::Matrix2d dm;
+    dm << e1.dot(t1), e2.dot(t1), 0.0, e2.dot(t2);
+    rest_inverse_[f] = dm.inverse();
+    rest_area_(f) = area;
+  }
+}
+
+MembraneElements::MembraneElements(const TriangleMesh& rest, const Material& material, MembraneModel model)
+    : MembraneElements(rest, material.stretch_stiffness, material.poisson, model) {}
+
+void MembraneElements::CheckSize(Eigen::Ref<const Vertices> x) const {
+  if (x.rows() != num_vertices_) {
+    throw InputError("membrane: positions have " + std::to_string(x.rows()) + " rows, the mesh has " +
+                     std::to_string(num_vertices_) + " vertices");
+  }
+}
+
+Eigen::Matrix3d MembraneElements::Corners(Eigen::Ref<const Vertices> x, int f) const {
+  Eigen::Matrix3d c;
+  for (int k = 0; k < 3; ++k) c.row(k) = x.row(triangles_(f, k));
+  return c;
+}
+
+double MembraneElements::Energy(Eigen::Ref<const Vertices> x) const {
+  CheckSize(x);
+  double e = 0;
+  for (int f = 0; f < num_triangles(); ++f) {
+    e += MembraneEnergy(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f));
+  }
+  return e;
+}
+
+void MembraneElements::AddGradient(Eigen::Ref<const Vertices> x, Eigen::Ref<Vertices> grad) const {
+  CheckSize(x);
+  CheckSize(grad);
+  for (int f = 0; f < num_triangles(); ++f) {
+    const Eigen::Matrix<double, 9, 1> g = MembraneGradient(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f));
+    for (int k = 0; k < 3; ++k) grad.row(triangles_(f, k)) += g.segment<3>(3 * k).transpose();
+  }
+}
+
+void MembraneElements::AddHessianTriplets(Eigen::Ref<const Vertices> x, std::vector<Eigen::Triplet<double>>* triplets,
+                                          bool project_psd) const {
+  CheckSize(x);
+  triplets->reserve(triplets->size() + 81 * static_cast<std::size_t>(num_triangles()));
+  for (int f = 0; f < num_triangles(); ++f) {
+    const Eigen::Matrix<double, 9, 9> h =
+        MembraneHessian(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f), project_psd);
+    for (int a = 0; a < 3; ++a) {
+      for (int b = 0; b < 3; ++b) {
+        for (int c = 0; c < 3; ++c) {
+          for (int d = 0; d < 3; ++d) {
+            triplets->emplace_back(3 * triangles_(f, a) + c, 3 * triangles_(f, b) + d, h(3 * a + c, 3 * b + d));
+          }
+        }
+      }
+    }
+  }
+}
+
+}  // namespace textile

@@ -1,0 +1,323 @@
+#include "textile/sim/membrane.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <Eigen/SparseCore>
+#include <cmath>
+#include <random>
+
+#include "textile/sim/error.h"
+#include "textile/sim/mesh.h"
+#include "textile/sim/pattern_mesh.h"
+
+namespace textile {
+namespace {
+
+constexpr double kStiffness = 1000.0;  // physics.md default [N/m]
+constexpr double kPoisson = 0.3;
+const MembraneModel kModels[] = {MembraneModel::kCorotationalLinear, MembraneModel::kStVK};
+
+std::string Name(MembraneModel m) { return m == MembraneModel::kStVK ? "StVK" : "corotational"; }
+
+// A 10 cm criss-cross patch with its interior vertices jittered: irregular rest triangles.
+TriangleMesh IrregularPatch(unsigned seed) {
+  TriangleMesh m = CrissCrossGridMesh(0.1, 0.1, 3, 3);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-0.004, 0.004);
+  for (int v = 0; v < m.num_vertices(); ++v) {
+    const double x = m.vertices(v, 0), y = m.vertices(v, 1);
+    if (x > 1e-9 && x < 0.1 - 1e-9 && y > 1e-9 && y < 0.1 - 1e-9) m.vertices.row(v) += Eigen::RowVector3d(u(rng), u(rng), 0);
+  }
+  return m;
+}
+
+Eigen::Matrix3d RandomRotation(std::mt19937& rng) {
+  std::normal_distribution<double> n(0, 1);
+  const Eigen::Quaterniond q(n(rng), n(rng), n(rng), n(rng));
+  return q.normalized().toRotationMatrix();
+}
+
+// The rest shape rotated and moved in 3D, each vertex displaced by up to `noise` [m] (vertex
+// spacing ~25 mm): a mix of stretched, compressed and sheared triangles.
+Vertices RandomConfiguration(const TriangleMesh& rest, double noise, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-noise, noise);
+  const Eigen::Matrix3d r = RandomRotation(rng);
+  Vertices x = rest.vertices * r.transpose();
+  for (int v = 0; v < x.rows(); ++v) x.row(v) += Eigen::RowVector3d(0.3 + u(rng), -0.2 + u(rng), 0.1 + u(rng));
+  return x;
+}
+
+Vertices Gradient(const MembraneElements& m, const Vertices& x) {
+  Vertices g = Vertices::Zero(x.rows(), 3);
+  m.AddGradient(x, g);
+  return g;
+}
+
+Eigen::MatrixXd DenseHessian(const MembraneElements& m, const Vertices& x, bool project_psd) {
+  std::vector<Eigen::Triplet<double>> triplets;
+  m.AddHessianTriplets(x, &triplets, project_psd);
+  Eigen::SparseMatrix<double> h(3 * x.rows(), 3 * x.rows());
+  h.setFromTriplets(triplets.begin(), triplets.end());
+  return Eigen::MatrixXd(h);
+}
+
+TEST(Membrane, GradientMatchesCentralDifferences) {
+  const TriangleMesh rest = IrregularPatch(1);
+  for (MembraneModel model : kModels) {
+    const MembraneElements m(rest, kStiffness, kPoisson, model);
+    for (unsigned seed = 0; seed < 3; ++seed) {
+      Vertices x = RandomConfiguration(rest, 0.006, seed);
+      const Vertices g = Gradient(m, x);
+      // Step 1e-7 m: truncation ~ (1e-7)² · ψ''' and round-off ~ 1e-16 · E / 1e-7 both far below
+      // 1e-6 of the largest force (~10 N).
+      const double step = 1e-7;
+      double max_err = 0;
+      for (int v = 0; v < x.rows(); ++v) {
+        for (int c = 0; c < 3; ++c) {
+          const double keep = x(v, c);
+          x(v, c) = keep + step;
+          const double ep = m.Energy(x);
+          x(v, c) = keep - step;
+          const double em = m.Energy(x);
+          x(v, c) = keep;
+          max_err = std::max(max_err, std::abs((ep - em) / (2 * step) - g(v, c)));
+        }
+      }
+      EXPECT_LT(max_err, 1e-6 * g.cwiseAbs().maxCoeff()) << Name(model) << " seed " << seed;
+    }
+  }
+}
+
+TEST(Membrane, HessianMatchesCentralDifferencesOfTheGradient) {
+  const TriangleMesh rest = IrregularPatch(2);
+  for (MembraneModel model : kModels) {
+    const MembraneElements m(rest, kStiffness, kPoisson, model);
+    for (unsigned seed = 0; seed < 3; ++seed) {
+      Vertices x = RandomConfiguration(rest, 0.006, 10 + seed);
+      const Eigen::MatrixXd h = DenseHessian(m, x, /*project_psd=*/false);
+      EXPECT_LT((h - h.transpose()).cwiseAbs().maxCoeff(), 1e-10 * h.cwiseAbs().maxCoeff());
+      const double step = 1e-7;
+      double max_err = 0;
+      for (int v = 0; v < x.rows(); ++v) {
+        for (int c = 0; c < 3; ++c) {
+          const double keep = x(v, c);
+          x(v, c) = keep + step;
+          const Vertices gp = Gradient(m, x);
+          x(v, c) = keep - step;
+          const Vertices gm = Gradient(m, x);
+          x(v, c) = keep;
+          const Eigen::VectorXd column =
+              (Eigen::Map<const Eigen::VectorXd>(gp.data(), gp.size()) - Eigen::Map<const Eigen::VectorXd>(gm.data(), gm.size())) /
+              (2 * step);
+          max_err = std::max(max_err, (column - h.col(3 * v + c)).cwiseAbs().maxCoeff());
+        }
+      }
+      EXPECT_LT(max_err, 1e-6 * h.cwiseAbs().maxCoeff()) << Name(model) << " seed " << seed;
+    }
+  }
+}
+
+TEST(Membrane, ZeroEnergyAndForceAtRestAndAfterRigidMotion) {
+  const TriangleMesh rest = IrregularPatch(3);
+  for (MembraneModel model : kModels) {
+    const MembraneElements m(rest, kStiffness, kPoisson, model);
+    const Vertices moved = RandomConfiguration(rest, 0.0, 7);  // rotated out of the plane, moved
+    for (const Vertices& x : {rest.vertices, moved}) {
+      // Round-off: strains ~1e-16 give energies ~ k ε² A ~ 1e-32 J and forces ~ k ε L ~ 1e-14 N.
+      EXPECT_LT(std::abs(m.Energy(x)), 1e-20) << Name(model);
+      EXPECT_LT(Gradient(m, x).cwiseAbs().maxCoeff(), 1e-10) << Name(model);
+    }
+  }
+}
+
+TEST(Membrane, InvariantUnderRigidMotion) {
+  const TriangleMesh rest = IrregularPatch(4);
+  std::mt19937 rng(5);
+  for (MembraneModel model : kModels) {
+    const MembraneElements m(rest, kStiffness, kPoisson, model);
+    const Vertices x = RandomConfiguration(rest, 0.006, 21);
+    const Eigen::Matrix3d r = RandomRotation(rng);
+    Vertices y = x * r.transpose();
+    y.rowwise() += Eigen::RowVector3d(1.0, -2.0, 0.5);
+    EXPECT_NEAR(m.Energy(y), m.Energy(x), 1e-12 * m.Energy(x)) << Name(model);
+    const Vertices gx = Gradient(m, x), gy = Gradient(m, y);
+    EXPECT_LT((gy - gx * r.transpose()).cwiseAbs().maxCoeff(), 1e-9 * gx.cwiseAbs().maxCoeff()) << Name(model);
+  }
+}
+
+TEST(Membrane, ForcesSumToZeroWithNoNetTorque) {
+  const TriangleMesh rest = IrregularPatch(5);
+  for (MembraneModel model : kModels) {
+    const MembraneElements m(rest, kStiffness, kPoisson, model);
+    for (unsigned seed = 0; seed < 5; ++seed) {
+      const Vertices x = RandomConfiguration(rest, 0.008, 30 + seed);
+      const Vertices g = Gradient(m, x);
+      Eigen::Vector3d torque = Eigen::Vector3d::Zero();
+      for (int v = 0; v < x.rows(); ++v) torque += Eigen::Vector3d(x.row(v)).cross(Eigen::Vector3d(g.row(v)));
+      const double scale = g.cwiseAbs().maxCoeff();
+      EXPECT_LT(g.colwise().sum().cwiseAbs().maxCoeff(), 1e-12 * scale * x.rows()) << Name(model);
+      EXPECT_LT(torque.cwiseAbs().maxCoeff(), 1e-12 * scale * x.rows()) << Name(model);
+    }
+  }
+}
+
+// A deformation gradient applied to a whole mesh (x = A X, A 3×2 acting on (X, Y)).
+Vertices Affine(const TriangleMesh& rest, const Eigen::Matrix<double, 3, 2>& a) {
+  Vertices x(rest.num_vertices(), 3);
+  for (int v = 0; v < rest.num_vertices(); ++v) x.row(v) = (a * rest.vertices.row(v).head<2>().transpose()).transpose();
+  return x;
+}
+
+// ψ = k / (2 (1 - ν²)) (e11² + e22² + 2 ν e11 e22 + 2 (1 - ν) e12²), the plane-stress law.
+double PlaneStressDensity(double k, double nu, const Eigen::Matrix2d& e) {
+  return k / (2 * (1 - nu * nu)) *
+         (e(0, 0) * e(0, 0) + e(1, 1) * e(1, 1) + 2 * nu * e(0, 0) * e(1, 1) + 2 * (1 - nu) * e(0, 1) * e(0, 1));
+}
+
+TEST(Membrane, PatchTestUniformStrainGivesTheAnalyticEnergyAndNoInteriorForce) {
+  // An unstructured Gmsh mesh of a 20 × 10 cm strip.
+  PatternMeshOptions options;
+  options.element_size = 0.02;
+  const TriangleMesh rest = MeshRectangle(0.2, 0.1, {}, options).mesh;
+  const double area = TriangleAreas(rest).sum();
+  std::vector<bool> boundary(rest.num_vertices(), false);
+  for (const auto& e : BoundaryEdges(rest)) boundary[e[0]] = boundary[e[1]] = true;
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  // Corotational: principal stretches along x and y (rotation-free strain diag(ε1, ε2)), rotated.
+  {
+    const double e1 = 0.02, e2 = -0.005;
+    const MembraneElements m(rest, kStiffness, kPoisson, MembraneModel::kCorotationalLinear);
+    const Eigen::Matrix<double, 3, 2> a = r.leftCols<2>() * Eigen::Vector2d(1 + e1, 1 + e2).asDiagonal();
+    const Vertices x = Affine(rest, a);
+    const Eigen::Matrix2d strain = Eigen::Vector2d(e1, e2).asDiagonal();
+    EXPECT_NEAR(m.Energy(x), area * PlaneStressDensity(kStiffness, kPoisson, strain), 1e-12 * m.Energy(x));
+    const Vertices g = Gradient(m, x);
+    for (int v = 0; v < rest.num_vertices(); ++v) {
+      if (!boundary[v]) {
+        EXPECT_LT(g.row(v).norm(), 1e-10 * g.cwiseAbs().maxCoeff()) << "vertex " << v;
+      }
+    }
+    // The right edge carries the traction σ11 · height = k (ε1 + ν ε2) / (1 - ν²) · 0.1, along R x̂.
+    Eigen::Vector3d right = Eigen::Vector3d::Zero();
+    for (int v = 0; v < rest.num_vertices(); ++v) {
+      if (rest.vertices(v, 0) > 0.2 - 1e-12) right += g.row(v).transpose();
+    }
+    const double sigma11 = kStiffness * (e1 + kPoisson * e2) / (1 - kPoisson * kPoisson);
+    // The corner vertices also carry half an edge of the top/bottom edges' zero shear traction.
+    EXPECT_LT((right - sigma11 * 0.1 * r.col(0)).norm(), 1e-9 * sigma11 * 0.1);
+  }
+  // StVK: any uniform F, Green strain E = ½(FᵀF - I).
+  {
+    Eigen::Matrix2d f2;
+    f2 << 1.03, 0.02, -0.01, 0.98;
+    const MembraneElements m(rest, kStiffness, kPoisson, MembraneModel::kStVK);
+    const Eigen::Matrix<double, 3, 2> a = r.leftCols<2>() * f2;
+    const Vertices x = Affine(rest, a);
+    const Eigen::Matrix2d green = 0.5 * (f2.transpose() * f2 - Eigen::Matrix2d::Identity());
+    EXPECT_NEAR(m.Energy(x), area * PlaneStressDensity(kStiffness, kPoisson, green), 1e-12 * m.Energy(x));
+    const Vertices g = Gradient(m, x);
+    for (int v = 0; v < rest.num_vertices(); ++v) {
+      if (!boundary[v]) {
+        EXPECT_LT(g.row(v).norm(), 1e-10 * g.cwiseAbs().maxCoeff()) << "vertex " << v;
+      }
+    }
+  }
+}
+
+TEST(Membrane, StripStretchedOnePercentStoresHalfKEpsilonSquaredArea) {
+  const TriangleMesh strip = RegularGridMesh(0.2, 0.05, 8, 2);
+  const double eps = 0.01, area = 0.2 * 0.05;
+  Eigen::Matrix<double, 3, 2> a = Eigen::Matrix<double, 3, 2>::Zero();
+  a(0, 0) = 1 + eps;
+  a(1, 1) = 1;  // lateral size held (ν = 0, so no lateral stress either way)
+  const Vertices x = Affine(strip, a);
+  const double expected = 0.5 * kStiffness * eps * eps * area;  // 5e-4 J
+  const MembraneElements linear(strip, kStiffness, 0.0, MembraneModel::kCorotationalLinear);
+  EXPECT_NEAR(linear.Energy(x), expected, 1e-12 * expected);
+  // Green strain E11 = ε + ε²/2: StVK stores ½ k (ε + ε²/2)² A, 1.0025 % more.
+  const MembraneElements stvk(strip, kStiffness, 0.0, MembraneModel::kStVK);
+  EXPECT_NEAR(stvk.Energy(x), 0.5 * kStiffness * std::pow(eps + eps * eps / 2, 2) * area, 1e-12 * expected);
+  EXPECT_NEAR(stvk.Energy(x) / expected, 1.0, 0.011);
+}
+
+double MinEigenvalue(const Eigen::MatrixXd& h) {
+  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(h).eigenvalues().minCoeff();
+}
+
+TEST(Membrane, StabilisedHessianIsPsdWhenCompressed) {
+  const TriangleMesh rest = IrregularPatch(6);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> u(-0.002, 0.002);
+  Vertices x = Affine(rest, (Eigen::Matrix<double, 3, 2>() << 0.7, 0.0, 0.05, 0.9, 0.0, 0.0).finished());
+  for (int v = 0; v < x.rows(); ++v) x.row(v) += Eigen::RowVector3d(u(rng), u(rng), u(rng));
+  for (MembraneModel model : kModels) {
+    const MembraneElements m(rest, kStiffness, kPoisson, model);
+    const Eigen::MatrixXd raw = DenseHessian(m, x, false);
+    const Eigen::MatrixXd stable = DenseHessian(m, x, true);
+    const double scale = raw.cwiseAbs().maxCoeff();
+    EXPECT_LT(MinEigenvalue(raw), -1e-3 * scale) << Name(model) << ": compression makes the raw Hessian indefinite";
+    // Eigen-solver round-off on a matrix of norm ~scale.
+    EXPECT_GT(MinEigenvalue(stable), -1e-10 * scale) << Name(model);
+    // The energy and gradient are those of the unstabilised element: the equilibria are unchanged.
+  }
+}
+
+TEST(Membrane, StabilisationLeavesStretchedStvkElementsAlone) {
+  const TriangleMesh rest = IrregularPatch(7);
+  const Vertices x = Affine(rest, (Eigen::Matrix<double, 3, 2>() << 1.05, 0.01, 0.0, 1.02, 0.0, 0.0).finished());
+  const MembraneElements m(rest, kStiffness, kPoisson, MembraneModel::kStVK);
+  const Eigen::MatrixXd raw = DenseHessian(m, x, false);
+  EXPECT_EQ(raw, DenseHessian(m, x, true));
+  EXPECT_GT(MinEigenvalue(raw), -1e-10 * raw.cwiseAbs().maxCoeff());
+}
+
+TEST(Membrane, SingleElementFunctionsAgreeWithTheMesh) {
+  TriangleMesh tri;
+  tri.vertices.resize(3, 3);
+  tri.vertices << 0, 0, 0, 0.02, 0, 0, 0.005, 0.015, 0;
+  tri.triangles.resize(1, 3);
+  tri.triangles << 0, 1, 2;
+  const MembraneElements m(tri, kStiffness, kPoisson, MembraneModel::kStVK);
+  Eigen::Matrix2d dm;
+  dm << 0.02, 0.005, 0, 0.015;
+  Eigen::Matrix3d x;
+  x << 0, 0, 0, 0.021, 0.001, 0.002, 0.004, 0.016, 0;
+  const MembraneLame lame = MembraneLame::FromStretch(kStiffness, kPoisson);
+  EXPECT_NEAR(MembraneEnergy(MembraneModel::kStVK, lame, dm.inverse(), 1.5e-4, x), m.Energy(Vertices(x)), 1e-18);
+  EXPECT_NEAR(lame.mu, 1000 / 2.6, 1e-12);
+  EXPECT_NEAR(lame.lambda, 300 / 0.91, 1e-12);
+}
+
+TEST(Membrane, BadInputIsRefusedByName) {
+  const TriangleMesh rest = RegularGridMesh(0.1, 0.1, 2, 2);
+  auto error = [&](const std::function<void()>& f) -> std::string {
+    try {
+      f();
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "(no InputError)";
+  };
+  EXPECT_EQ(error([&] { MembraneElements(rest, -5.0, 0.3, MembraneModel::kStVK); }),
+            "membrane: stretch_stiffness must be a positive number of N/m, got -5");
+  EXPECT_EQ(error([&] { MembraneElements(rest, 1000.0, 1.0, MembraneModel::kStVK); }),
+            "membrane: poisson must lie in (-1, 1) for a stable sheet, got 1");
+  EXPECT_EQ(error([&] { MembraneElements(rest, std::nan(""), 0.3, MembraneModel::kStVK); }),
+            "membrane: stretch_stiffness must be a positive number of N/m, got nan");
+  TriangleMesh flat = rest;
+  flat.vertices.row(flat.triangles(3, 2)) = flat.vertices.row(flat.triangles(3, 0));
+  EXPECT_EQ(error([&] { MembraneElements(flat, 1000.0, 0.3, MembraneModel::kStVK); }).substr(0, 39),
+            "membrane: rest triangle 0 is degenerate");
+  TriangleMesh bad = rest;
+  bad.triangles(1, 1) = 99;
+  EXPECT_EQ(error([&] { MembraneElements(bad, 1000.0, 0.3, MembraneModel::kStVK); }),
+            "membrane: triangle 1 refers to vertex 99, outside 0..8");
+  const MembraneElements m(rest, 1000.0, 0.3, MembraneModel::kStVK);
+  EXPECT_EQ(error([&] { m.Energy(Vertices::Zero(4, 3)); }), "membrane: positions have 4 rows, the mesh has 9 vertices");
+}
+
+}  // namespace
+}  // namespace textile

@@ -515,24 +515,24 @@ void CheckSeams(const std::vector<Seam>& seams, const TriangleMesh& mesh) {
   }
 }
 
-Eigen::VectorXd HingeSeamDistances(const TriangleMesh& mesh, const std::vector<Hinge>& hinges,
-                                   const SeamLine& line) {
-  Eigen::VectorXd d(static_cast<Eigen::Index>(hinges.size()));
+std::vector<double> HingeSeamDistances(const TriangleMesh& mesh, const std::vector<Hinge>& hinges,
+                                       const SeamLine& line) {
+  std::vector<double> d(hinges.size());
   for (std::size_t h = 0; h < hinges.size(); ++h) {
     const Eigen::Vector2d mid = 0.5 * (Xy(mesh, hinges[h].v[2]) + Xy(mesh, hinges[h].v[3]));
-    d(static_cast<Eigen::Index>(h)) = DistanceToSeamLine(mid, line);
+    d[h] = DistanceToSeamLine(mid, line);
   }
   return d;
 }
 
-Eigen::VectorXd HingeSeamMultipliers(const TriangleMesh& mesh, const std::vector<Hinge>& hinges,
-                                     const std::vector<Seam>& seams) {
+std::vector<double> HingeSeamMultipliers(const TriangleMesh& mesh, const std::vector<Hinge>& hinges,
+                                         const std::vector<Seam>& seams) {
   CheckSeams(seams, mesh);
-  Eigen::VectorXd s = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(hinges.size()));
+  std::vector<double> s(hinges.size(), 1.0);
   for (const Seam& seam : seams) {
-    const Eigen::VectorXd d = HingeSeamDistances(mesh, hinges, seam.line);
-    for (Eigen::Index h = 0; h < d.size(); ++h) {
-      s(h) = std::max(s(h), seam.profile.Multiplier(units::MToMm(d(h))));
+    const std::vector<double> d = HingeSeamDistances(mesh, hinges, seam.line);
+    for (std::size_t h = 0; h < d.size(); ++h) {
+      s[h] = std::max(s[h], seam.profile.Multiplier(units::MToMm(d[h])));
     }
   }
   return s;

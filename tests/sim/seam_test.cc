@@ -341,60 +341,54 @@ TEST(SeamHinges, GridWithSeamAlongXConstPicksUpTheSeam) {
   const TriangleMesh mesh = RegularGridMesh(0.4, 0.2, 40, 20);  // 10 mm cells
   const std::vector<Hinge> hinges = BuildHinges(mesh);
   const Seam seam = MakeSeam("C-plain", {{0.2, 0.0}, {0.2, 0.2}});
-  const Eigen::VectorXd s = HingeSeamMultipliers(mesh, hinges, {seam});
-  const Eigen::VectorXd d = HingeSeamDistances(mesh, hinges, seam.line);
-  ASSERT_EQ(s.size(), static_cast<Eigen::Index>(hinges.size()));
-  int on_line = 0, stiffened = 0;
+  const std::vector<double> s = HingeSeamMultipliers(mesh, hinges, {seam});
+  const std::vector<double> d = HingeSeamDistances(mesh, hinges, seam.line);
+  ASSERT_EQ(s.size(), hinges.size());
+  ASSERT_EQ(d.size(), hinges.size());
+  const auto midpoint = [&](std::size_t h) -> Eigen::Vector2d {
+    return 0.5 * (mesh.vertices.row(hinges[h].v[2]) + mesh.vertices.row(hinges[h].v[3]))
+                     .head<2>()
+                     .transpose();
+  };
+  int on_line = 0, stiffened = 0, expected_stiffened = 0;
   for (std::size_t h = 0; h < hinges.size(); ++h) {
-    const auto i = static_cast<Eigen::Index>(h);
     // The seam spans the full height, so the distance is |x_mid - 0.2| (computed here anew).
-    const double x_mid =
-        0.5 * (mesh.vertices(hinges[h].v[2], 0) + mesh.vertices(hinges[h].v[3], 0));
-    const double d_mm = 1e3 * std::abs(x_mid - 0.2);
-    EXPECT_NEAR(1e3 * d(i), d_mm, 1e-9);
-    EXPECT_NEAR(s(i), seam.profile.Multiplier(d_mm), kPolynomialTolerance * 10);
+    const double d_mm = 1e3 * std::abs(midpoint(h).x() - 0.2);
+    EXPECT_NEAR(1e3 * d[h], d_mm, 1e-9);
+    EXPECT_NEAR(s[h], seam.profile.Multiplier(d_mm), kPolynomialTolerance * 10);
     if (d_mm < 1e-9) {
       ++on_line;
-      EXPECT_NEAR(s(i), 9.07, kPolynomialTolerance * 10);
+      EXPECT_NEAR(s[h], 9.07, kPolynomialTolerance * 10);
     }
     if (d_mm >= 120.0) {
-      EXPECT_EQ(s(i), 1.0);
+      EXPECT_EQ(s[h], 1.0);
     }
-    if (s(i) > 1.0) ++stiffened;
+    stiffened += s[h] > 1.0;
+    expected_stiffened += d_mm < 120.0 - 1e-9;  // closer than d_max + fade
   }
   EXPECT_EQ(on_line, 20);  // the vertical edges on x = 0.2, all interior
-  // Every hinge closer than d_max + fade is stiffened, no other.
-  int expected = 0;
-  for (std::size_t h = 0; h < hinges.size(); ++h)
-    expected += d(static_cast<Eigen::Index>(h)) < 0.12 - 1e-12;
-  EXPECT_EQ(stiffened, expected);
+  EXPECT_EQ(stiffened, expected_stiffened);
   EXPECT_GT(stiffened, static_cast<int>(hinges.size()) / 3);
   // A second, softer seam across: the crossing keeps the stiffer seam's multiplier (max).
   const Seam across = MakeSeam("A-plain", {{0.0, 0.1}, {0.4, 0.1}});
-  const Eigen::VectorXd both = HingeSeamMultipliers(mesh, hinges, {seam, across});
-  const Eigen::VectorXd d_across = HingeSeamDistances(mesh, hinges, across.line);
+  const std::vector<double> both = HingeSeamMultipliers(mesh, hinges, {seam, across});
+  const std::vector<double> d_across = HingeSeamDistances(mesh, hinges, across.line);
+  int far_on_across = 0;
   for (std::size_t h = 0; h < hinges.size(); ++h) {
-    const auto i = static_cast<Eigen::Index>(h);
-    EXPECT_EQ(both(i), std::max(s(i), across.profile.Multiplier(1e3 * d_across(i))));
-  }
-  // Far from the C seam, on the A seam's line: A's factor at the line.
-  const Eigen::Vector2d far(0.35, 0.1);
-  for (std::size_t h = 0; h < hinges.size(); ++h) {
-    const Eigen::Vector2d mid =
-        0.5 * (mesh.vertices.row(hinges[h].v[2]) + mesh.vertices.row(hinges[h].v[3]))
-                  .head<2>()
-                  .transpose();
-    if ((mid - far).norm() < 1e-9) {
-      EXPECT_NEAR(both(static_cast<Eigen::Index>(h)), 3.46, kPolynomialTolerance * 10);
+    EXPECT_EQ(both[h], std::max(s[h], across.profile.Multiplier(1e3 * d_across[h])));
+    // The edge (0.34, 0.1)-(0.35, 0.1): on the A seam, 145 mm from the C seam: A's factor.
+    if ((midpoint(h) - Eigen::Vector2d(0.345, 0.1)).norm() < 1e-9) {
+      ++far_on_across;
+      EXPECT_NEAR(both[h], 3.46, kPolynomialTolerance * 10);
     }
   }
+  EXPECT_EQ(far_on_across, 1);
 }
 
 TEST(SeamHinges, NoSeamsGiveOnes) {
   const TriangleMesh mesh = CrissCrossGridMesh(0.1, 0.1, 3, 3);
   const std::vector<Hinge> hinges = BuildHinges(mesh);
-  EXPECT_EQ(HingeSeamMultipliers(mesh, hinges, {}),
-            Eigen::VectorXd::Ones(static_cast<Eigen::Index>(hinges.size())));
+  EXPECT_EQ(HingeSeamMultipliers(mesh, hinges, {}), std::vector<double>(hinges.size(), 1.0));
 }
 
 // --- Mass -------------------------------------------------------------------------------------

@@ -12,7 +12,7 @@
 //   seam.line << 0.0, 0.1,  0.2, 0.1;                             // along y = 0.1 m
 //   textile::TriangleMesh mesh = textile::RegularGridMesh(0.2, 0.2, 40, 40);
 //   std::vector<textile::Hinge> hinges = textile::BuildHinges(mesh);
-//   Eigen::VectorXd s_h = textile::HingeSeamMultipliers(mesh, hinges, {seam});   // #H, ≥ 1
+//   std::vector<double> s_h = textile::HingeSeamMultipliers(mesh, hinges, {seam});  // #H, ≥ 1
 //   Eigen::VectorXd m = textile::LumpedMasses(mesh, 0.2, {seam});              // #V [kg]
 //   auto area_factor = textile::SeamAreaFactor({c});   // d [m] -> ⌈B_f⌉, for the mesher
 //
@@ -124,14 +124,14 @@ double DistanceToSeamLine(const Eigen::Vector2d& p, const SeamLine& line);
 void CheckSeams(const std::vector<Seam>& seams, const TriangleMesh& mesh);
 
 // Per-hinge distance [m] (#H) from the hinge's rest edge midpoint (v[2], v[3]) to the line.
-Eigen::VectorXd HingeSeamDistances(const TriangleMesh& mesh, const std::vector<Hinge>& hinges,
-                                   const SeamLine& line);
+std::vector<double> HingeSeamDistances(const TriangleMesh& mesh, const std::vector<Hinge>& hinges,
+                                       const SeamLine& line);
 
-// Per-hinge bending multipliers S (#H, ≥ 1) for the bending elements: for each hinge the
+// Per-hinge bending multipliers S (#H, ≥ 1), as BendingElements takes them: for each hinge the
 // largest S_i(d_i) over the seams (max, not product: crossing seams are as stiff as the
 // stiffer one; physics.md fixes no rule). No seams: all ones. Calls CheckSeams.
-Eigen::VectorXd HingeSeamMultipliers(const TriangleMesh& mesh, const std::vector<Hinge>& hinges,
-                                     const std::vector<Seam>& seams);
+std::vector<double> HingeSeamMultipliers(const TriangleMesh& mesh, const std::vector<Hinge>& hinges,
+                                         const std::vector<Seam>& seams);
 
 // The mesher's area factor (section 4.3) as a function of the distance d [m] to the nearest
 // seam: the largest AreaFactor over the profiles (all 1 for an empty list).

@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <fstream>
 #include <limits>
-#include <map>
 #include <set>
 #include <sstream>
 

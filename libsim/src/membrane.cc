@@ -1,5 +1,6 @@
 #include "textile/sim/membrane.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
@@ -158,6 +159,7 @@ Mat6 CorotationalStressDerivative(const MembraneLame& l, const Mat32& f) {
 // Clamps negative eigenvalues to zero (Teran et al. 2005; Sensitive Couture section 5).
 Mat6 ProjectPsd(const Mat6& h) {
   const Mat6 sym = 0.5 * (h + h.transpose());
+  if (Eigen::LLT<Mat6>(sym).info() == Eigen::Success) return sym;  // positive definite: cheap exit
   Eigen::SelfAdjointEigenSolver<Mat6> eig(sym);
   if (eig.eigenvalues().minCoeff() >= 0) return sym;
   return eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();

@@ -222,7 +222,7 @@ class SizeField {
   double AreaFactor(const Vector2d& p) const {
     if (!options_.area_factor || segments_.empty()) return 1.0;
     const double d = Distance(p);
-    if (d > options_.refinement_range) return 1.0;
+    if (!(d < options_.refinement_range)) return 1.0;  // range 0: no refinement at all
     const double f = options_.area_factor(d);
     if (!std::isfinite(f)) {
       throw InputError("pattern mesh: area_factor(d = " + Num(d) + " m) returned " + Num(f) +
@@ -305,7 +305,9 @@ struct RawMesh {
   std::vector<std::vector<std::size_t>> seam_nodes;  // per seam: nodes on its curves
 };
 
-RawMesh RunGmsh(const Outline& outline, const std::vector<Polyline2>& seams, const SizeField& field, double h) {
+RawMesh RunGmsh(const Outline& outline, const std::vector<Polyline2>& seams, const SizeField& field,
+                const PatternMeshOptions& options) {
+  const double h = options.element_size;
   RawMesh raw;
   GmshSession session;
   std::exception_ptr callback_error;
@@ -351,7 +353,7 @@ RawMesh RunGmsh(const Outline& outline, const std::vector<Polyline2>& seams, con
     }
     gmsh::model::occ::synchronize();
 
-    gmsh::option::setNumber("Mesh.Algorithm", 6);  // Frontal-Delaunay: well-shaped triangles
+    gmsh::option::setNumber("Mesh.Algorithm", options.gmsh_algorithm);
     gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
     gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
     gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
@@ -495,7 +497,7 @@ PatternMesh MeshOutline(const Outline& outline, const std::vector<Polyline2>& se
                      Num(h * 1e3) + " mm would exceed the limit of " + std::to_string(options.max_triangles) +
                      "; use a larger element size");
   }
-  PatternMesh pm = Assemble(RunGmsh(outline, seams, field, h), seams, snap);
+  PatternMesh pm = Assemble(RunGmsh(outline, seams, field, options), seams, snap);
   if (pm.mesh.num_triangles() > options.max_triangles) {
     throw InputError("pattern mesh: " + std::to_string(pm.mesh.num_triangles()) +
                      " triangles exceed the limit of " + std::to_string(options.max_triangles) +
@@ -516,6 +518,9 @@ bool PatternMeshOptions::Check(std::string* why) const {
   }
   if (!(refinement_range >= 0)) return fail("refinement_range must be >= 0, got " + Num(refinement_range));
   if (max_triangles < 1) return fail("max_triangles must be >= 1, got " + std::to_string(max_triangles));
+  if (gmsh_algorithm != 1 && gmsh_algorithm != 2 && gmsh_algorithm != 5 && gmsh_algorithm != 6) {
+    return fail("gmsh_algorithm must be 1, 2, 5 or 6, got " + std::to_string(gmsh_algorithm));
+  }
   return true;
 }
 

@@ -241,6 +241,12 @@ TEST(Membrane, StripStretchedOnePercentStoresHalfKEpsilonSquaredArea) {
   const MembraneElements stvk(strip, kStiffness, 0.0, MembraneModel::kStVK);
   EXPECT_NEAR(stvk.Energy(x), 0.5 * kStiffness * std::pow(eps + eps * eps / 2, 2) * area, 1e-12 * expected);
   EXPECT_NEAR(stvk.Energy(x) / expected, 1.0, 0.011);
+  // Tiny strains are not lost in round-off: ε = 1e-7 still gives ½ k ε² A to 1e-6.
+  a(0, 0) = 1 + 1e-7;
+  const Vertices tiny = Affine(strip, a);
+  const double tiny_expected = 0.5 * kStiffness * 1e-14 * area;
+  EXPECT_NEAR(linear.Energy(tiny), tiny_expected, 1e-6 * tiny_expected);
+  EXPECT_NEAR(stvk.Energy(tiny), tiny_expected, 1e-6 * tiny_expected);
 }
 
 double MinEigenvalue(const Eigen::MatrixXd& h) {

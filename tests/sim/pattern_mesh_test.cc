@@ -156,12 +156,16 @@ TEST(PatternMesh, DrapemeterSeamsAreEdgePathsThroughTheCentre) {
 }
 
 TEST(PatternMesh, SeamInsideAndPolylineSeamsAreEdgePaths) {
-  // A seam ending inside the pattern and a bent seam with one end on the boundary.
+  // A seam ending inside the pattern, a bent seam with one end on the boundary and a seam
+  // starting on the first one (a T junction).
   const std::vector<Polyline2> seams = {Line({{0.05, 0.05}, {0.15, 0.05}}),
-                                        Line({{0.0, 0.15}, {0.1, 0.12}, {0.17, 0.17}})};
+                                        Line({{0.0, 0.15}, {0.1, 0.12}, {0.17, 0.17}}),
+                                        Line({{0.1, 0.05}, {0.1, 0.09}})};
   const PatternMesh pm = MeshRectangle(0.2, 0.2, seams, Options(0.015));
   ExpectFlatCcw(pm.mesh);
   ExpectSeamPathsAreEdgePaths(pm, seams);
+  EXPECT_NE(std::find(pm.seam_paths[0].begin(), pm.seam_paths[0].end(), pm.seam_paths[2].front()),
+            pm.seam_paths[0].end());
 }
 
 TEST(PatternMesh, RefinesNearSeamsByTheAreaFactor) {
@@ -222,6 +226,10 @@ TEST(PatternMesh, OptionsCheckNamesTheField) {
   o.max_triangles = 0;
   EXPECT_FALSE(o.Check(&why));
   EXPECT_NE(why.find("max_triangles"), std::string::npos);
+  o = PatternMeshOptions();
+  o.gmsh_algorithm = 3;
+  EXPECT_FALSE(o.Check(&why));
+  EXPECT_EQ(why, "gmsh_algorithm must be 1, 2, 5 or 6, got 3");
 }
 
 TEST(PatternMesh, BadOutlinesAreRefusedByName) {

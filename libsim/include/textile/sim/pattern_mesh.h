@@ -40,10 +40,13 @@ struct PatternMeshOptions {
   // number; values below 1 mean no refinement. It should fall to 1 away from the seams: raw
   // Table 2 polynomials rise again far from the seam, S(d) does not.
   std::function<double(double d_m)> area_factor;
-  // Beyond this distance from every seam [m] area_factor is not consulted (factor 1).
+  // area_factor is consulted only for d < refinement_range [m]; elsewhere the factor is 1.
   double refinement_range = std::numeric_limits<double>::infinity();
   // Refuse (InputError) patterns whose estimated or actual triangle count exceeds this.
   long max_triangles = 2'000'000;
+  // Gmsh's 2D algorithm (option Mesh.Algorithm): 6 Frontal-Delaunay (best-shaped triangles),
+  // 5 Delaunay (faster on large meshes), 1 MeshAdapt, 2 automatic.
+  int gmsh_algorithm = 6;
 
   // False with a one-line reason when a field is out of range.
   bool Check(std::string* why) const;

@@ -89,11 +89,11 @@ Mat6 StvkStressDerivative(const MembraneLame& l, const Mat32& f) {
 // smooth function of F wherever the triangle has area (J > 0), no SVD needed.
 
 struct CorotationalTerms {
-  double s = 0;        // σ1 + σ2
-  double j = 0;        // σ1 σ2
-  Eigen::Vector3d n;   // unit normal of the deformed triangle
-  Vec6 grad_j;         // ∂J/∂vec(F)
-  Vec6 grad_s;         // ∂s/∂vec(F)
+  double s = 0;       // σ1 + σ2
+  double j = 0;       // σ1 σ2
+  Eigen::Vector3d n;  // unit normal of the deformed triangle
+  Vec6 grad_j;        // ∂J/∂vec(F)
+  Vec6 grad_s;        // ∂s/∂vec(F)
 };
 
 CorotationalTerms Corotational(const Mat32& f) {
@@ -147,7 +147,8 @@ Mat6 CorotationalStressDerivative(const MembraneLame& l, const Mat32& f) {
   Eigen::Matrix<double, 3, 6> a;
   a << -Skew(f2), Skew(f1);
   Mat6 hess_j = Mat6::Zero();
-  if (t.j > 0) hess_j = a.transpose() * (Eigen::Matrix3d::Identity() - t.n * t.n.transpose()) * a / t.j;
+  if (t.j > 0)
+    hess_j = a.transpose() * (Eigen::Matrix3d::Identity() - t.n * t.n.transpose()) * a / t.j;
   hess_j.block<3, 3>(0, 3) -= Skew(t.n);
   hess_j.block<3, 3>(3, 0) += Skew(t.n);
   const double s = std::max(t.s, 1e-300);
@@ -162,7 +163,8 @@ Mat6 ProjectPsd(const Mat6& h) {
   if (Eigen::LLT<Mat6>(sym).info() == Eigen::Success) return sym;  // positive definite: cheap exit
   Eigen::SelfAdjointEigenSolver<Mat6> eig(sym);
   if (eig.eigenvalues().minCoeff() >= 0) return sym;
-  return eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+  return eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
+         eig.eigenvectors().transpose();
 }
 
 // StVK's Hessian is positive semi-definite when the Green strain is (no direction compressed)
@@ -176,10 +178,12 @@ bool StvkNeedsProjection(const MembraneLame& l, const Mat32& f) {
 
 MembraneLame MembraneLame::FromStretch(double stretch_stiffness, double poisson) {
   if (!(stretch_stiffness > 0) || !std::isfinite(stretch_stiffness)) {
-    throw InputError("membrane: stretch_stiffness must be a positive number of N/m, got " + Num(stretch_stiffness));
+    throw InputError("membrane: stretch_stiffness must be a positive number of N/m, got " +
+                     Num(stretch_stiffness));
   }
   if (!(poisson > -1 && poisson < 1)) {
-    throw InputError("membrane: poisson must lie in (-1, 1) for a stable sheet, got " + Num(poisson));
+    throw InputError("membrane: poisson must lie in (-1, 1) for a stable sheet, got " +
+                     Num(poisson));
   }
   MembraneLame l;
   l.mu = stretch_stiffness / (2 * (1 + poisson));
@@ -187,10 +191,12 @@ MembraneLame MembraneLame::FromStretch(double stretch_stiffness, double poisson)
   return l;
 }
 
-double MembraneEnergy(MembraneModel model, const MembraneLame& lame, const Eigen::Matrix2d& rest_inverse,
-                      double rest_area, const Eigen::Matrix3d& x) {
+double MembraneEnergy(MembraneModel model, const MembraneLame& lame,
+                      const Eigen::Matrix2d& rest_inverse, double rest_area,
+                      const Eigen::Matrix3d& x) {
   const Mat32 f = DeformationGradient(rest_inverse, x);
-  const double psi = model == MembraneModel::kStVK ? StvkDensity(lame, f) : CorotationalDensity(lame, f);
+  const double psi =
+      model == MembraneModel::kStVK ? StvkDensity(lame, f) : CorotationalDensity(lame, f);
   return rest_area * psi;
 }
 
@@ -218,8 +224,8 @@ Eigen::Matrix<double, 9, 9> MembraneHessian(MembraneModel model, const MembraneL
   return rest_area * g.transpose() * h * g;
 }
 
-MembraneElements::MembraneElements(const TriangleMesh& rest, double stretch_stiffness, double poisson,
-                                   MembraneModel model)
+MembraneElements::MembraneElements(const TriangleMesh& rest, double stretch_stiffness,
+                                   double poisson, MembraneModel model)
     : model_(model), lame_(MembraneLame::FromStretch(stretch_stiffness, poisson)) {
   num_vertices_ = rest.num_vertices();
   triangles_ = rest.triangles;
@@ -230,18 +236,20 @@ MembraneElements::MembraneElements(const TriangleMesh& rest, double stretch_stif
     for (int c = 0; c < 3; ++c) {
       if (triangles_(f, c) < 0 || triangles_(f, c) >= num_vertices_) {
         throw InputError("membrane: triangle " + std::to_string(f) + " refers to vertex " +
-                         std::to_string(triangles_(f, c)) + ", outside 0.." + std::to_string(num_vertices_ - 1));
+                         std::to_string(triangles_(f, c)) + ", outside 0.." +
+                         std::to_string(num_vertices_ - 1));
       }
     }
-    const Eigen::Vector3d x0 = rest.vertices.row(triangles_(f, 0)), x1 = rest.vertices.row(triangles_(f, 1)),
+    const Eigen::Vector3d x0 = rest.vertices.row(triangles_(f, 0)),
+                          x1 = rest.vertices.row(triangles_(f, 1)),
                           x2 = rest.vertices.row(triangles_(f, 2));
     // A frame of the triangle's plane: t1 along the first edge, t2 = n × t1.
     const Eigen::Vector3d e1 = x1 - x0, e2 = x2 - x0;
     const Eigen::Vector3d normal = e1.cross(e2);
     const double area = 0.5 * normal.norm();
     if (!(area > 1e-14 * std::max(e1.squaredNorm(), e2.squaredNorm())) || !std::isfinite(area)) {
-      throw InputError("membrane: rest triangle " + std::to_string(f) + " is degenerate (area " + Num(area) +
-                       " m²)");
+      throw InputError("membrane: rest triangle " + std::to_string(f) + " is degenerate (area " +
+                       Num(area) + " m²)");
     }
     const Eigen::Vector3d t1 = e1.normalized(), t2 = normal.normalized().cross(t1);
     Eigen::Matrix2d dm;
@@ -251,13 +259,14 @@ MembraneElements::MembraneElements(const TriangleMesh& rest, double stretch_stif
   }
 }
 
-MembraneElements::MembraneElements(const TriangleMesh& rest, const Material& material, MembraneModel model)
+MembraneElements::MembraneElements(const TriangleMesh& rest, const Material& material,
+                                   MembraneModel model)
     : MembraneElements(rest, material.stretch_stiffness, material.poisson, model) {}
 
 void MembraneElements::CheckSize(Eigen::Ref<const Vertices> x) const {
   if (x.rows() != num_vertices_) {
-    throw InputError("membrane: positions have " + std::to_string(x.rows()) + " rows, the mesh has " +
-                     std::to_string(num_vertices_) + " vertices");
+    throw InputError("membrane: positions have " + std::to_string(x.rows()) +
+                     " rows, the mesh has " + std::to_string(num_vertices_) + " vertices");
   }
 }
 
@@ -280,12 +289,14 @@ void MembraneElements::AddGradient(Eigen::Ref<const Vertices> x, Eigen::Ref<Vert
   CheckSize(x);
   CheckSize(grad);
   for (int f = 0; f < num_triangles(); ++f) {
-    const Eigen::Matrix<double, 9, 1> g = MembraneGradient(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f));
+    const Eigen::Matrix<double, 9, 1> g =
+        MembraneGradient(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f));
     for (int k = 0; k < 3; ++k) grad.row(triangles_(f, k)) += g.segment<3>(3 * k).transpose();
   }
 }
 
-void MembraneElements::AddHessianTriplets(Eigen::Ref<const Vertices> x, std::vector<Eigen::Triplet<double>>* triplets,
+void MembraneElements::AddHessianTriplets(Eigen::Ref<const Vertices> x,
+                                          std::vector<Eigen::Triplet<double>>* triplets,
                                           bool project_psd) const {
   CheckSize(x);
   triplets->reserve(triplets->size() + 81 * static_cast<std::size_t>(num_triangles()));
@@ -296,7 +307,8 @@ void MembraneElements::AddHessianTriplets(Eigen::Ref<const Vertices> x, std::vec
       for (int b = 0; b < 3; ++b) {
         for (int c = 0; c < 3; ++c) {
           for (int d = 0; d < 3; ++d) {
-            triplets->emplace_back(3 * triangles_(f, a) + c, 3 * triangles_(f, b) + d, h(3 * a + c, 3 * b + d));
+            triplets->emplace_back(3 * triangles_(f, a) + c, 3 * triangles_(f, b) + d,
+                                   h(3 * a + c, 3 * b + d));
           }
         }
       }

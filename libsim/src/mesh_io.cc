@@ -42,8 +42,9 @@ void CheckScalar(const TriangleMesh& mesh, const VertexScalar& s) {
                      "\" must be letters, digits and '_', not starting with a digit");
   }
   if (s.values.size() != mesh.num_vertices()) {
-    throw InputError("mesh export: vertex data \"" + s.name + "\" has " + std::to_string(s.values.size()) +
-                     " values for " + std::to_string(mesh.num_vertices()) + " vertices");
+    throw InputError("mesh export: vertex data \"" + s.name + "\" has " +
+                     std::to_string(s.values.size()) + " values for " +
+                     std::to_string(mesh.num_vertices()) + " vertices");
   }
   for (int i = 0; i < s.values.size(); ++i) {
     if (!std::isfinite(s.values(i))) {
@@ -94,7 +95,8 @@ std::string ObjText(const TriangleMesh& mesh, const VertexScalar* colour) {
     Append(&out, hi);
     out += " (red)\n";
   }
-  out.reserve(out.size() + 60 * static_cast<std::size_t>(mesh.num_vertices() + mesh.num_triangles()));
+  out.reserve(out.size() +
+              60 * static_cast<std::size_t>(mesh.num_vertices() + mesh.num_triangles()));
   for (int v = 0; v < mesh.num_vertices(); ++v) {
     out += "v";
     for (int c = 0; c < 3; ++c) {
@@ -156,7 +158,8 @@ void WriteObj(const std::string& path, const TriangleMesh& mesh, const VertexSca
   WriteText(path, ObjText(mesh, colour));
 }
 
-void WritePly(const std::string& path, const TriangleMesh& mesh, const std::vector<VertexScalar>& scalars) {
+void WritePly(const std::string& path, const TriangleMesh& mesh,
+              const std::vector<VertexScalar>& scalars) {
   WriteText(path, PlyText(mesh, scalars));
 }
 
@@ -167,7 +170,9 @@ TriangleMesh ParseObj(const std::string& text, const std::string& source) {
   std::istringstream in(text);
   std::string line;
   int line_no = 0;
-  auto fail = [&](const std::string& what) { throw InputError(source + ":" + std::to_string(line_no) + ": " + what); };
+  auto fail = [&](const std::string& what) {
+    throw InputError(source + ":" + std::to_string(line_no) + ": " + what);
+  };
   while (std::getline(in, line)) {
     ++line_no;
     std::istringstream words(line);
@@ -191,10 +196,12 @@ TriangleMesh ParseObj(const std::string& text, const std::string& source) {
         const std::string head = word.substr(0, word.find('/'));
         long id;
         const auto r = std::from_chars(head.data(), head.data() + head.size(), id);
-        if (r.ec != std::errc() || r.ptr != head.data() + head.size() || id == 0) fail("bad vertex index \"" + word + "\"");
+        if (r.ec != std::errc() || r.ptr != head.data() + head.size() || id == 0)
+          fail("bad vertex index \"" + word + "\"");
         ids.push_back(id);
       }
-      if (ids.size() != 3) fail("face with " + std::to_string(ids.size()) + " vertices; only triangles are read");
+      if (ids.size() != 3)
+        fail("face with " + std::to_string(ids.size()) + " vertices; only triangles are read");
       const long defined = static_cast<long>(xyz.size() / 3);
       std::array<long, 3> face;
       for (int c = 0; c < 3; ++c) {
@@ -213,8 +220,8 @@ TriangleMesh ParseObj(const std::string& text, const std::string& source) {
     for (int c = 0; c < 3; ++c) {
       if (faces[f][c] >= nv) {
         line_no = face_lines[f];
-        fail("vertex index " + std::to_string(faces[f][c] + 1) + " is out of range (" + std::to_string(nv) +
-             " vertices)");
+        fail("vertex index " + std::to_string(faces[f][c] + 1) + " is out of range (" +
+             std::to_string(nv) + " vertices)");
       }
       mesh.triangles(f, c) = static_cast<int>(faces[f][c]);
     }
@@ -252,8 +259,9 @@ MeshQuality ComputeMeshQuality(const TriangleMesh& mesh) {
     const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
     q.min_area = std::min(q.min_area, area);
     q.max_area = std::max(q.max_area, area);
-    q.max_aspect_ratio = std::max(q.max_aspect_ratio, area > 0 ? longest * perimeter / (4 * std::sqrt(3.0) * area)
-                                                               : std::numeric_limits<double>::infinity());
+    q.max_aspect_ratio =
+        std::max(q.max_aspect_ratio, area > 0 ? longest * perimeter / (4 * std::sqrt(3.0) * area)
+                                              : std::numeric_limits<double>::infinity());
     for (int c = 0; c < 3; ++c) {
       // Angle at corner c from atan2(|u × v|, u · v): accurate for small and obtuse angles.
       const Eigen::Vector3d u = p[(c + 1) % 3] - p[c], v = p[(c + 2) % 3] - p[c];
@@ -278,9 +286,10 @@ MeshQuality ComputeMeshQuality(const TriangleMesh& mesh) {
 std::string MeshQuality::BriefReport() const {
   std::ostringstream s;
   s.setf(std::ios::fixed);
-  s << num_triangles << " triangles, " << num_vertices << " vertices; angles " << std::setprecision(1) << min_angle_deg
-    << ".." << max_angle_deg << "°; max aspect ratio " << std::setprecision(2) << max_aspect_ratio << "; edges "
-    << min_edge * 1e3 << ".." << max_edge * 1e3 << " mm (mean " << mean_edge * 1e3 << " mm)";
+  s << num_triangles << " triangles, " << num_vertices << " vertices; angles "
+    << std::setprecision(1) << min_angle_deg << ".." << max_angle_deg << "°; max aspect ratio "
+    << std::setprecision(2) << max_aspect_ratio << "; edges " << min_edge * 1e3 << ".."
+    << max_edge * 1e3 << " mm (mean " << mean_edge * 1e3 << " mm)";
   return s.str();
 }
 

@@ -27,8 +27,10 @@ std::string Num(double v) {
 
 double Cross(const Vector2d& a, const Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
-// Distance from p to the segment [a, b], and the segment parameter t in [0, 1] of the nearest point.
-double SegmentDistance(const Vector2d& p, const Vector2d& a, const Vector2d& b, double* t_out = nullptr) {
+// Distance from p to the segment [a, b], and the segment parameter t in [0, 1] of the nearest
+// point.
+double SegmentDistance(const Vector2d& p, const Vector2d& a, const Vector2d& b,
+                       double* t_out = nullptr) {
   const Vector2d ab = b - a;
   const double len2 = ab.squaredNorm();
   double t = len2 > 0 ? (p - a).dot(ab) / len2 : 0.0;
@@ -38,10 +40,12 @@ double SegmentDistance(const Vector2d& p, const Vector2d& a, const Vector2d& b, 
 }
 
 // Closed segments [a, b] and [c, d] share a point or come closer than tol.
-bool SegmentsTouch(const Vector2d& a, const Vector2d& b, const Vector2d& c, const Vector2d& d, double tol) {
+bool SegmentsTouch(const Vector2d& a, const Vector2d& b, const Vector2d& c, const Vector2d& d,
+                   double tol) {
   const double o1 = Cross(b - a, c - a), o2 = Cross(b - a, d - a);
   const double o3 = Cross(d - c, a - c), o4 = Cross(d - c, b - c);
-  if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0))) return true;
+  if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0)))
+    return true;
   return SegmentDistance(c, a, b) <= tol || SegmentDistance(d, a, b) <= tol ||
          SegmentDistance(a, c, d) <= tol || SegmentDistance(b, c, d) <= tol;
 }
@@ -50,7 +54,7 @@ bool SegmentsTouch(const Vector2d& a, const Vector2d& b, const Vector2d& c, cons
 struct Outline {
   bool is_disk = false;
   double radius = 0.0;
-  Polyline2 polygon;   // #N×2, counter-clockwise, not closed (last != first)
+  Polyline2 polygon;    // #N×2, counter-clockwise, not closed (last != first)
   double diameter = 0;  // bounding-box diagonal [m]
 
   int num_edges() const { return static_cast<int>(polygon.rows()); }
@@ -65,10 +69,12 @@ struct Outline {
   double DistanceToBoundary(const Vector2d& p) const {
     if (is_disk) return std::abs(p.norm() - radius);
     double d = std::numeric_limits<double>::infinity();
-    for (int i = 0; i < num_edges(); ++i) d = std::min(d, SegmentDistance(p, Corner(i), Corner(i + 1)));
+    for (int i = 0; i < num_edges(); ++i)
+      d = std::min(d, SegmentDistance(p, Corner(i), Corner(i + 1)));
     return d;
   }
-  // Strictly inside or outside; points on the boundary may go either way (callers test distance first).
+  // Strictly inside or outside; points on the boundary may go either way (callers test distance
+  // first).
   bool Contains(const Vector2d& p) const {
     if (is_disk) return p.norm() < radius;
     bool inside = false;
@@ -111,7 +117,8 @@ Outline PolygonOutline(const Polyline2& outline_in) {
   }
   const int n = static_cast<int>(outline.rows());
   if (n < 3) {
-    throw InputError("pattern mesh: the outline has " + std::to_string(n) + " points; a polygon needs at least 3");
+    throw InputError("pattern mesh: the outline has " + std::to_string(n) +
+                     " points; a polygon needs at least 3");
   }
   Outline o;
   o.polygon = outline;
@@ -131,13 +138,14 @@ Outline PolygonOutline(const Polyline2& outline_in) {
   for (int i = 0; i < n; ++i) {
     const Vector2d a = o.Corner(i), b = o.Corner(i + 1), c = o.Corner(i + 2);
     if (SegmentDistance(c, a, b) <= tol || SegmentDistance(a, b, c) <= tol) {
-      throw InputError("pattern mesh: the outline folds back on itself at point " + std::to_string((i + 1) % n));
+      throw InputError("pattern mesh: the outline folds back on itself at point " +
+                       std::to_string((i + 1) % n));
     }
     for (int j = i + 2; j < n; ++j) {
       if (i == 0 && j == n - 1) continue;  // adjacent through the closing edge
       if (SegmentsTouch(a, b, o.Corner(j), o.Corner(j + 1), tol)) {
-        throw InputError("pattern mesh: the outline intersects itself (edges " + std::to_string(i) + " and " +
-                         std::to_string(j) + ")");
+        throw InputError("pattern mesh: the outline intersects itself (edges " + std::to_string(i) +
+                         " and " + std::to_string(j) + ")");
       }
     }
   }
@@ -147,30 +155,34 @@ Outline PolygonOutline(const Polyline2& outline_in) {
 
 // Validates the seams against the outline and returns them with points within `snap` of the
 // boundary moved onto it (so that Gmsh splits the boundary there instead of leaving a sliver).
-std::vector<Polyline2> CheckedSeams(const std::vector<Polyline2>& seams, const Outline& outline, double snap) {
+std::vector<Polyline2> CheckedSeams(const std::vector<Polyline2>& seams, const Outline& outline,
+                                    double snap) {
   std::vector<Polyline2> out = seams;
   for (int k = 0; k < static_cast<int>(seams.size()); ++k) {
     Polyline2& s = out[k];
     const std::string name = "pattern mesh: seam " + std::to_string(k);
     const int n = static_cast<int>(s.rows());
-    if (n < 2) throw InputError(name + " has " + std::to_string(n) + " point(s); a seam needs at least 2");
+    if (n < 2)
+      throw InputError(name + " has " + std::to_string(n) + " point(s); a seam needs at least 2");
     for (int i = 0; i < n; ++i) {
       Vector2d p = s.row(i).transpose();
-      if (!p.allFinite()) throw InputError(name + " point " + std::to_string(i) + " is NaN or infinite");
+      if (!p.allFinite())
+        throw InputError(name + " point " + std::to_string(i) + " is NaN or infinite");
       const double d = outline.DistanceToBoundary(p);
       if (d <= snap) {
         p = outline.ProjectToBoundary(p);
       } else if (!outline.Contains(p)) {
-        throw InputError(name + " point " + std::to_string(i) + " lies outside the pattern (" + Num(d * 1e3) +
-                         " mm from its boundary)");
+        throw InputError(name + " point " + std::to_string(i) + " lies outside the pattern (" +
+                         Num(d * 1e3) + " mm from its boundary)");
       }
       s.row(i) = p.transpose();
     }
     auto pt = [&](int i) -> Vector2d { return s.row(i).transpose(); };
     for (int i = 0; i + 1 < n; ++i) {
       if ((pt(i + 1) - pt(i)).norm() <= snap) {
-        throw InputError(name + " segment " + std::to_string(i) + " has zero length (points " + std::to_string(i) +
-                         " and " + std::to_string(i + 1) + " coincide within " + Num(snap) + " m)");
+        throw InputError(name + " segment " + std::to_string(i) + " has zero length (points " +
+                         std::to_string(i) + " and " + std::to_string(i + 1) + " coincide within " +
+                         Num(snap) + " m)");
       }
     }
     for (int i = 0; i + 1 < n; ++i) {
@@ -180,24 +192,31 @@ std::vector<Polyline2> CheckedSeams(const std::vector<Polyline2>& seams, const O
           const Vector2d c = outline.Corner(e), d = outline.Corner(e + 1);
           const double o1 = Cross(b - a, c - a), o2 = Cross(b - a, d - a);
           const double o3 = Cross(d - c, a - c), o4 = Cross(d - c, b - c);
-          const bool proper = ((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0));
-          const bool ends_here = SegmentDistance(a, c, d) <= snap || SegmentDistance(b, c, d) <= snap;
-          const bool corner_on = (SegmentDistance(c, a, b) <= snap && (c - a).norm() > snap && (c - b).norm() > snap);
+          const bool proper = ((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) &&
+                              ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0));
+          const bool ends_here =
+              SegmentDistance(a, c, d) <= snap || SegmentDistance(b, c, d) <= snap;
+          const bool corner_on =
+              (SegmentDistance(c, a, b) <= snap && (c - a).norm() > snap && (c - b).norm() > snap);
           if ((proper && !ends_here) || corner_on) {
-            throw InputError(name + " segment " + std::to_string(i) + " crosses the pattern boundary");
+            throw InputError(name + " segment " + std::to_string(i) +
+                             " crosses the pattern boundary");
           }
         }
       }
       // Not crossing the boundary, the open segment is inside or outside as a whole.
       if (outline.DistanceToBoundary(0.5 * (a + b)) <= snap || !outline.Contains(0.5 * (a + b))) {
-        throw InputError(name + " segment " + std::to_string(i) + " runs outside or along the pattern boundary");
+        throw InputError(name + " segment " + std::to_string(i) +
+                         " runs outside or along the pattern boundary");
       }
-      if (i + 2 < n && (SegmentDistance(pt(i + 2), a, b) <= snap || SegmentDistance(a, b, pt(i + 2)) <= snap)) {
+      if (i + 2 < n &&
+          (SegmentDistance(pt(i + 2), a, b) <= snap || SegmentDistance(a, b, pt(i + 2)) <= snap)) {
         throw InputError(name + " folds back on itself at point " + std::to_string(i + 1));
       }
       for (int j = i + 2; j + 1 < n; ++j) {
         if (SegmentsTouch(a, b, pt(j), pt(j + 1), snap)) {
-          throw InputError(name + " crosses itself (segments " + std::to_string(i) + " and " + std::to_string(j) + ")");
+          throw InputError(name + " crosses itself (segments " + std::to_string(i) + " and " +
+                           std::to_string(j) + ")");
         }
       }
     }
@@ -208,9 +227,11 @@ std::vector<Polyline2> CheckedSeams(const std::vector<Polyline2>& seams, const O
 // Edge length h / sqrt(⌈area_factor(d)⌉) at distance d from the nearest seam.
 class SizeField {
  public:
-  SizeField(const std::vector<Polyline2>& seams, const PatternMeshOptions& options) : options_(options) {
+  SizeField(const std::vector<Polyline2>& seams, const PatternMeshOptions& options)
+      : options_(options) {
     for (const Polyline2& s : seams) {
-      for (int i = 0; i + 1 < s.rows(); ++i) segments_.push_back({s.row(i).transpose(), s.row(i + 1).transpose()});
+      for (int i = 0; i + 1 < s.rows(); ++i)
+        segments_.push_back({s.row(i).transpose(), s.row(i + 1).transpose()});
     }
   }
   double Distance(const Vector2d& p) const {
@@ -244,7 +265,8 @@ double EstimateTriangleCount(const Outline& outline, const SizeField& field, dou
   if (outline.is_disk) {
     lo.setConstant(-outline.radius), hi.setConstant(outline.radius);
   } else {
-    lo = outline.polygon.colwise().minCoeff().transpose(), hi = outline.polygon.colwise().maxCoeff().transpose();
+    lo = outline.polygon.colwise().minCoeff().transpose(),
+    hi = outline.polygon.colwise().maxCoeff().transpose();
   }
   const int n = 160;
   const Vector2d step = (hi - lo) / n;
@@ -300,8 +322,8 @@ std::string GmshError(const std::string& thrown) {
 // What Gmsh hands back, before compaction.
 struct RawMesh {
   std::vector<std::size_t> node_tags;
-  std::vector<double> node_xyz;                   // 3 per node
-  std::vector<std::size_t> triangle_nodes;        // 3 per triangle
+  std::vector<double> node_xyz;                      // 3 per node
+  std::vector<std::size_t> triangle_nodes;           // 3 per triangle
   std::vector<std::vector<std::size_t>> seam_nodes;  // per seam: nodes on its curves
 };
 
@@ -319,7 +341,8 @@ RawMesh RunGmsh(const Outline& outline, const std::vector<Polyline2>& seams, con
     } else {
       std::vector<int> points, lines;
       for (int i = 0; i < outline.num_edges(); ++i) {
-        points.push_back(gmsh::model::occ::addPoint(outline.polygon(i, 0), outline.polygon(i, 1), 0));
+        points.push_back(
+            gmsh::model::occ::addPoint(outline.polygon(i, 0), outline.polygon(i, 1), 0));
       }
       for (int i = 0; i < outline.num_edges(); ++i) {
         lines.push_back(gmsh::model::occ::addLine(points[i], points[(i + 1) % points.size()]));
@@ -377,17 +400,19 @@ RawMesh RunGmsh(const Outline& outline, const std::vector<Polyline2>& seams, con
     gmsh::model::mesh::getElements(types, element_tags, element_nodes, 2, -1);
     for (std::size_t i = 0; i < types.size(); ++i) {
       if (types[i] != 2) {
-        throw ComputeError("pattern mesh: Gmsh returned surface elements of type " + std::to_string(types[i]) +
-                           ", not 3-node triangles");
+        throw ComputeError("pattern mesh: Gmsh returned surface elements of type " +
+                           std::to_string(types[i]) + ", not 3-node triangles");
       }
-      raw.triangle_nodes.insert(raw.triangle_nodes.end(), element_nodes[i].begin(), element_nodes[i].end());
+      raw.triangle_nodes.insert(raw.triangle_nodes.end(), element_nodes[i].begin(),
+                                element_nodes[i].end());
     }
     raw.seam_nodes.resize(seams.size());
     for (std::size_t k = 0; k < seams.size(); ++k) {
       for (int curve : seam_curves[k]) {
         std::vector<std::size_t> tags;
         std::vector<double> xyz;
-        gmsh::model::mesh::getNodes(tags, xyz, parametric, 1, curve, /*includeBoundary=*/true, false);
+        gmsh::model::mesh::getNodes(tags, xyz, parametric, 1, curve, /*includeBoundary=*/true,
+                                    false);
         raw.seam_nodes[k].insert(raw.seam_nodes[k].end(), tags.begin(), tags.end());
       }
     }
@@ -402,7 +427,8 @@ RawMesh RunGmsh(const Outline& outline, const std::vector<Polyline2>& seams, con
 // orders each seam's vertices along the seam.
 PatternMesh Assemble(const RawMesh& raw, const std::vector<Polyline2>& seams, double snap) {
   std::unordered_map<std::size_t, int> node_index;
-  for (std::size_t i = 0; i < raw.node_tags.size(); ++i) node_index[raw.node_tags[i]] = static_cast<int>(i);
+  for (std::size_t i = 0; i < raw.node_tags.size(); ++i)
+    node_index[raw.node_tags[i]] = static_cast<int>(i);
   const int num_triangles = static_cast<int>(raw.triangle_nodes.size() / 3);
   if (num_triangles == 0) throw ComputeError("pattern mesh: Gmsh returned no triangles");
   std::vector<int> vertex_of_node(raw.node_tags.size(), -1);
@@ -415,13 +441,15 @@ PatternMesh Assemble(const RawMesh& raw, const std::vector<Polyline2>& seams, do
   pm.mesh.vertices.resize(static_cast<int>(used.size()), 3);
   for (int v = 0; v < static_cast<int>(used.size()); ++v) {
     const auto it = node_index.find(used[v]);
-    if (it == node_index.end()) throw ComputeError("pattern mesh: Gmsh returned a triangle with an unknown node");
+    if (it == node_index.end())
+      throw ComputeError("pattern mesh: Gmsh returned a triangle with an unknown node");
     vertex_of_node[it->second] = v;
     pm.mesh.vertices.row(v) << raw.node_xyz[3 * it->second], raw.node_xyz[3 * it->second + 1], 0.0;
   }
   pm.mesh.triangles.resize(num_triangles, 3);
   for (int f = 0; f < num_triangles; ++f) {
-    for (int c = 0; c < 3; ++c) pm.mesh.triangles(f, c) = vertex_of_node[node_index.at(raw.triangle_nodes[3 * f + c])];
+    for (int c = 0; c < 3; ++c)
+      pm.mesh.triangles(f, c) = vertex_of_node[node_index.at(raw.triangle_nodes[3 * f + c])];
     const Vector2d a = pm.mesh.vertices.row(pm.mesh.triangles(f, 0)).head<2>().transpose();
     const Vector2d b = pm.mesh.vertices.row(pm.mesh.triangles(f, 1)).head<2>().transpose();
     const Vector2d c = pm.mesh.vertices.row(pm.mesh.triangles(f, 2)).head<2>().transpose();
@@ -435,9 +463,12 @@ PatternMesh Assemble(const RawMesh& raw, const std::vector<Polyline2>& seams, do
 
   // Seams: vertices sorted by arc length along the polyline, then checked to be an edge path.
   std::unordered_set<std::uint64_t> edges;
-  auto key = [](int a, int b) { return (std::uint64_t(std::min(a, b)) << 32) | std::uint32_t(std::max(a, b)); };
+  auto key = [](int a, int b) {
+    return (std::uint64_t(std::min(a, b)) << 32) | std::uint32_t(std::max(a, b));
+  };
   for (int f = 0; f < num_triangles; ++f) {
-    for (int c = 0; c < 3; ++c) edges.insert(key(pm.mesh.triangles(f, c), pm.mesh.triangles(f, (c + 1) % 3)));
+    for (int c = 0; c < 3; ++c)
+      edges.insert(key(pm.mesh.triangles(f, c), pm.mesh.triangles(f, (c + 1) % 3)));
   }
   pm.vertex_seam.assign(pm.mesh.num_vertices(), -1);
   pm.seam_paths.resize(seams.size());
@@ -470,11 +501,13 @@ PatternMesh Assemble(const RawMesh& raw, const std::vector<Polyline2>& seams, do
         path.size() >= 2 &&
         (pm.mesh.vertices.row(path.front()).head<2>() - s.row(0)).norm() <= snap &&
         (pm.mesh.vertices.row(path.back()).head<2>() - s.row(s.rows() - 1)).norm() <= snap;
-    if (!ends_ok) throw ComputeError(name + " is not an edge path of the mesh (its ends have no vertices)");
+    if (!ends_ok)
+      throw ComputeError(name + " is not an edge path of the mesh (its ends have no vertices)");
     for (std::size_t i = 0; i + 1 < path.size(); ++i) {
       if (!edges.count(key(path[i], path[i + 1]))) {
-        throw ComputeError(name + " is not an edge path of the mesh (vertices " + std::to_string(path[i]) + " and " +
-                           std::to_string(path[i + 1]) + " share no edge)");
+        throw ComputeError(name + " is not an edge path of the mesh (vertices " +
+                           std::to_string(path[i]) + " and " + std::to_string(path[i + 1]) +
+                           " share no edge)");
       }
     }
     for (int v : path) {
@@ -493,8 +526,9 @@ PatternMesh MeshOutline(const Outline& outline, const std::vector<Polyline2>& se
   const SizeField field(seams, options);
   const double estimate = EstimateTriangleCount(outline, field, h);
   if (estimate > static_cast<double>(options.max_triangles)) {
-    throw InputError("pattern mesh: about " + std::to_string(std::llround(estimate)) + " triangles at element size " +
-                     Num(h * 1e3) + " mm would exceed the limit of " + std::to_string(options.max_triangles) +
+    throw InputError("pattern mesh: about " + std::to_string(std::llround(estimate)) +
+                     " triangles at element size " + Num(h * 1e3) +
+                     " mm would exceed the limit of " + std::to_string(options.max_triangles) +
                      "; use a larger element size");
   }
   PatternMesh pm = Assemble(RunGmsh(outline, seams, field, options), seams, snap);
@@ -516,8 +550,10 @@ bool PatternMeshOptions::Check(std::string* why) const {
   if (!(element_size > 0) || !std::isfinite(element_size)) {
     return fail("element_size must be a positive length in metres, got " + Num(element_size));
   }
-  if (!(refinement_range >= 0)) return fail("refinement_range must be >= 0, got " + Num(refinement_range));
-  if (max_triangles < 1) return fail("max_triangles must be >= 1, got " + std::to_string(max_triangles));
+  if (!(refinement_range >= 0))
+    return fail("refinement_range must be >= 0, got " + Num(refinement_range));
+  if (max_triangles < 1)
+    return fail("max_triangles must be >= 1, got " + std::to_string(max_triangles));
   if (gmsh_algorithm != 1 && gmsh_algorithm != 2 && gmsh_algorithm != 5 && gmsh_algorithm != 6) {
     return fail("gmsh_algorithm must be 1, 2, 5 or 6, got " + std::to_string(gmsh_algorithm));
   }
@@ -528,18 +564,20 @@ PatternMesh MeshRectangle(double width, double height, const std::vector<Polylin
                           const PatternMeshOptions& options) {
   CheckOptions(options);
   if (!(width > 0) || !(height > 0) || !std::isfinite(width) || !std::isfinite(height)) {
-    throw InputError("pattern mesh: rectangle sides must be positive lengths, got " + Num(width) + " × " +
-                     Num(height) + " m");
+    throw InputError("pattern mesh: rectangle sides must be positive lengths, got " + Num(width) +
+                     " × " + Num(height) + " m");
   }
   Polyline2 corners(4, 2);
   corners << 0, 0, width, 0, width, height, 0, height;
   return MeshOutline(PolygonOutline(corners), seams, options);
 }
 
-PatternMesh MeshDisk(double radius, const std::vector<Polyline2>& seams, const PatternMeshOptions& options) {
+PatternMesh MeshDisk(double radius, const std::vector<Polyline2>& seams,
+                     const PatternMeshOptions& options) {
   CheckOptions(options);
   if (!(radius > 0) || !std::isfinite(radius)) {
-    throw InputError("pattern mesh: disk radius must be a positive length, got " + Num(radius) + " m");
+    throw InputError("pattern mesh: disk radius must be a positive length, got " + Num(radius) +
+                     " m");
   }
   Outline o;
   o.is_disk = true;

@@ -28,7 +28,8 @@ TriangleMesh IrregularPatch(unsigned seed) {
   std::uniform_real_distribution<double> u(-0.004, 0.004);
   for (int v = 0; v < m.num_vertices(); ++v) {
     const double x = m.vertices(v, 0), y = m.vertices(v, 1);
-    if (x > 1e-9 && x < 0.1 - 1e-9 && y > 1e-9 && y < 0.1 - 1e-9) m.vertices.row(v) += Eigen::RowVector3d(u(rng), u(rng), 0);
+    if (x > 1e-9 && x < 0.1 - 1e-9 && y > 1e-9 && y < 0.1 - 1e-9)
+      m.vertices.row(v) += Eigen::RowVector3d(u(rng), u(rng), 0);
   }
   return m;
 }
@@ -46,7 +47,8 @@ Vertices RandomConfiguration(const TriangleMesh& rest, double noise, unsigned se
   std::uniform_real_distribution<double> u(-noise, noise);
   const Eigen::Matrix3d r = RandomRotation(rng);
   Vertices x = rest.vertices * r.transpose();
-  for (int v = 0; v < x.rows(); ++v) x.row(v) += Eigen::RowVector3d(0.3 + u(rng), -0.2 + u(rng), 0.1 + u(rng));
+  for (int v = 0; v < x.rows(); ++v)
+    x.row(v) += Eigen::RowVector3d(0.3 + u(rng), -0.2 + u(rng), 0.1 + u(rng));
   return x;
 }
 
@@ -109,9 +111,9 @@ TEST(Membrane, HessianMatchesCentralDifferencesOfTheGradient) {
           x(v, c) = keep - step;
           const Vertices gm = Gradient(m, x);
           x(v, c) = keep;
-          const Eigen::VectorXd column =
-              (Eigen::Map<const Eigen::VectorXd>(gp.data(), gp.size()) - Eigen::Map<const Eigen::VectorXd>(gm.data(), gm.size())) /
-              (2 * step);
+          const Eigen::VectorXd column = (Eigen::Map<const Eigen::VectorXd>(gp.data(), gp.size()) -
+                                          Eigen::Map<const Eigen::VectorXd>(gm.data(), gm.size())) /
+                                         (2 * step);
           max_err = std::max(max_err, (column - h.col(3 * v + c)).cwiseAbs().maxCoeff());
         }
       }
@@ -144,7 +146,8 @@ TEST(Membrane, InvariantUnderRigidMotion) {
     y.rowwise() += Eigen::RowVector3d(1.0, -2.0, 0.5);
     EXPECT_NEAR(m.Energy(y), m.Energy(x), 1e-12 * m.Energy(x)) << Name(model);
     const Vertices gx = Gradient(m, x), gy = Gradient(m, y);
-    EXPECT_LT((gy - gx * r.transpose()).cwiseAbs().maxCoeff(), 1e-9 * gx.cwiseAbs().maxCoeff()) << Name(model);
+    EXPECT_LT((gy - gx * r.transpose()).cwiseAbs().maxCoeff(), 1e-9 * gx.cwiseAbs().maxCoeff())
+        << Name(model);
   }
 }
 
@@ -156,7 +159,8 @@ TEST(Membrane, ForcesSumToZeroWithNoNetTorque) {
       const Vertices x = RandomConfiguration(rest, 0.008, 30 + seed);
       const Vertices g = Gradient(m, x);
       Eigen::Vector3d torque = Eigen::Vector3d::Zero();
-      for (int v = 0; v < x.rows(); ++v) torque += Eigen::Vector3d(x.row(v)).cross(Eigen::Vector3d(g.row(v)));
+      for (int v = 0; v < x.rows(); ++v)
+        torque += Eigen::Vector3d(x.row(v)).cross(Eigen::Vector3d(g.row(v)));
       const double scale = g.cwiseAbs().maxCoeff();
       EXPECT_LT(g.colwise().sum().cwiseAbs().maxCoeff(), 1e-12 * scale * x.rows()) << Name(model);
       EXPECT_LT(torque.cwiseAbs().maxCoeff(), 1e-12 * scale * x.rows()) << Name(model);
@@ -167,14 +171,16 @@ TEST(Membrane, ForcesSumToZeroWithNoNetTorque) {
 // A deformation gradient applied to a whole mesh (x = A X, A 3×2 acting on (X, Y)).
 Vertices Affine(const TriangleMesh& rest, const Eigen::Matrix<double, 3, 2>& a) {
   Vertices x(rest.num_vertices(), 3);
-  for (int v = 0; v < rest.num_vertices(); ++v) x.row(v) = (a * rest.vertices.row(v).head<2>().transpose()).transpose();
+  for (int v = 0; v < rest.num_vertices(); ++v)
+    x.row(v) = (a * rest.vertices.row(v).head<2>().transpose()).transpose();
   return x;
 }
 
 // ψ = k / (2 (1 - ν²)) (e11² + e22² + 2 ν e11 e22 + 2 (1 - ν) e12²), the plane-stress law.
 double PlaneStressDensity(double k, double nu, const Eigen::Matrix2d& e) {
   return k / (2 * (1 - nu * nu)) *
-         (e(0, 0) * e(0, 0) + e(1, 1) * e(1, 1) + 2 * nu * e(0, 0) * e(1, 1) + 2 * (1 - nu) * e(0, 1) * e(0, 1));
+         (e(0, 0) * e(0, 0) + e(1, 1) * e(1, 1) + 2 * nu * e(0, 0) * e(1, 1) +
+          2 * (1 - nu) * e(0, 1) * e(0, 1));
 }
 
 TEST(Membrane, PatchTestUniformStrainGivesTheAnalyticEnergyAndNoInteriorForce) {
@@ -185,15 +191,18 @@ TEST(Membrane, PatchTestUniformStrainGivesTheAnalyticEnergyAndNoInteriorForce) {
   const double area = TriangleAreas(rest).sum();
   std::vector<bool> boundary(rest.num_vertices(), false);
   for (const auto& e : BoundaryEdges(rest)) boundary[e[0]] = boundary[e[1]] = true;
-  const Eigen::Matrix3d r = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d r =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   // Corotational: principal stretches along x and y (rotation-free strain diag(ε1, ε2)), rotated.
   {
     const double e1 = 0.02, e2 = -0.005;
     const MembraneElements m(rest, kStiffness, kPoisson, MembraneModel::kCorotationalLinear);
-    const Eigen::Matrix<double, 3, 2> a = r.leftCols<2>() * Eigen::Vector2d(1 + e1, 1 + e2).asDiagonal();
+    const Eigen::Matrix<double, 3, 2> a =
+        r.leftCols<2>() * Eigen::Vector2d(1 + e1, 1 + e2).asDiagonal();
     const Vertices x = Affine(rest, a);
     const Eigen::Matrix2d strain = Eigen::Vector2d(e1, e2).asDiagonal();
-    EXPECT_NEAR(m.Energy(x), area * PlaneStressDensity(kStiffness, kPoisson, strain), 1e-12 * m.Energy(x));
+    EXPECT_NEAR(m.Energy(x), area * PlaneStressDensity(kStiffness, kPoisson, strain),
+                1e-12 * m.Energy(x));
     const Vertices g = Gradient(m, x);
     for (int v = 0; v < rest.num_vertices(); ++v) {
       if (!boundary[v]) {
@@ -217,7 +226,8 @@ TEST(Membrane, PatchTestUniformStrainGivesTheAnalyticEnergyAndNoInteriorForce) {
     const Eigen::Matrix<double, 3, 2> a = r.leftCols<2>() * f2;
     const Vertices x = Affine(rest, a);
     const Eigen::Matrix2d green = 0.5 * (f2.transpose() * f2 - Eigen::Matrix2d::Identity());
-    EXPECT_NEAR(m.Energy(x), area * PlaneStressDensity(kStiffness, kPoisson, green), 1e-12 * m.Energy(x));
+    EXPECT_NEAR(m.Energy(x), area * PlaneStressDensity(kStiffness, kPoisson, green),
+                1e-12 * m.Energy(x));
     const Vertices g = Gradient(m, x);
     for (int v = 0; v < rest.num_vertices(); ++v) {
       if (!boundary[v]) {
@@ -239,7 +249,8 @@ TEST(Membrane, StripStretchedOnePercentStoresHalfKEpsilonSquaredArea) {
   EXPECT_NEAR(linear.Energy(x), expected, 1e-12 * expected);
   // Green strain E11 = ε + ε²/2: StVK stores ½ k (ε + ε²/2)² A, 1.0025 % more.
   const MembraneElements stvk(strip, kStiffness, 0.0, MembraneModel::kStVK);
-  EXPECT_NEAR(stvk.Energy(x), 0.5 * kStiffness * std::pow(eps + eps * eps / 2, 2) * area, 1e-12 * expected);
+  EXPECT_NEAR(stvk.Energy(x), 0.5 * kStiffness * std::pow(eps + eps * eps / 2, 2) * area,
+              1e-12 * expected);
   EXPECT_NEAR(stvk.Energy(x) / expected, 1.0, 0.011);
   // Tiny strains are not lost in round-off: ε = 1e-7 still gives ½ k ε² A to 1e-6.
   a(0, 0) = 1 + 1e-7;
@@ -257,14 +268,16 @@ TEST(Membrane, StabilisedHessianIsPsdWhenCompressed) {
   const TriangleMesh rest = IrregularPatch(6);
   std::mt19937 rng(8);
   std::uniform_real_distribution<double> u(-0.002, 0.002);
-  Vertices x = Affine(rest, (Eigen::Matrix<double, 3, 2>() << 0.7, 0.0, 0.05, 0.9, 0.0, 0.0).finished());
+  Vertices x =
+      Affine(rest, (Eigen::Matrix<double, 3, 2>() << 0.7, 0.0, 0.05, 0.9, 0.0, 0.0).finished());
   for (int v = 0; v < x.rows(); ++v) x.row(v) += Eigen::RowVector3d(u(rng), u(rng), u(rng));
   for (MembraneModel model : kModels) {
     const MembraneElements m(rest, kStiffness, kPoisson, model);
     const Eigen::MatrixXd raw = DenseHessian(m, x, false);
     const Eigen::MatrixXd stable = DenseHessian(m, x, true);
     const double scale = raw.cwiseAbs().maxCoeff();
-    EXPECT_LT(MinEigenvalue(raw), -1e-3 * scale) << Name(model) << ": compression makes the raw Hessian indefinite";
+    EXPECT_LT(MinEigenvalue(raw), -1e-3 * scale)
+        << Name(model) << ": compression makes the raw Hessian indefinite";
     // Eigen-solver round-off on a matrix of norm ~scale.
     EXPECT_GT(MinEigenvalue(stable), -1e-10 * scale) << Name(model);
     // The energy and gradient are those of the unstabilised element: the equilibria are unchanged.
@@ -273,7 +286,8 @@ TEST(Membrane, StabilisedHessianIsPsdWhenCompressed) {
 
 TEST(Membrane, StabilisationLeavesStretchedStvkElementsAlone) {
   const TriangleMesh rest = IrregularPatch(7);
-  const Vertices x = Affine(rest, (Eigen::Matrix<double, 3, 2>() << 1.05, 0.01, 0.0, 1.02, 0.0, 0.0).finished());
+  const Vertices x =
+      Affine(rest, (Eigen::Matrix<double, 3, 2>() << 1.05, 0.01, 0.0, 1.02, 0.0, 0.0).finished());
   const MembraneElements m(rest, kStiffness, kPoisson, MembraneModel::kStVK);
   const Eigen::MatrixXd raw = DenseHessian(m, x, false);
   EXPECT_EQ(raw, DenseHessian(m, x, true));
@@ -292,7 +306,8 @@ TEST(Membrane, SingleElementFunctionsAgreeWithTheMesh) {
   Eigen::Matrix3d x;
   x << 0, 0, 0, 0.021, 0.001, 0.002, 0.004, 0.016, 0;
   const MembraneLame lame = MembraneLame::FromStretch(kStiffness, kPoisson);
-  EXPECT_NEAR(MembraneEnergy(MembraneModel::kStVK, lame, dm.inverse(), 1.5e-4, x), m.Energy(Vertices(x)), 1e-18);
+  EXPECT_NEAR(MembraneEnergy(MembraneModel::kStVK, lame, dm.inverse(), 1.5e-4, x),
+              m.Energy(Vertices(x)), 1e-18);
   EXPECT_NEAR(lame.mu, 1000 / 2.6, 1e-12);
   EXPECT_NEAR(lame.lambda, 300 / 0.91, 1e-12);
 }
@@ -322,7 +337,8 @@ TEST(Membrane, BadInputIsRefusedByName) {
   EXPECT_EQ(error([&] { MembraneElements(bad, 1000.0, 0.3, MembraneModel::kStVK); }),
             "membrane: triangle 1 refers to vertex 99, outside 0..8");
   const MembraneElements m(rest, 1000.0, 0.3, MembraneModel::kStVK);
-  EXPECT_EQ(error([&] { m.Energy(Vertices::Zero(4, 3)); }), "membrane: positions have 4 rows, the mesh has 9 vertices");
+  EXPECT_EQ(error([&] { m.Energy(Vertices::Zero(4, 3)); }),
+            "membrane: positions have 4 rows, the mesh has 9 vertices");
 }
 
 }  // namespace

@@ -29,7 +29,8 @@ TriangleMesh AwkwardMesh() {
   TriangleMesh m = RegularGridMesh(0.1, 0.07, 3, 2);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1e-3, 1e-3);
-  for (int v = 0; v < m.num_vertices(); ++v) m.vertices.row(v) += Eigen::RowVector3d(u(rng), u(rng), u(rng) / 3);
+  for (int v = 0; v < m.num_vertices(); ++v)
+    m.vertices.row(v) += Eigen::RowVector3d(u(rng), u(rng), u(rng) / 3);
   return m;
 }
 
@@ -61,7 +62,9 @@ TEST(MeshIo, ObjColoursMapTheScalarFromBlueToRed) {
   TriangleMesh m = RegularGridMesh(1, 1, 1, 1);
   VertexScalar s{"seam_multiplier", Eigen::Vector4d(1.0, 2.0, 3.0, 5.0)};
   const std::string text = ObjText(m, &s);
-  EXPECT_NE(text.find("# vertex colour: seam_multiplier from 1 (blue) to 5 (red)\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("# vertex colour: seam_multiplier from 1 (blue) to 5 (red)\n"),
+            std::string::npos)
+      << text;
   EXPECT_NE(text.find("v 0 0 0 0 0 1\n"), std::string::npos) << text;
   EXPECT_NE(text.find("v 1 0 0 0.25 0 0.75\n"), std::string::npos) << text;
   EXPECT_NE(text.find("v 1 1 0 1 0 0\n"), std::string::npos) << text;
@@ -70,7 +73,8 @@ TEST(MeshIo, ObjColoursMapTheScalarFromBlueToRed) {
 
 TEST(MeshIo, PlyCarriesScalarsAsProperties) {
   const TriangleMesh m = AwkwardMesh();
-  Eigen::VectorXd a = m.vertices.col(0) * 3.1, b = Eigen::VectorXd::Constant(m.num_vertices(), 1.0 / 3);
+  Eigen::VectorXd a = m.vertices.col(0) * 3.1,
+                  b = Eigen::VectorXd::Constant(m.num_vertices(), 1.0 / 3);
   const std::string text = PlyText(m, {{"seam_multiplier", a}, {"distance_m", b}});
   std::istringstream in(text);
   std::string line;
@@ -79,10 +83,15 @@ TEST(MeshIo, PlyCarriesScalarsAsProperties) {
   ASSERT_GE(header.size(), 10u);
   EXPECT_EQ(header[0], "ply");
   EXPECT_EQ(header[1], "format ascii 1.0");
-  EXPECT_NE(std::find(header.begin(), header.end(), "element vertex " + std::to_string(m.num_vertices())), header.end());
-  EXPECT_NE(std::find(header.begin(), header.end(), "property double seam_multiplier"), header.end());
+  EXPECT_NE(
+      std::find(header.begin(), header.end(), "element vertex " + std::to_string(m.num_vertices())),
+      header.end());
+  EXPECT_NE(std::find(header.begin(), header.end(), "property double seam_multiplier"),
+            header.end());
   EXPECT_NE(std::find(header.begin(), header.end(), "property double distance_m"), header.end());
-  EXPECT_NE(std::find(header.begin(), header.end(), "element face " + std::to_string(m.num_triangles())), header.end());
+  EXPECT_NE(
+      std::find(header.begin(), header.end(), "element face " + std::to_string(m.num_triangles())),
+      header.end());
   for (int v = 0; v < m.num_vertices(); ++v) {
     double x, y, z, s, d;
     in >> x >> y >> z >> s >> d;
@@ -109,29 +118,41 @@ TEST(MeshIo, PlyCarriesScalarsAsProperties) {
 
 TEST(MeshIo, BadVertexDataAndPathsAreRefusedByName) {
   const TriangleMesh m = RegularGridMesh(1, 1, 1, 1);
-  EXPECT_EQ(InputErrorOf([&] { PlyText(m, {{"seam multiplier", Eigen::Vector4d::Ones()}}); }),
-            "mesh export: vertex data name \"seam multiplier\" must be letters, digits and '_', not starting with a digit");
-  EXPECT_EQ(InputErrorOf([&] { PlyText(m, {{"s", Eigen::Vector3d::Ones()}}); }),
+  EXPECT_EQ(InputErrorOf([&] {
+              PlyText(m, {{"seam multiplier", Eigen::Vector4d::Ones()}});
+            }),
+            "mesh export: vertex data name \"seam multiplier\" must be letters, digits and '_', "
+            "not starting with a digit");
+  EXPECT_EQ(InputErrorOf([&] {
+              PlyText(m, {{"s", Eigen::Vector3d::Ones()}});
+            }),
             "mesh export: vertex data \"s\" has 3 values for 4 vertices");
   VertexScalar nan{"s", Eigen::Vector4d(1, 2, std::nan(""), 4)};
-  EXPECT_EQ(InputErrorOf([&] { ObjText(m, &nan); }), "mesh export: vertex data \"s\" value 2 is NaN or infinite");
+  EXPECT_EQ(InputErrorOf([&] { ObjText(m, &nan); }),
+            "mesh export: vertex data \"s\" value 2 is NaN or infinite");
   EXPECT_EQ(InputErrorOf([&] { WriteObj("/nonexistent-dir/m.obj", m); }),
             "/nonexistent-dir/m.obj: cannot open for writing");
-  EXPECT_EQ(InputErrorOf([&] { ReadObj("/nonexistent-dir/m.obj"); }), "/nonexistent-dir/m.obj: cannot open for reading");
+  EXPECT_EQ(InputErrorOf([&] { ReadObj("/nonexistent-dir/m.obj"); }),
+            "/nonexistent-dir/m.obj: cannot open for reading");
 }
 
 TEST(MeshIo, ObjReaderHandlesCommonFormsAndNamesBadLines) {
-  const TriangleMesh m = ParseObj("# c\nv 0 0 0\nv 1 0 0\nvt 0 0\nv 0 1 0 0.5 0.5 0.5\nf 1/1 2/1/1 3//1\nf -3 -2 -1\n", "a.obj");
+  const TriangleMesh m =
+      ParseObj("# c\nv 0 0 0\nv 1 0 0\nvt 0 0\nv 0 1 0 0.5 0.5 0.5\nf 1/1 2/1/1 3//1\nf -3 -2 -1\n",
+               "a.obj");
   EXPECT_EQ(m.num_vertices(), 3);
   ASSERT_EQ(m.num_triangles(), 2);
   EXPECT_EQ(m.triangles.row(0), Eigen::RowVector3i(0, 1, 2));
   EXPECT_EQ(m.triangles.row(1), Eigen::RowVector3i(0, 1, 2));
-  EXPECT_EQ(InputErrorOf([] { ParseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3\n", "q.obj"); }),
-            "q.obj:5: face with 4 vertices; only triangles are read");
+  EXPECT_EQ(
+      InputErrorOf([] { ParseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3\n", "q.obj"); }),
+      "q.obj:5: face with 4 vertices; only triangles are read");
   EXPECT_EQ(InputErrorOf([] { ParseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n", "q.obj"); }),
             "q.obj:4: vertex index 7 is out of range (3 vertices)");
-  EXPECT_EQ(InputErrorOf([] { ParseObj("v 0 zero 0\n", "q.obj"); }), "q.obj:1: bad coordinate \"zero\"");
-  EXPECT_EQ(InputErrorOf([] { ParseObj("v 0 0\n", "q.obj"); }), "q.obj:1: a vertex needs 3 coordinates");
+  EXPECT_EQ(InputErrorOf([] { ParseObj("v 0 zero 0\n", "q.obj"); }),
+            "q.obj:1: bad coordinate \"zero\"");
+  EXPECT_EQ(InputErrorOf([] { ParseObj("v 0 0\n", "q.obj"); }),
+            "q.obj:1: a vertex needs 3 coordinates");
 }
 
 TEST(MeshIo, QualityOfKnownTriangles) {
@@ -150,14 +171,16 @@ TEST(MeshIo, QualityOfKnownTriangles) {
   q = ComputeMeshQuality(RegularGridMesh(0.2, 0.2, 2, 2));
   EXPECT_NEAR(q.min_angle_deg, 45.0, 1e-12);
   EXPECT_NEAR(q.max_angle_deg, 90.0, 1e-12);
-  EXPECT_NEAR(q.max_aspect_ratio, std::sqrt(2.0) * (2 + std::sqrt(2.0)) / (2 * std::sqrt(3.0)), 1e-12);
+  EXPECT_NEAR(q.max_aspect_ratio, std::sqrt(2.0) * (2 + std::sqrt(2.0)) / (2 * std::sqrt(3.0)),
+              1e-12);
   EXPECT_NEAR(q.min_edge, 0.1, 1e-15);
   EXPECT_NEAR(q.max_edge, 0.1 * std::sqrt(2.0), 1e-15);
   EXPECT_EQ(q.num_triangles, 8);
   EXPECT_EQ(q.num_vertices, 9);
   EXPECT_NEAR(q.min_area, 0.005, 1e-15);
   EXPECT_EQ(q.BriefReport(),
-            "8 triangles, 9 vertices; angles 45.0..90.0°; max aspect ratio 1.39; edges 100.00..141.42 mm (mean 110.36 mm)");
+            "8 triangles, 9 vertices; angles 45.0..90.0°; max aspect ratio 1.39; edges "
+            "100.00..141.42 mm (mean 110.36 mm)");
 }
 
 TEST(MeshIo, GmshPatternMeshesAreWellShaped) {

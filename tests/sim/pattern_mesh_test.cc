@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-
 #include <cmath>
 #include <numbers>
 #include <set>
@@ -52,7 +51,9 @@ void ExpectSeamPathsAreEdgePaths(const PatternMesh& pm, const std::vector<Polyli
     ASSERT_GE(path.size(), 2u);
     // Gmsh puts seam end points exactly where asked (up to OCC's tolerance, 1e-7 m).
     EXPECT_LT((pm.mesh.vertices.row(path.front()).head<2>() - seams[k].row(0)).norm(), 1e-7);
-    EXPECT_LT((pm.mesh.vertices.row(path.back()).head<2>() - seams[k].row(seams[k].rows() - 1)).norm(), 1e-7);
+    EXPECT_LT(
+        (pm.mesh.vertices.row(path.back()).head<2>() - seams[k].row(seams[k].rows() - 1)).norm(),
+        1e-7);
     for (std::size_t i = 0; i + 1 < path.size(); ++i) {
       EXPECT_TRUE(edges.count({std::min(path[i], path[i + 1]), std::max(path[i], path[i + 1])}))
           << "seam " << k << " step " << i;
@@ -65,7 +66,8 @@ void ExpectFlatCcw(const TriangleMesh& m) {
   EXPECT_NO_THROW(CheckMesh(m));
   EXPECT_EQ(m.vertices.col(2).cwiseAbs().maxCoeff(), 0.0);
   for (int f = 0; f < m.num_triangles(); ++f) {
-    const Eigen::Vector3d a = m.vertices.row(m.triangles(f, 0)), b = m.vertices.row(m.triangles(f, 1)),
+    const Eigen::Vector3d a = m.vertices.row(m.triangles(f, 0)),
+                          b = m.vertices.row(m.triangles(f, 1)),
                           c = m.vertices.row(m.triangles(f, 2));
     ASSERT_GT((b - a).cross(c - a).z(), 0.0) << "triangle " << f;
   }
@@ -132,8 +134,9 @@ TEST(PatternMesh, MeshingIsDeterministic) {
 TEST(PatternMesh, DrapemeterSeamsAreEdgePathsThroughTheCentre) {
   const double r = 0.15;
   // Weft and warp seams through the centre (ending on the rim) and a shifted chord.
-  const std::vector<Polyline2> seams = {Line({{-r, 0}, {r, 0}}), Line({{0, -r}, {0, r}}),
-                                        Line({{0.05, -std::sqrt(r * r - 0.0025)}, {0.05, std::sqrt(r * r - 0.0025)}})};
+  const std::vector<Polyline2> seams = {
+      Line({{-r, 0}, {r, 0}}), Line({{0, -r}, {0, r}}),
+      Line({{0.05, -std::sqrt(r * r - 0.0025)}, {0.05, std::sqrt(r * r - 0.0025)}})};
   const PatternMesh pm = MeshDisk(r, seams, Options(0.01));
   ExpectFlatCcw(pm.mesh);
   ExpectSeamPathsAreEdgePaths(pm, seams);
@@ -206,7 +209,9 @@ TEST(PatternMesh, IsThreadSafeAndQuiet) {
   std::vector<PatternMesh> out(4);
   std::vector<std::thread> threads;
   for (int i = 0; i < 4; ++i) {
-    threads.emplace_back([&out, i] { out[i] = MeshDisk(0.1, {Line({{-0.1, 0}, {0.1, 0}})}, Options(0.01)); });
+    threads.emplace_back([&out, i] {
+      out[i] = MeshDisk(0.1, {Line({{-0.1, 0}, {0.1, 0}})}, Options(0.01));
+    });
   }
   for (auto& t : threads) t.join();
   EXPECT_EQ(testing::internal::GetCapturedStdout(), "");
@@ -234,18 +239,30 @@ TEST(PatternMesh, OptionsCheckNamesTheField) {
 
 TEST(PatternMesh, BadOutlinesAreRefusedByName) {
   const PatternMeshOptions o = Options(0.01);
-  EXPECT_EQ(MeshError([&] { MeshPolygon(Line({{0, 0}, {1, 0}}), {}, o); }),
+  EXPECT_EQ(MeshError([&] {
+              MeshPolygon(Line({{0, 0}, {1, 0}}), {}, o);
+            }),
             "pattern mesh: the outline has 2 points; a polygon needs at least 3");
-  EXPECT_EQ(MeshError([&] { MeshPolygon(Line({{0, 0}, {1, 0}, {std::nan(""), 1}}), {}, o); }),
+  EXPECT_EQ(MeshError([&] {
+              MeshPolygon(Line({{0, 0}, {1, 0}, {std::nan(""), 1}}), {}, o);
+            }),
             "pattern mesh: outline point 2 is NaN or infinite");
-  EXPECT_EQ(MeshError([&] { MeshPolygon(Line({{0, 0}, {0.1, 0}, {0.1, 0.1}, {0.1, 0.1}}), {}, o); }),
+  EXPECT_EQ(MeshError([&] {
+              MeshPolygon(Line({{0, 0}, {0.1, 0}, {0.1, 0.1}, {0.1, 0.1}}), {}, o);
+            }),
             "pattern mesh: outline points 2 and 3 coincide (zero-length edge)");
-  EXPECT_EQ(MeshError([&] { MeshPolygon(Line({{0, 0}, {0.1, 0}, {0.2, 0}}), {}, o); }).substr(0, 46),
+  EXPECT_EQ(MeshError([&] {
+              MeshPolygon(Line({{0, 0}, {0.1, 0}, {0.2, 0}}), {}, o);
+            }).substr(0, 46),
             "pattern mesh: the outline is degenerate (area ");
   // A bow tie.
-  EXPECT_EQ(MeshError([&] { MeshPolygon(Line({{0, 0}, {0.1, 0.1}, {0.1, 0}, {0, 0.2}}), {}, o); }),
+  EXPECT_EQ(MeshError([&] {
+              MeshPolygon(Line({{0, 0}, {0.1, 0.1}, {0.1, 0}, {0, 0.2}}), {}, o);
+            }),
             "pattern mesh: the outline intersects itself (edges 0 and 2)");
-  EXPECT_EQ(MeshError([&] { MeshPolygon(Line({{0, 0}, {0.2, 0}, {0.1, 0}, {0.1, 0.1}}), {}, o); }),
+  EXPECT_EQ(MeshError([&] {
+              MeshPolygon(Line({{0, 0}, {0.2, 0}, {0.1, 0}, {0.1, 0.1}}), {}, o);
+            }),
             "pattern mesh: the outline folds back on itself at point 1");
   EXPECT_EQ(MeshError([&] { MeshDisk(-1, {}, o); }),
             "pattern mesh: disk radius must be a positive length, got -1 m");
@@ -257,41 +274,57 @@ TEST(PatternMesh, BadOutlinesAreRefusedByName) {
 
 TEST(PatternMesh, BadSeamsAreRefusedByName) {
   const PatternMeshOptions o = Options(0.01);
-  auto disk = [&](std::vector<Polyline2> seams) { return MeshError([&] { MeshDisk(0.1, seams, o); }); };
+  auto disk = [&](std::vector<Polyline2> seams) {
+    return MeshError([&] { MeshDisk(0.1, seams, o); });
+  };
   const Polyline2 ok = Line({{0, 0}, {0.05, 0}});
-  EXPECT_EQ(disk({ok, ok, Line({{0, 0}})}), "pattern mesh: seam 2 has 1 point(s); a seam needs at least 2");
+  EXPECT_EQ(disk({ok, ok, Line({{0, 0}})}),
+            "pattern mesh: seam 2 has 1 point(s); a seam needs at least 2");
   EXPECT_EQ(disk({ok, ok, Line({{0, 0}, {0.01, 0}, {0.02, 0}, {0.2, 0}})}),
             "pattern mesh: seam 2 point 3 lies outside the pattern (100 mm from its boundary)");
-  EXPECT_EQ(disk({Line({{0, 0}, {0.01, std::nan("")}})}), "pattern mesh: seam 0 point 1 is NaN or infinite");
-  EXPECT_EQ(disk({ok, Line({{0, 0}, {0.01, 0}, {0.01, 0}})}),
-            "pattern mesh: seam 1 segment 1 has zero length (points 1 and 2 coincide within 1e-05 m)");
+  EXPECT_EQ(disk({Line({{0, 0}, {0.01, std::nan("")}})}),
+            "pattern mesh: seam 0 point 1 is NaN or infinite");
+  EXPECT_EQ(
+      disk({ok, Line({{0, 0}, {0.01, 0}, {0.01, 0}})}),
+      "pattern mesh: seam 1 segment 1 has zero length (points 1 and 2 coincide within 1e-05 m)");
   EXPECT_EQ(disk({Line({{-0.05, 0}, {0.05, 0}, {0.05, 0.05}, {0, -0.05}})}),
             "pattern mesh: seam 0 crosses itself (segments 0 and 2)");
-  EXPECT_EQ(disk({Line({{-0.05, 0}, {0.05, 0}, {0.0, 0}})}), "pattern mesh: seam 0 folds back on itself at point 1");
+  EXPECT_EQ(disk({Line({{-0.05, 0}, {0.05, 0}, {0.0, 0}})}),
+            "pattern mesh: seam 0 folds back on itself at point 1");
   // Both ends inside a concave pattern, the segment across the notch.
   const Polyline2 l_shape = Line({{0, 0}, {0.2, 0}, {0.2, 0.1}, {0.1, 0.1}, {0.1, 0.2}, {0, 0.2}});
-  EXPECT_EQ(MeshError([&] { MeshPolygon(l_shape, {Line({{0.05, 0.18}, {0.18, 0.05}})}, o); }),
+  EXPECT_EQ(MeshError([&] {
+              MeshPolygon(l_shape, {Line({{0.05, 0.18}, {0.18, 0.05}})}, o);
+            }),
             "pattern mesh: seam 0 segment 0 crosses the pattern boundary");
-  EXPECT_EQ(MeshError([&] { MeshPolygon(l_shape, {Line({{0.1, 0.15}, {0.15, 0.1}})}, o); }),
+  EXPECT_EQ(MeshError([&] {
+              MeshPolygon(l_shape, {Line({{0.1, 0.15}, {0.15, 0.1}})}, o);
+            }),
             "pattern mesh: seam 0 segment 0 runs outside or along the pattern boundary");
-  EXPECT_EQ(MeshError([&] { MeshPolygon(l_shape, {Line({{0.0, 0.05}, {0.0, 0.15}})}, o); }),
+  EXPECT_EQ(MeshError([&] {
+              MeshPolygon(l_shape, {Line({{0.0, 0.05}, {0.0, 0.15}})}, o);
+            }),
             "pattern mesh: seam 0 segment 0 runs outside or along the pattern boundary");
   PatternMeshOptions nan_factor = o;
   nan_factor.area_factor = [](double d) { return d < 0.01 ? std::nan("") : 1.0; };
   const std::string nan_error = MeshError([&] { MeshDisk(0.1, {ok}, nan_factor); });
   EXPECT_EQ(nan_error.substr(0, 30), "pattern mesh: area_factor(d = ") << nan_error;
-  EXPECT_NE(nan_error.find(" m) returned nan; it must be a finite number"), std::string::npos) << nan_error;
+  EXPECT_NE(nan_error.find(" m) returned nan; it must be a finite number"), std::string::npos)
+      << nan_error;
 }
 
 TEST(PatternMesh, RefusesMeshesAboveTheTriangleCap) {
   // 1 m disk at 0.5 mm: about 2.31·π·1/0.25e-6 ≈ 29 million triangles.
   const std::string big = MeshError([&] { MeshDisk(1.0, {}, Options(0.0005)); });
   EXPECT_EQ(big.substr(0, 23), "pattern mesh: about 290") << big;
-  EXPECT_NE(big.find(" triangles at element size 0.5 mm would exceed the limit of 2000000"), std::string::npos) << big;
+  EXPECT_NE(big.find(" triangles at element size 0.5 mm would exceed the limit of 2000000"),
+            std::string::npos)
+      << big;
   PatternMeshOptions o = Options(0.01);
   o.max_triangles = 100;
   const std::string e = MeshError([&] { MeshDisk(0.15, {}, o); });
-  EXPECT_NE(e.find("would exceed the limit of 100; use a larger element size"), std::string::npos) << e;
+  EXPECT_NE(e.find("would exceed the limit of 100; use a larger element size"), std::string::npos)
+      << e;
 }
 
 }  // namespace

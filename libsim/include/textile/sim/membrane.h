@@ -26,10 +26,9 @@
 //   std::vector<Eigen::Triplet<double>> triplets;
 //   membrane.AddHessianTriplets(x, &triplets, /*project_psd=*/true);  // dof 3 v + c, [N/m]
 
-#include <vector>
-
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <vector>
 
 #include "textile/sim/material.h"
 #include "textile/sim/mesh.h"
@@ -55,8 +54,9 @@ struct MembraneLame {
 // @param rest_area     rest area [m²]
 // @param x             3×3 current positions, one vertex per row [m]
 // Energy [J]; gradient with respect to (x0, x1, x2) stacked, 9 [N]; Hessian 9×9 [N/m].
-double MembraneEnergy(MembraneModel model, const MembraneLame& lame, const Eigen::Matrix2d& rest_inverse,
-                      double rest_area, const Eigen::Matrix3d& x);
+double MembraneEnergy(MembraneModel model, const MembraneLame& lame,
+                      const Eigen::Matrix2d& rest_inverse, double rest_area,
+                      const Eigen::Matrix3d& x);
 Eigen::Matrix<double, 9, 1> MembraneGradient(MembraneModel model, const MembraneLame& lame,
                                              const Eigen::Matrix2d& rest_inverse, double rest_area,
                                              const Eigen::Matrix3d& x);
@@ -72,7 +72,8 @@ class MembraneElements {
   // @param rest  rest mesh (flat patterns: z = 0, but any non-degenerate triangles work) [m]
   // Throws InputError for a bad stiffness or Poisson ratio, a triangle referring to a missing
   // vertex, or a degenerate rest triangle (naming it).
-  MembraneElements(const TriangleMesh& rest, double stretch_stiffness, double poisson, MembraneModel model);
+  MembraneElements(const TriangleMesh& rest, double stretch_stiffness, double poisson,
+                   MembraneModel model);
   // Uses material.stretch_stiffness and material.poisson.
   MembraneElements(const TriangleMesh& rest, const Material& material, MembraneModel model);
 
@@ -81,8 +82,8 @@ class MembraneElements {
   // Adds ∂E/∂x [N] to grad (#V×3).
   void AddGradient(Eigen::Ref<const Vertices> x, Eigen::Ref<Vertices> grad) const;
   // Appends the Hessian [N/m] as (3 i + c, 3 j + d, value) triplets, 81 per triangle.
-  void AddHessianTriplets(Eigen::Ref<const Vertices> x, std::vector<Eigen::Triplet<double>>* triplets,
-                          bool project_psd) const;
+  void AddHessianTriplets(Eigen::Ref<const Vertices> x,
+                          std::vector<Eigen::Triplet<double>>* triplets, bool project_psd) const;
 
   MembraneModel model() const { return model_; }
   const MembraneLame& lame() const { return lame_; }
@@ -97,9 +98,9 @@ class MembraneElements {
   MembraneModel model_;
   MembraneLame lame_;
   int num_vertices_ = 0;
-  Triangles triangles_;                       // #F×3
+  Triangles triangles_;                        // #F×3
   std::vector<Eigen::Matrix2d> rest_inverse_;  // #F Dm⁻¹ [1/m]
-  Eigen::VectorXd rest_area_;                 // #F [m²]
+  Eigen::VectorXd rest_area_;                  // #F [m²]
 };
 
 }  // namespace textile

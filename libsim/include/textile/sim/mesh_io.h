@@ -8,15 +8,15 @@
 //   std::string ply = textile::PlyText(mesh, {s});                  // the CLI writes it atomically
 //   textile::WriteObj("drape.obj", mesh, &s);                       // or write through a path
 //   textile::MeshQuality q = textile::ComputeMeshQuality(mesh);
-//   std::cerr << q.BriefReport() << "\n";  // "18273 triangles, 9295 vertices; angles 34.1..104.6°; ..."
+//   std::cerr << q.BriefReport() << "\n";  // "18273 triangles, 9295 vertices; angles 34.1..104.6°;
+//   ..."
 //
 // Numbers are written in the shortest form that reads back to the same double, so a written mesh
 // reads back bit for bit. Positions are in metres, as everywhere inside textile.
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "textile/sim/mesh.h"
 
@@ -24,7 +24,7 @@ namespace textile {
 
 // A named per-vertex quantity, e.g. the seam multiplier S.
 struct VertexScalar {
-  std::string name;       // PLY property name: letters, digits and '_', not starting with a digit
+  std::string name;        // PLY property name: letters, digits and '_', not starting with a digit
   Eigen::VectorXd values;  // #V, finite
 };
 
@@ -38,8 +38,10 @@ std::string PlyText(const TriangleMesh& mesh, const std::vector<VertexScalar>& s
 
 // Write the same texts to `path` (through a temporary file renamed into place). Throw InputError
 // naming the path when it cannot be written.
-void WriteObj(const std::string& path, const TriangleMesh& mesh, const VertexScalar* colour = nullptr);
-void WritePly(const std::string& path, const TriangleMesh& mesh, const std::vector<VertexScalar>& scalars = {});
+void WriteObj(const std::string& path, const TriangleMesh& mesh,
+              const VertexScalar* colour = nullptr);
+void WritePly(const std::string& path, const TriangleMesh& mesh,
+              const std::vector<VertexScalar>& scalars = {});
 
 // Reads the vertices and triangles of an OBJ ("v" and "f" lines; "f" entries may be v, v/vt,
 // v/vt/vn or v//vn, negative indices count from the end; other lines are ignored). Throws
@@ -52,8 +54,8 @@ TriangleMesh ReadObj(const std::string& path);
 struct MeshQuality {
   int num_triangles = 0;
   int num_vertices = 0;
-  double min_angle_deg = 0;   // smallest interior angle [°]
-  double max_angle_deg = 0;   // largest interior angle [°]
+  double min_angle_deg = 0;  // smallest interior angle [°]
+  double max_angle_deg = 0;  // largest interior angle [°]
   // Largest e_max (e0 + e1 + e2) / (4 √3 A): 1 for an equilateral triangle, growing without bound
   // as a triangle degenerates (e_max over 2√3 times the inradius).
   double max_aspect_ratio = 0;

@@ -18,12 +18,11 @@
 // base element (factors below 1 count as 1). Gmsh is global state: calls are serialised by a mutex
 // and each call initialises and finalises Gmsh; nothing is printed.
 
+#include <Eigen/Core>
 #include <functional>
 #include <limits>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "textile/sim/mesh.h"
 

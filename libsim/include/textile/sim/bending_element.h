@@ -38,6 +38,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -58,7 +59,7 @@ BendingModel ParseBendingModel(const std::string& name);
 struct BendingOptions {
   BendingModel model = BendingModel::kPabst;  // which energy (see above)
   // Worker threads for the hinge loops: 1 = serial (the default, and what solvers that
-  // thread elsewhere want), 0 = all hardware threads. Results do not depend on it beyond
+  // thread elsewhere want), 0 = all hardware threads; at most 64 are used. Results do not depend on it beyond
   // round-off in the energy sum.
   int threads = 1;
 
@@ -142,11 +143,12 @@ class BendingElements {
     Eigen::Vector3d rest_vector;
   };
 
-  template <bool kWithGradient>
+  static constexpr int kMaxThreads = 64;
+  template <bool kWithEnergy, bool kWithGradient>
   double Evaluate(const Vertices& x, double* grad) const;
   double HingeTerms(const Vertices& x, int h, double* d_energy, double* d2_energy) const;
   double DihedralTerms(double cos_term, double sin_term, int h, double* d_energy,
-                       double* d2_energy) const;
+                       double* d2_energy, bool want_energy) const;
   double LawEnergy(const HingeRest& r, double kappa) const;
   double LawMoment(const HingeRest& r, double kappa) const;
   double LawStiffness(const HingeRest& r, double kappa) const;

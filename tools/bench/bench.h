@@ -46,6 +46,7 @@ double MedianSeconds(const std::function<void()>& f, int repeats);
 // Each benchmark file defines one of these.
 Benchmark ElasticaBenchmark();
 Benchmark FitAccuracyBenchmark();
+Benchmark BendForceBenchmark(); Benchmark HingeCurveBenchmark();
 
 }  // namespace textile::bench
 

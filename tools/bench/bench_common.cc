@@ -13,7 +13,7 @@
 namespace textile::bench {
 
 const std::vector<Benchmark>& Registry() {
-  static const std::vector<Benchmark> all = {FitAccuracyBenchmark(), ElasticaBenchmark()};
+  static const std::vector<Benchmark> all = {FitAccuracyBenchmark(), ElasticaBenchmark(), BendForceBenchmark(), HingeCurveBenchmark()};
   return all;
 }
 

@@ -7,7 +7,6 @@
 #include <barrier>
 #include <cassert>
 #include <cmath>
-#include <numbers>
 #include <sstream>
 #include <thread>
 
@@ -19,26 +18,6 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
 using Mat12 = Eigen::Matrix<double, 12, 12>;
-
-// ---- atan2 by table + short series ----
-//
-// The angle of (|x|, |y|) in [0, π/2] is split into 9 sectors centred on kπ/16; rotating the
-// vector back by the sector's centre leaves a residual angle atan(u), |u| ≤ tan(π/32) < 0.099,
-// whose Taylor series to u^15 is exact to 5e-19. The centre offsets are atan2 of the rounded
-// table entries, so the identity holds for the constants actually used.
-struct AtanTable {
-  std::array<double, 8> threshold;  // tan((2j+1)π/32): sector k has k thresholds below it
-  std::array<double, 9> c, s, offset;
-  AtanTable() {
-    for (int j = 0; j < 8; ++j) threshold[j] = std::tan((2 * j + 1) * std::numbers::pi / 32.0);
-    for (int k = 0; k <= 8; ++k) {
-      c[k] = std::cos(k * std::numbers::pi / 16.0);
-      s[k] = std::sin(k * std::numbers::pi / 16.0);
-      offset[k] = std::atan2(s[k], c[k]);
-    }
-  }
-};
-const AtanTable kAtan;
 
 inline Mat3 Skew(const Vec3& v) {
   Mat3 m;
@@ -66,7 +45,7 @@ struct HingeGeometry {
     cos_term = n0.dot(n1);
     sin_term = l * n1.dot(a0);  // (n1 × n0)·e/|e| = |e| (a1 × e)·a0
   }
-  double Angle() const { return FastAtan2(sin_term, cos_term); }
+  double Angle() const { return std::atan2(sin_term, cos_term); }
   // ∂θ/∂x_i for the four vertices: g0 = |e| n0/|n0|², g1 = |e| n1/|n1|², the edge vertices take
   // the reactions at the wings' feet t0, t1 (Bridson et al. 2003's u_i).
   void Gradient(std::array<Vec3, 4>* g) const {
@@ -143,26 +122,10 @@ std::string HingeName(int h, const Hinge& hinge) {
 
 }  // namespace
 
-double FastAtan2(double y, double x) {
-  const double ax = std::abs(x), ay = std::abs(y);
-  int k = 0;
-  for (int j = 0; j < 8; ++j) k += ay > ax * kAtan.threshold[j];
-  const double c = kAtan.c[k], s = kAtan.s[k];
-  const double rx = ax * c + ay * s, ry = ay * c - ax * s;
-  if (rx == 0.0) return 0.0;  // x = y = 0, as std::atan2(0, 0)
-  const double u = ry / rx, u2 = u * u;
-  const double series =
-      u * (1.0 + u2 * (-1.0 / 3 + u2 * (1.0 / 5 + u2 * (-1.0 / 7 + u2 * (1.0 / 9 + u2 * (-1.0 / 11 +
-          u2 * (1.0 / 13 + u2 * (-1.0 / 15))))))));
-  double a = kAtan.offset[k] + series;
-  if (std::signbit(x)) a = std::numbers::pi - a;
-  return std::signbit(y) ? -a : a;
-}
-
 double HingeBendAngle(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3) {
   const Vec3 e = x3 - x2, a0 = x0 - x2, a1 = x1 - x2;
   const Vec3 n0 = e.cross(a0), n1 = a1.cross(e);
-  return FastAtan2(e.norm() * n1.dot(a0), n0.dot(n1));
+  return std::atan2(e.norm() * n1.dot(a0), n0.dot(n1));
 }
 
 std::string BendingModelName(BendingModel model) {
@@ -349,7 +312,7 @@ double BendingElements::DihedralTerms(double cos_term, double sin_term, int h, d
                                       double* d2_energy, bool want_energy) const {
   const HingeRest& r = rest_[h];
   if (options_.model == BendingModel::kPabst) {
-    const double kappa = (FastAtan2(sin_term, cos_term) - r.rest_angle) * r.inv_height;
+    const double kappa = (std::atan2(sin_term, cos_term) - r.rest_angle) * r.inv_height;
     if (d_energy) *d_energy = r.weight * LawMoment(r, kappa) * r.inv_height;
     if (d2_energy) *d2_energy = r.weight * LawStiffness(r, kappa) * r.inv_height * r.inv_height;
     return want_energy ? r.weight * LawEnergy(r, kappa) : 0.0;
@@ -371,7 +334,7 @@ double BendingElements::DihedralTerms(double cos_term, double sin_term, int h, d
   if (d2_energy) *d2_energy = r.weight * 0.5 * ch;
   if (!want_energy) return 0.0;
   double energy = 2.0 * (sh - sb) * (sh + sb) / (cb + ch);  // 2(cos θ̄/2 - cos θ/2)
-  if (sb != 0.0) energy -= (FastAtan2(sin_term, cos_term) - r.rest_angle) * sb;
+  if (sb != 0.0) energy -= (std::atan2(sin_term, cos_term) - r.rest_angle) * sb;
   return r.weight * energy;
 }
 

@@ -7,7 +7,6 @@
 #include <Eigen/SparseCore>
 #include <cmath>
 #include <functional>
-#include <numbers>
 #include <random>
 
 #include "textile/sim/error.h"
@@ -58,29 +57,6 @@ Eigen::MatrixXd DenseHessian(const BendingElements& b, const Vertices& x, bool p
 }
 
 std::string Name(BendingModel m) { return BendingModelName(m); }
-
-TEST(FastAtan2, MatchesStdAtan2EverywhereIncludingAxesAndSigns) {
-  // Bound: the table constants and the series are good to ~1e-19; what remains is a few
-  // roundings of values up to π, i.e. a couple of ulp of π (4.4e-16 each).
-  constexpr double kTolerance = 8.9e-16;
-  std::mt19937 rng(1);
-  std::uniform_real_distribution<double> angle(-std::numbers::pi, std::numbers::pi);
-  std::uniform_real_distribution<double> log_r(-30.0, 30.0);
-  for (int i = 0; i < 200000; ++i) {
-    const double a = angle(rng), r = std::exp(log_r(rng));
-    const double y = r * std::sin(a), x = r * std::cos(a);
-    ASSERT_NEAR(FastAtan2(y, x), std::atan2(y, x), kTolerance) << "y = " << y << ", x = " << x;
-  }
-  for (double y : {0.0, -0.0, 1.0, -1.0, 1e-300, -1e-300})
-    for (double x : {0.0, -0.0, 1.0, -1.0, 1e-300, -1e-300}) {
-      if (x == 0.0 && y == 0.0) continue;
-      EXPECT_NEAR(FastAtan2(y, x), std::atan2(y, x), kTolerance) << y << ", " << x;
-    }
-  EXPECT_EQ(FastAtan2(0.0, 0.0), 0.0);
-  EXPECT_TRUE(std::isnan(FastAtan2(std::nan(""), 1.0)));
-  // Tiny angles keep their relative accuracy (κ of nearly flat hinges).
-  EXPECT_NEAR(FastAtan2(1e-12, 1.0), 1e-12, 1e-28);
-}
 
 TEST(HingeBendAngle, IsSignedAndPositiveWhenFoldingTowardsTheNormals) {
   // Edge along y, wings at x = ∓1 rising by δ: the flat pattern's normals point to +z, the

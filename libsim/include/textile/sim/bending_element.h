@@ -73,10 +73,6 @@ struct BendingOptions {
 double HingeBendAngle(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1,
                       const Eigen::Vector3d& x2, const Eigen::Vector3d& x3);
 
-// atan2(y, x) to within 2 ulp of π, about 8 times faster than glibc's on this project's
-// machines; exposed for its test.
-double FastAtan2(double y, double x);
-
 class BendingElements {
  public:
   // @param rest        rest mesh: #V×3 rest positions [m] (flat patterns: z = 0; a curved

@@ -25,7 +25,9 @@ inline Mat3 Skew(const Vec3& v) {
   return m;
 }
 
-inline Eigen::Map<const Vec3> Row(const Vertices& x, int i) { return Eigen::Map<const Vec3>(x.data() + 3 * i); }
+inline Eigen::Map<const Vec3> Row(const Vertices& x, int i) {
+  return Eigen::Map<const Vec3>(x.data() + 3 * i);
+}
 
 // Geometry of one hinge at positions x: everything the gradient of θ needs (docs/bending.md,
 // "Gradient of the bend angle"). n0 = e × a0 and n1 = a1 × e are the unnormalised normals of
@@ -84,7 +86,8 @@ void AddTriangleAngleHessian(const Vec3& w, const Vec3& x2, const Vec3& x3, cons
   for (int p = 0; p < 3; ++p) {
     for (int q = 0; q < 3; ++q) {
       const Vec3 d_phi = grad_f[p][q] * inv - phi[p] * (grad_log_l[q] + two_u[q]);
-      h->block<3, 3>(3 * index[p], 3 * index[q]) += scale * (n * d_phi.transpose() + phi[p] * skew[q]);
+      h->block<3, 3>(3 * index[p], 3 * index[q]) +=
+          scale * (n * d_phi.transpose() + phi[p] * skew[q]);
     }
   }
 }
@@ -108,7 +111,9 @@ void ParallelChunks(int n, int threads, F&& f) {
   std::vector<std::jthread> workers;
   workers.reserve(threads - 1);
   for (int t = 1; t < threads; ++t) {
-    workers.emplace_back([&f, n, threads, t] { f(static_cast<long>(n) * t / threads, static_cast<long>(n) * (t + 1) / threads, t); });
+    workers.emplace_back([&f, n, threads, t] {
+      f(static_cast<long>(n) * t / threads, static_cast<long>(n) * (t + 1) / threads, t);
+    });
   }
   f(0, n / threads, 0);
 }
@@ -130,10 +135,14 @@ double HingeBendAngle(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3
 
 std::string BendingModelName(BendingModel model) {
   switch (model) {
-    case BendingModel::kPabst: return "pabst";
-    case BendingModel::kBridson: return "bridson";
-    case BendingModel::kVolino: return "volino";
-    case BendingModel::kIsometric: return "isometric";
+    case BendingModel::kPabst:
+      return "pabst";
+    case BendingModel::kBridson:
+      return "bridson";
+    case BendingModel::kVolino:
+      return "volino";
+    case BendingModel::kIsometric:
+      return "isometric";
   }
   return "unknown";
 }
@@ -143,7 +152,8 @@ BendingModel ParseBendingModel(const std::string& name) {
                          BendingModel::kIsometric}) {
     if (BendingModelName(m) == name) return m;
   }
-  throw InputError("bending model '" + name + "' is unknown (known: pabst, bridson, volino, isometric)");
+  throw InputError("bending model '" + name +
+                   "' is unknown (known: pabst, bridson, volino, isometric)");
 }
 
 bool BendingOptions::Check(std::string* why) const {
@@ -152,7 +162,8 @@ bool BendingOptions::Check(std::string* why) const {
       model != BendingModel::kVolino && model != BendingModel::kIsometric) {
     reason = "bending options: model is not one of pabst, bridson, volino, isometric";
   } else if (threads < 0) {
-    reason = "bending options: threads must be >= 0 (0 = all hardware threads), got " + std::to_string(threads);
+    reason = "bending options: threads must be >= 0 (0 = all hardware threads), got " +
+             std::to_string(threads);
   }
   if (why) *why = reason;
   return reason.empty();
@@ -170,19 +181,25 @@ BendingElements::BendingElements(const TriangleMesh& rest, const std::vector<Hin
                                  const BendingLaw& warp, const std::optional<BendingLaw>& weft,
                                  const BendingOptions& options,
                                  const std::vector<double>& stiffness_multiplier)
-    : options_(options), warp_(warp), weft_(weft ? *weft : warp), anisotropic_(weft.has_value()),
-      num_vertices_(rest.num_vertices()), hinges_(hinges) {
+    : options_(options),
+      warp_(warp),
+      weft_(weft ? *weft : warp),
+      anisotropic_(weft.has_value()),
+      num_vertices_(rest.num_vertices()),
+      hinges_(hinges) {
   if (std::string why; !options.Check(&why)) throw InputError(why);
   const int nh = static_cast<int>(hinges.size());
   if (!stiffness_multiplier.empty() && static_cast<int>(stiffness_multiplier.size()) != nh) {
-    throw InputError("bending: stiffness multiplier has " + std::to_string(stiffness_multiplier.size()) +
-                     " values for " + std::to_string(nh) + " hinges");
+    throw InputError("bending: stiffness multiplier has " +
+                     std::to_string(stiffness_multiplier.size()) + " values for " +
+                     std::to_string(nh) + " hinges");
   }
   rest_.resize(nh);
   edge_length_.resize(nh);
   multiplier_.assign(nh, 1.0);
   if (options_.model == BendingModel::kBridson) half_angle_.resize(2 * nh);
-  const bool linear = options_.model == BendingModel::kVolino || options_.model == BendingModel::kIsometric;
+  const bool linear =
+      options_.model == BendingModel::kVolino || options_.model == BendingModel::kIsometric;
   if (linear) linear_.resize(nh);
 
   for (int h = 0; h < nh; ++h) {
@@ -275,7 +292,8 @@ BendingElements::BendingElements(const TriangleMesh& rest, const std::vector<Hin
 }
 
 int BendingElements::NumThreads() const {
-  const int n = options_.threads > 0 ? options_.threads : static_cast<int>(std::thread::hardware_concurrency());
+  const int n = options_.threads > 0 ? options_.threads
+                                     : static_cast<int>(std::thread::hardware_concurrency());
   return std::clamp(n, 1, kMaxThreads);
 }
 
@@ -293,7 +311,8 @@ double BendingElements::LawStiffness(const HingeRest& r, double kappa) const {
 }
 
 // Energy of hinge h and, for the dihedral models, dE/dθ and d²E/dθ² (null pointers skip them).
-double BendingElements::HingeTerms(const Vertices& x, int h, double* d_energy, double* d2_energy) const {
+double BendingElements::HingeTerms(const Vertices& x, int h, double* d_energy,
+                                   double* d2_energy) const {
   const HingeRest& r = rest_[h];
   if (options_.model == BendingModel::kVolino || options_.model == BendingModel::kIsometric) {
     const auto& al = linear_[h].alpha;
@@ -416,7 +435,9 @@ double BendingElements::Evaluate(const Vertices& x, double* grad) const {
   return total;
 }
 
-double BendingElements::Energy(const Vertices& x) const { return Evaluate<true, false>(x, nullptr); }
+double BendingElements::Energy(const Vertices& x) const {
+  return Evaluate<true, false>(x, nullptr);
+}
 
 void BendingElements::AddGradient(const Vertices& x, Eigen::Ref<Vertices> grad) const {
   Evaluate<false, true>(x, grad.data());
@@ -426,11 +447,13 @@ double BendingElements::EnergyGradient(const Vertices& x, Eigen::Ref<Vertices> g
   return Evaluate<true, true>(x, grad.data());
 }
 
-void BendingElements::AddHessianTriplets(const Vertices& x, std::vector<Eigen::Triplet<double>>* triplets,
+void BendingElements::AddHessianTriplets(const Vertices& x,
+                                         std::vector<Eigen::Triplet<double>>* triplets,
                                          bool project_psd) const {
   assert(x.rows() == num_vertices_);
   const int nh = num_hinges();
-  const bool linear = options_.model == BendingModel::kVolino || options_.model == BendingModel::kIsometric;
+  const bool linear =
+      options_.model == BendingModel::kVolino || options_.model == BendingModel::kIsometric;
   const size_t per_hinge = linear ? 48 : 144;
   const size_t first = triplets->size();
   const int threads = NumThreads();
@@ -448,7 +471,7 @@ void BendingElements::AddHessianTriplets(const Vertices& x, std::vector<Eigen::T
     for (long h = begin; h < end; ++h) {
       const HingeRest& r = rest_[h];
       auto emit = [&, next = threads == 1 ? nullptr : triplets->data() + first + per_hinge * h](
-                            int row, int col, double value) mutable {
+                      int row, int col, double value) mutable {
         if (next) {
           *next++ = {row, col, value};
         } else {

@@ -93,7 +93,8 @@ TEST(BendingElements, GradientMatchesFiniteDifferencesForEveryModel) {
           xm(i, c) -= kFdStep;
           fd(i, c) = (b.Energy(xp) - b.Energy(xm)) / (2 * kFdStep);
         }
-      EXPECT_LT((g - fd).cwiseAbs().maxCoeff(), kFdRelTolerance * g.cwiseAbs().maxCoeff()) << Name(model);
+      EXPECT_LT((g - fd).cwiseAbs().maxCoeff(), kFdRelTolerance * g.cwiseAbs().maxCoeff())
+          << Name(model);
       // EnergyGradient is the fused version of the same.
       Vertices g2 = Vertices::Zero(x.rows(), 3);
       EXPECT_DOUBLE_EQ(b.EnergyGradient(x, g2), b.Energy(x)) << Name(model);
@@ -119,8 +120,10 @@ TEST(BendingElements, HessianMatchesFiniteDifferencesOfTheGradientForEveryModel)
         const Vertices d = (Gradient(b, xp) - Gradient(b, xm)) / (2 * kFdStep);
         fd.col(j) = Eigen::Map<const Eigen::VectorXd>(d.data(), n);
       }
-      EXPECT_LT((h - fd).cwiseAbs().maxCoeff(), kFdRelTolerance * h.cwiseAbs().maxCoeff()) << Name(model);
-      EXPECT_LT((h - h.transpose()).cwiseAbs().maxCoeff(), 1e-12 * h.cwiseAbs().maxCoeff()) << Name(model);
+      EXPECT_LT((h - fd).cwiseAbs().maxCoeff(), kFdRelTolerance * h.cwiseAbs().maxCoeff())
+          << Name(model);
+      EXPECT_LT((h - h.transpose()).cwiseAbs().maxCoeff(), 1e-12 * h.cwiseAbs().maxCoeff())
+          << Name(model);
     }
   }
 }
@@ -141,7 +144,8 @@ TEST(BendingElements, ZeroEnergyAndForceAtFlatAndCurvedRest) {
       const double scale_g = Gradient(b, bent).cwiseAbs().maxCoeff();
       ASSERT_GT(scale_e, 0.0);
       EXPECT_LE(std::abs(b.Energy(rest.vertices)), kRestTolerance * scale_e) << Name(model);
-      EXPECT_LE(Gradient(b, rest.vertices).cwiseAbs().maxCoeff(), kRestTolerance * scale_g) << Name(model);
+      EXPECT_LE(Gradient(b, rest.vertices).cwiseAbs().maxCoeff(), kRestTolerance * scale_g)
+          << Name(model);
     }
   }
 }
@@ -170,11 +174,13 @@ TEST(BendingElements, EnergyIsInvariantUnderRigidMotions) {
     const bool linear = model == BendingModel::kVolino || model == BendingModel::kIsometric;
     for (const bool is_curved : {false, true}) {
       const TriangleMesh& rest = is_curved ? curved : flat;
-      const BendingElements b(rest, BuildHinges(rest), Interlining(), std::nullopt, {.model = model});
+      const BendingElements b(rest, BuildHinges(rest), Interlining(), std::nullopt,
+                              {.model = model});
       const Vertices x = Perturbed(rest.vertices, 0.002, &rng);
       const double e = b.Energy(x);
       const Eigen::Vector3d shift(0.3, -1.2, 0.7);
-      EXPECT_NEAR(b.Energy(Moved(x, Eigen::Matrix3d::Identity(), shift)), e, kInvarianceTolerance * e)
+      EXPECT_NEAR(b.Energy(Moved(x, Eigen::Matrix3d::Identity(), shift)), e,
+                  kInvarianceTolerance * e)
           << Name(model);
       const double rotated = b.Energy(Moved(x, RandomRotation(&rng), shift));
       if (linear && is_curved) {
@@ -209,7 +215,8 @@ TEST(BendingElements, ForcesSumToZeroAndExertNoNetTorque) {
 }
 
 // A single hinge as its own element set, for per-vertex comparisons.
-BendingElements OneHinge(const TriangleMesh& rest, const Hinge& h, BendingModel model, const BendingLaw& law) {
+BendingElements OneHinge(const TriangleMesh& rest, const Hinge& h, BendingModel model,
+                         const BendingLaw& law) {
   return BendingElements(rest, {h}, law, std::nullopt, {.model = model});
 }
 
@@ -236,7 +243,8 @@ TEST(BendingElements, PabstForcesAreParallelToBridsonsPerVertex) {
 }
 
 TEST(BendingElements, PabstWingForceIsTwiceEquationThree) {
-  // Eq. 3: F_i = ½ M |E| / |L_i| along the wing's normal. -∇E with A_h = |e| h̄e gives M |E| / |L_i|.
+  // Eq. 3: F_i = ½ M |E| / |L_i| along the wing's normal. -∇E with A_h = |e| h̄e gives M |E| /
+  // |L_i|.
   const TriangleMesh rest = [] {
     TriangleMesh m;
     m.vertices.resize(4, 3);
@@ -254,14 +262,16 @@ TEST(BendingElements, PabstWingForceIsTwiceEquationThree) {
   x(hinges[0].v[1], 2) = 0.001;
   const Vertices g = Gradient(b, x);
   const double kappa = b.HingeCurvature(x, 0);
-  const Eigen::Vector3d x0 = x.row(hinges[0].v[0]), x2 = x.row(hinges[0].v[2]), x3 = x.row(hinges[0].v[3]);
+  const Eigen::Vector3d x0 = x.row(hinges[0].v[0]), x2 = x.row(hinges[0].v[2]),
+                        x3 = x.row(hinges[0].v[3]);
   const Eigen::Vector3d e = x3 - x2;
   const double t = (x0 - x2).dot(e) / e.squaredNorm();
   const double lever = (x0 - (x2 + t * e)).norm();  // |L_0|
   const double eq3 = 0.5 * law.Moment(kappa) * e.norm() / lever;
   EXPECT_NEAR(g.row(hinges[0].v[0]).norm(), 2.0 * eq3, 1e-12 * eq3);
   EXPECT_NEAR(b.area_weight(0), e.norm() * b.rest_height(0), 1e-18);
-  EXPECT_NEAR(b.HingeEnergy(x, 0), b.area_weight(0) * law.Energy(kappa), 1e-15 * b.HingeEnergy(x, 0));
+  EXPECT_NEAR(b.HingeEnergy(x, 0), b.area_weight(0) * law.Energy(kappa),
+              1e-15 * b.HingeEnergy(x, 0));
 }
 
 TEST(BendingElements, ProjectedHessianBlocksArePositiveSemiDefinite) {
@@ -300,7 +310,8 @@ TEST(BendingElements, AllModelsAgreeForSmallBendsOfAFlatRestState) {
   const auto hinges = BuildHinges(rest);
   const double e_pabst = BendingElements(rest, hinges, Fig8(), std::nullopt, {}).Energy(x);
   for (BendingModel model : kAllModels) {
-    const double e = BendingElements(rest, hinges, Fig8(), std::nullopt, {.model = model}).Energy(x);
+    const double e =
+        BendingElements(rest, hinges, Fig8(), std::nullopt, {.model = model}).Energy(x);
     EXPECT_NEAR(e, e_pabst, kAgreement * e_pabst) << Name(model);
   }
 }
@@ -335,8 +346,10 @@ TEST(BendingElements, VolinoAndIsometricAreTheSameEnergyOnceCalibrated) {
   std::mt19937 rng(43);
   const TriangleMesh rest = SmallPattern(&rng);
   const auto hinges = BuildHinges(rest);
-  const BendingElements volino(rest, hinges, Interlining(), std::nullopt, {.model = BendingModel::kVolino});
-  const BendingElements ibm(rest, hinges, Interlining(), std::nullopt, {.model = BendingModel::kIsometric});
+  const BendingElements volino(rest, hinges, Interlining(), std::nullopt,
+                               {.model = BendingModel::kVolino});
+  const BendingElements ibm(rest, hinges, Interlining(), std::nullopt,
+                            {.model = BendingModel::kIsometric});
   const Vertices x = Perturbed(rest.vertices, 0.004, &rng);
   EXPECT_NEAR(volino.Energy(x), ibm.Energy(x), 1e-12 * ibm.Energy(x));
 }
@@ -366,7 +379,8 @@ TEST(BendingElements, StiffnessMultiplierScalesEachHinge) {
   for (BendingModel model : kAllModels) {
     const BendingElements plain(rest, hinges, Fig8(), std::nullopt, {.model = model});
     const BendingElements seam(rest, hinges, Fig8(), std::nullopt, {.model = model}, s);
-    EXPECT_NEAR(seam.HingeEnergy(x, 3), 4.5 * plain.HingeEnergy(x, 3), 1e-14 * seam.HingeEnergy(x, 3));
+    EXPECT_NEAR(seam.HingeEnergy(x, 3), 4.5 * plain.HingeEnergy(x, 3),
+                1e-14 * seam.HingeEnergy(x, 3));
     EXPECT_EQ(seam.HingeEnergy(x, 4), plain.HingeEnergy(x, 4));
   }
 }
@@ -377,8 +391,10 @@ TEST(BendingElements, ThreadsGiveTheSerialResults) {
   const auto hinges = BuildHinges(rest);
   const Vertices x = Perturbed(rest.vertices, 0.002, &rng);
   for (BendingModel model : kAllModels) {
-    const BendingElements serial(rest, hinges, Fig8(), std::nullopt, {.model = model, .threads = 1});
-    const BendingElements threaded(rest, hinges, Fig8(), std::nullopt, {.model = model, .threads = 3});
+    const BendingElements serial(rest, hinges, Fig8(), std::nullopt,
+                                 {.model = model, .threads = 1});
+    const BendingElements threaded(rest, hinges, Fig8(), std::nullopt,
+                                   {.model = model, .threads = 3});
     const double e = serial.Energy(x);
     EXPECT_NEAR(threaded.Energy(x), e, 1e-14 * e);
     // The gather adds each vertex's hinge terms in hinge order, like the serial loop.
@@ -407,8 +423,11 @@ void ExpectInputError(const std::function<void()>& f, const std::string& fragmen
 TEST(BendingElements, RejectsBadInputNamingTheHinge) {
   const TriangleMesh rest = RegularGridMesh(0.02, 0.02, 2, 2);
   const auto hinges = BuildHinges(rest);
-  ExpectInputError([&] { BendingElements(rest, hinges, Fig8(), std::nullopt, {}, {1.0, 2.0}); },
-                   "stiffness multiplier has 2 values for " + std::to_string(hinges.size()) + " hinges");
+  ExpectInputError(
+      [&] {
+        BendingElements(rest, hinges, Fig8(), std::nullopt, {}, {1.0, 2.0});
+      },
+      "stiffness multiplier has 2 values for " + std::to_string(hinges.size()) + " hinges");
   std::vector<double> s(hinges.size(), 1.0);
   s[2] = std::nan("");
   ExpectInputError([&] { BendingElements(rest, hinges, Fig8(), std::nullopt, {}, s); },
@@ -428,14 +447,16 @@ TEST(BendingElements, RejectsBadInputNamingTheHinge) {
                    "hinge 0 (vertices " + std::to_string(hinges[0].v[0]));
   TriangleMesh nan = rest;
   nan.vertices(hinges[0].v[3], 1) = std::nan("");
-  ExpectInputError([&] { BendingElements(nan, hinges, Fig8(), std::nullopt, {}); }, "NaN or infinite");
+  ExpectInputError([&] { BendingElements(nan, hinges, Fig8(), std::nullopt, {}); },
+                   "NaN or infinite");
   std::string why;
   EXPECT_FALSE((BendingOptions{.threads = -2}).Check(&why));
   EXPECT_NE(why.find("threads must be >= 0"), std::string::npos) << why;
   ExpectInputError([&] { BendingElements(rest, hinges, Fig8(), std::nullopt, {.threads = -2}); },
                    "threads must be >= 0");
   EXPECT_TRUE(BendingOptions{}.Check(&why));
-  ExpectInputError([] { ParseBendingModel("kirchhoff"); }, "known: pabst, bridson, volino, isometric");
+  ExpectInputError([] { ParseBendingModel("kirchhoff"); },
+                   "known: pabst, bridson, volino, isometric");
   for (BendingModel m : kAllModels) EXPECT_EQ(ParseBendingModel(BendingModelName(m)), m);
 }
 

@@ -64,7 +64,8 @@ TriangleMesh EquilateralMesh(double size, int n) {
   TriangleMesh m;
   m.vertices.resize((rows + 1) * (n + 1), 3);
   for (int j = 0; j <= rows; ++j)
-    for (int i = 0; i <= n; ++i) m.vertices.row(j * (n + 1) + i) << a * (i + 0.5 * (j % 2)), row * j, 0.0;
+    for (int i = 0; i <= n; ++i)
+      m.vertices.row(j * (n + 1) + i) << a * (i + 0.5 * (j % 2)), row * j, 0.0;
   m.triangles.resize(2 * rows * n, 3);
   int f = 0;
   for (int j = 0; j < rows; ++j)
@@ -120,7 +121,8 @@ constexpr double kRadii[] = {0.02, 0.01};
 
 // Bending energy per area [J/m²] of the mesh laid on the cylinder.
 double EnergyPerArea(const TriangleMesh& flat, const BendingLaw& law, double radius, Axis axis) {
-  const BendingElements b(flat, BuildHinges(flat), law, std::nullopt, {.model = BendingModel::kPabst});
+  const BendingElements b(flat, BuildHinges(flat), law, std::nullopt,
+                          {.model = BendingModel::kPabst});
   return b.Energy(OnCylinder(flat.vertices, radius, axis)) / TriangleAreas(flat).sum();
 }
 
@@ -143,7 +145,8 @@ const std::vector<Row>& Table() {
           for (double radius : kRadii) {
             Row r{family.name, law.name, axis, radius, {}};
             for (const TriangleMesh& m : meshes)
-              r.ratio.push_back(EnergyPerArea(m, law.law, radius, axis) / law.law.Energy(1.0 / radius));
+              r.ratio.push_back(EnergyPerArea(m, law.law, radius, axis) /
+                                law.law.Energy(1.0 / radius));
             out.push_back(r);
           }
     }
@@ -197,7 +200,8 @@ constexpr double kEquilateralLinearBoundAtFinest = 0.012;
 TEST(CylinderTest, EquilateralMeshesConvergeToPsiForALinearLaw) {
   for (const Row& r : Table()) {
     if (r.family != "equilateral" || r.law != "linear") continue;
-    for (int k = 1; k < kNumLevels; ++k) EXPECT_LT(std::abs(r.ratio[k] - 1.0), std::abs(r.ratio[k - 1] - 1.0));
+    for (int k = 1; k < kNumLevels; ++k)
+      EXPECT_LT(std::abs(r.ratio[k] - 1.0), std::abs(r.ratio[k - 1] - 1.0));
     EXPECT_LE(std::abs(r.ratio.back() - 1.0), kEquilateralLinearBoundAtFinest);
   }
 }
@@ -244,7 +248,8 @@ TEST(CylinderTest, JitteredGridsSettleWithinTheirMeshQualityBias) {
     const double bound = r.family == "jittered 10%" ? 0.06 : r.family == "jittered 20%" ? 0.19 : -1;
     if (bound < 0) continue;
     EXPECT_LE(std::abs(r.ratio.back() - 1.0), bound) << r.family << " " << r.law;
-    EXPECT_LE(std::abs(r.ratio[kNumLevels - 1] - r.ratio[kNumLevels - 2]), 0.03) << r.family << " " << r.law;
+    EXPECT_LE(std::abs(r.ratio[kNumLevels - 1] - r.ratio[kNumLevels - 2]), 0.03)
+        << r.family << " " << r.law;
   }
 }
 

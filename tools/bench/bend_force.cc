@@ -32,7 +32,8 @@ Vertices HangingSheet(const TriangleMesh& flat, double length) {
       px += std::cos(phi) * ds;
       pz -= std::sin(phi) * ds;
     }
-    const double wave = 0.003 * (s / length) * (s / length) * std::sin(2.0 * std::numbers::pi * y / 0.25);
+    const double wave =
+        0.003 * (s / length) * (s / length) * std::sin(2.0 * std::numbers::pi * y / 0.25);
     x.row(i) << px, y, pz + wave;
   }
   return x;
@@ -41,115 +42,140 @@ Vertices HangingSheet(const TriangleMesh& flat, double length) {
 }  // namespace
 
 Benchmark BendForceBenchmark() {
-  return {"bend-force",
-          "Bending force and force + Jacobian on Pabst's Table 3 sheet (3600 triangles), four models",
-          [](const Context& ctx) {
-            Result res;
-            res.columns = {"model", "threads", "triangles", "hinges", "force_ms", "force_jacobian_ms",
-                           "force_jacobian_psd_ms", "assemble_ms", "force_vs_bridson"};
-            const TriangleMesh mesh = CrissCrossGridMesh(0.5, 0.5, 30, 30);  // 4·30·30 = 3600
-            const std::vector<Hinge> hinges = BuildHinges(mesh);
-            const Vertices x = HangingSheet(mesh, 0.5);
-            const BendingLaw law = BendingLaw::FromKes(0.1, 0.0892, -0.0092);  // Fig. 8 fabric
-            const int all = std::max(1u, std::thread::hardware_concurrency());
-            std::vector<int> thread_counts = {1};
-            if (all > 1) thread_counts.push_back(all);
-            const int repeats = ctx.quick ? 30 : 400;
-            const BendingModel models[] = {BendingModel::kVolino, BendingModel::kBridson,
-                                           BendingModel::kIsometric, BendingModel::kPabst};
-            for (BendingModel model : models) {
-              for (int threads : thread_counts) {
-                const BendingElements b(mesh, hinges, law, std::nullopt, {.model = model, .threads = threads});
-                Vertices grad = Vertices::Zero(mesh.num_vertices(), 3);
-                std::vector<Eigen::Triplet<double>> triplets;
-                triplets.reserve(144 * hinges.size());
-                const auto force = [&] {
-                  grad.setZero();
-                  b.AddGradient(x, grad);
-                };
-                force();  // warm up caches and the scratch buffer
-                const double force_s = MedianSeconds(force, repeats);
-                const auto force_jacobian = [&](bool psd) {
-                  force();
-                  triplets.clear();
-                  b.AddHessianTriplets(x, &triplets, psd);
-                };
-                force_jacobian(false);
-                const double fj_s = MedianSeconds([&] { force_jacobian(false); }, repeats);
-                const double psd_s = MedianSeconds([&] { force_jacobian(true); }, std::max(5, repeats / 20));
-                // What a Newton step pays on top: the sparse matrix from the triplets.
-                Eigen::SparseMatrix<double> hessian(3 * mesh.num_vertices(), 3 * mesh.num_vertices());
-                force_jacobian(false);
-                const double assemble_s = MedianSeconds(
-                    [&] { hessian.setFromTriplets(triplets.begin(), triplets.end()); }, std::max(5, repeats / 20));
-                res.rows.push_back({{"model", BendingModelName(model)}, {"threads", threads},
-                                    {"triangles", mesh.num_triangles()}, {"hinges", static_cast<int>(hinges.size())},
-                                    {"force_ms", force_s * 1e3}, {"force_jacobian_ms", fj_s * 1e3},
-                                    {"force_jacobian_psd_ms", psd_s * 1e3}, {"assemble_ms", assemble_s * 1e3}});
-              }
-            }
-            // Ratios to Bridson at the same thread count.
-            for (auto& r : res.rows) {
-              for (const auto& q : res.rows) {
-                if (q["model"] == "bridson" && q["threads"] == r["threads"]) {
-                  r["force_vs_bridson"] = r["force_ms"].get<double>() / q["force_ms"].get<double>();
-                }
-              }
-            }
-
-            std::ostringstream sum;
-            char line[220];
-            std::snprintf(line, sizeof line, "%-10s %7s %9s %10s %12s %12s %11s %9s\n", "model", "threads",
-                          "triangles", "force_ms", "force+J_ms", "force+Jpsd", "assemble", "vs_bridson");
-            sum << line;
-            for (const auto& r : res.rows) {
-              std::snprintf(line, sizeof line, "%-10s %7d %9d %10.4f %12.4f %12.3f %11.3f %9.2f\n",
-                            r["model"].get<std::string>().c_str(), r["threads"].get<int>(),
-                            r["triangles"].get<int>(), r["force_ms"].get<double>(),
-                            r["force_jacobian_ms"].get<double>(), r["force_jacobian_psd_ms"].get<double>(),
-                            r["assemble_ms"].get<double>(), r["force_vs_bridson"].get<double>());
-              sum << line;
-            }
-            const auto find = [&](const char* model, int threads) -> const nlohmann::json& {
-              for (const auto& r : res.rows)
-                if (r["model"] == model && r["threads"] == threads) return r;
-              return res.rows.front();
+  return {
+      "bend-force",
+      "Bending force and force + Jacobian on Pabst's Table 3 sheet (3600 triangles), four models",
+      [](const Context& ctx) {
+        Result res;
+        res.columns = {"model",
+                       "threads",
+                       "triangles",
+                       "hinges",
+                       "force_ms",
+                       "force_jacobian_ms",
+                       "force_jacobian_psd_ms",
+                       "assemble_ms",
+                       "force_vs_bridson"};
+        const TriangleMesh mesh = CrissCrossGridMesh(0.5, 0.5, 30, 30);  // 4·30·30 = 3600
+        const std::vector<Hinge> hinges = BuildHinges(mesh);
+        const Vertices x = HangingSheet(mesh, 0.5);
+        const BendingLaw law = BendingLaw::FromKes(0.1, 0.0892, -0.0092);  // Fig. 8 fabric
+        const int all = std::max(1u, std::thread::hardware_concurrency());
+        std::vector<int> thread_counts = {1};
+        if (all > 1) thread_counts.push_back(all);
+        const int repeats = ctx.quick ? 30 : 400;
+        const BendingModel models[] = {BendingModel::kVolino, BendingModel::kBridson,
+                                       BendingModel::kIsometric, BendingModel::kPabst};
+        for (BendingModel model : models) {
+          for (int threads : thread_counts) {
+            const BendingElements b(mesh, hinges, law, std::nullopt,
+                                    {.model = model, .threads = threads});
+            Vertices grad = Vertices::Zero(mesh.num_vertices(), 3);
+            std::vector<Eigen::Triplet<double>> triplets;
+            triplets.reserve(144 * hinges.size());
+            const auto force = [&] {
+              grad.setZero();
+              b.AddGradient(x, grad);
             };
-            const auto& p1 = find("pabst", 1);
-            std::snprintf(line, sizeof line,
-                          "targets (1 thread): pabst force %.4f ms (<= 0.1: %s), pabst/bridson %.2f (<= 1.2: %s), "
-                          "force + Jacobian %.3f ms (<= 0.5: %s); paper: 6.3 / 51.1 / 65.0 ms\n",
-                          p1["force_ms"].get<double>(), p1["force_ms"].get<double>() <= 0.1 ? "met" : "MISSED",
-                          p1["force_vs_bridson"].get<double>(),
-                          p1["force_vs_bridson"].get<double>() <= 1.2 ? "met" : "MISSED",
-                          p1["force_jacobian_ms"].get<double>(),
-                          p1["force_jacobian_ms"].get<double>() <= 0.5 ? "met" : "MISSED");
-            sum << line;
-            res.summary = sum.str();
-
-            namespace chart = textile::chart;
-            chart::Panel p{.title = "Bending on 3600 triangles (" + std::to_string(hinges.size()) + " hinges)",
-                           .x_label = "model (1 Volino, 2 Bridson, 3 isometric, 4 Pabst)",
-                           .y_label = "time per evaluation [ms]", .log_y = true};
-            int k = 0;
-            for (int threads : thread_counts) {
-              for (const char* what : {"force_ms", "force_jacobian_ms"}) {
-                chart::Series s{.label = std::string(what == std::string("force_ms") ? "force" : "force + Jacobian") +
-                                         ", " + std::to_string(threads) + " thread" + (threads > 1 ? "s" : ""),
-                                .style = chart::Series::Style::kLineAndMarkers,
-                                .color = chart::PaletteColor(k++), .dashed = threads > 1};
-                int i = 1;
-                for (BendingModel model : models) {
-                  s.x.push_back(i++);
-                  s.y.push_back(find(BendingModelName(model).c_str(), threads)[what].get<double>());
-                }
-                p.series.push_back(s);
-              }
+            force();  // warm up caches and the scratch buffer
+            const double force_s = MedianSeconds(force, repeats);
+            const auto force_jacobian = [&](bool psd) {
+              force();
+              triplets.clear();
+              b.AddHessianTriplets(x, &triplets, psd);
+            };
+            force_jacobian(false);
+            const double fj_s = MedianSeconds([&] { force_jacobian(false); }, repeats);
+            const double psd_s =
+                MedianSeconds([&] { force_jacobian(true); }, std::max(5, repeats / 20));
+            // What a Newton step pays on top: the sparse matrix from the triplets.
+            Eigen::SparseMatrix<double> hessian(3 * mesh.num_vertices(), 3 * mesh.num_vertices());
+            force_jacobian(false);
+            const double assemble_s =
+                MedianSeconds([&] { hessian.setFromTriplets(triplets.begin(), triplets.end()); },
+                              std::max(5, repeats / 20));
+            res.rows.push_back({{"model", BendingModelName(model)},
+                                {"threads", threads},
+                                {"triangles", mesh.num_triangles()},
+                                {"hinges", static_cast<int>(hinges.size())},
+                                {"force_ms", force_s * 1e3},
+                                {"force_jacobian_ms", fj_s * 1e3},
+                                {"force_jacobian_psd_ms", psd_s * 1e3},
+                                {"assemble_ms", assemble_s * 1e3}});
+          }
+        }
+        // Ratios to Bridson at the same thread count.
+        for (auto& r : res.rows) {
+          for (const auto& q : res.rows) {
+            if (q["model"] == "bridson" && q["threads"] == r["threads"]) {
+              r["force_vs_bridson"] = r["force_ms"].get<double>() / q["force_ms"].get<double>();
             }
-            p.notes = {"paper (2008 CPU): Volino 6.3, Bridson 51.1, Pabst 65.0 ms (force)"};
-            chart::WritePng({.title = "bend-force benchmark", .panels = {p}}, ctx.out_dir + "/bend-force.png");
-            return res;
-          }};
+          }
+        }
+
+        std::ostringstream sum;
+        char line[220];
+        std::snprintf(line, sizeof line, "%-10s %7s %9s %10s %12s %12s %11s %9s\n", "model",
+                      "threads", "triangles", "force_ms", "force+J_ms", "force+Jpsd", "assemble",
+                      "vs_bridson");
+        sum << line;
+        for (const auto& r : res.rows) {
+          std::snprintf(line, sizeof line, "%-10s %7d %9d %10.4f %12.4f %12.3f %11.3f %9.2f\n",
+                        r["model"].get<std::string>().c_str(), r["threads"].get<int>(),
+                        r["triangles"].get<int>(), r["force_ms"].get<double>(),
+                        r["force_jacobian_ms"].get<double>(),
+                        r["force_jacobian_psd_ms"].get<double>(), r["assemble_ms"].get<double>(),
+                        r["force_vs_bridson"].get<double>());
+          sum << line;
+        }
+        const auto find = [&](const char* model, int threads) -> const nlohmann::json& {
+          for (const auto& r : res.rows)
+            if (r["model"] == model && r["threads"] == threads) return r;
+          return res.rows.front();
+        };
+        const auto& p1 = find("pabst", 1);
+        std::snprintf(line, sizeof line,
+                      "targets (1 thread): pabst force %.4f ms (<= 0.1: %s), pabst/bridson %.2f "
+                      "(<= 1.2: %s), "
+                      "force + Jacobian %.3f ms (<= 0.5: %s); paper: 6.3 / 51.1 / 65.0 ms\n",
+                      p1["force_ms"].get<double>(),
+                      p1["force_ms"].get<double>() <= 0.1 ? "met" : "MISSED",
+                      p1["force_vs_bridson"].get<double>(),
+                      p1["force_vs_bridson"].get<double>() <= 1.2 ? "met" : "MISSED",
+                      p1["force_jacobian_ms"].get<double>(),
+                      p1["force_jacobian_ms"].get<double>() <= 0.5 ? "met" : "MISSED");
+        sum << line;
+        res.summary = sum.str();
+
+        namespace chart = textile::chart;
+        chart::Panel p{
+            .title = "Bending on 3600 triangles (" + std::to_string(hinges.size()) + " hinges)",
+            .x_label = "model (1 Volino, 2 Bridson, 3 isometric, 4 Pabst)",
+            .y_label = "time per evaluation [ms]",
+            .log_y = true};
+        int k = 0;
+        for (int threads : thread_counts) {
+          for (const char* what : {"force_ms", "force_jacobian_ms"}) {
+            chart::Series s{
+                .label =
+                    std::string(what == std::string("force_ms") ? "force" : "force + Jacobian") +
+                    ", " + std::to_string(threads) + " thread" + (threads > 1 ? "s" : ""),
+                .style = chart::Series::Style::kLineAndMarkers,
+                .color = chart::PaletteColor(k++),
+                .dashed = threads > 1};
+            int i = 1;
+            for (BendingModel model : models) {
+              s.x.push_back(i++);
+              s.y.push_back(find(BendingModelName(model).c_str(), threads)[what].get<double>());
+            }
+            p.series.push_back(s);
+          }
+        }
+        p.notes = {"paper (2008 CPU): Volino 6.3, Bridson 51.1, Pabst 65.0 ms (force)"};
+        chart::WritePng({.title = "bend-force benchmark", .panels = {p}},
+                        ctx.out_dir + "/bend-force.png");
+        return res;
+      }};
 }
 
 }  // namespace textile::bench

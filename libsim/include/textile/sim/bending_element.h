@@ -7,10 +7,10 @@
 //   textile::TriangleMesh rest = textile::CrissCrossGridMesh(0.5, 0.5, 30, 30);
 //   std::vector<textile::Hinge> hinges = textile::BuildHinges(rest);
 //   textile::Material fabric = textile::ReadMaterial("samples/materials/pabst-fig8.json");
-//   textile::BendingElements bending(rest, hinges, fabric, {.model = textile::BendingModel::kPabst});
-//   textile::Vertices grad = textile::Vertices::Zero(rest.num_vertices(), 3);
-//   double energy = bending.EnergyGradient(x, grad);   // J and J/m; forces are -grad
-//   std::vector<Eigen::Triplet<double>> triplets;
+//   textile::BendingElements bending(rest, hinges, fabric, {.model =
+//   textile::BendingModel::kPabst}); textile::Vertices grad =
+//   textile::Vertices::Zero(rest.num_vertices(), 3); double energy = bending.EnergyGradient(x,
+//   grad);   // J and J/m; forces are -grad std::vector<Eigen::Triplet<double>> triplets;
 //   bending.AddHessianTriplets(x, &triplets, /*project_psd=*/true);  // 3V×3V, for Newton
 //
 // Hinge h has wings v[0], v[1] and edge (v[2], v[3]) (mesh.h). Its bend angle θ is the signed
@@ -59,8 +59,8 @@ BendingModel ParseBendingModel(const std::string& name);
 struct BendingOptions {
   BendingModel model = BendingModel::kPabst;  // which energy (see above)
   // Worker threads for the hinge loops: 1 = serial (the default, and what solvers that
-  // thread elsewhere want), 0 = all hardware threads; at most 64 are used. Results do not depend on it beyond
-  // round-off in the energy sum.
+  // thread elsewhere want), 0 = all hardware threads; at most 64 are used. Results do not depend on
+  // it beyond round-off in the energy sum.
   int threads = 1;
 
   // False with a reason when a field is out of range.
@@ -113,12 +113,12 @@ class BendingElements {
   int num_hinges() const { return static_cast<int>(rest_.size()); }
   const Hinge& hinge(int h) const { return hinges_[h]; }
   BendingModel model() const { return options_.model; }
-  double rest_dihedral(int h) const { return rest_[h].rest_angle; }     // θ̄ [rad]
-  double rest_height(int h) const { return 1.0 / rest_[h].inv_height; }  // h̄e [m]
-  double rest_edge_length(int h) const { return edge_length_[h]; }       // |ē| [m]
+  double rest_dihedral(int h) const { return rest_[h].rest_angle; }                  // θ̄ [rad]
+  double rest_height(int h) const { return 1.0 / rest_[h].inv_height; }              // h̄e [m]
+  double rest_edge_length(int h) const { return edge_length_[h]; }                   // |ē| [m]
   double area_weight(int h) const { return edge_length_[h] / rest_[h].inv_height; }  // A_h [m²]
-  double stiffness_multiplier(int h) const { return multiplier_[h]; }    // S
-  double warp_weight(int h) const { return rest_[h].warp_weight; }       // cos²φ
+  double stiffness_multiplier(int h) const { return multiplier_[h]; }                // S
+  double warp_weight(int h) const { return rest_[h].warp_weight; }                   // cos²φ
   // Bend angle θ [rad], hinge curvature κ = (θ - θ̄)/h̄e [1/m] and energy [J] of hinge h.
   double BendAngle(const Vertices& x, int h) const;
   double HingeCurvature(const Vertices& x, int h) const;
@@ -143,8 +143,8 @@ class BendingElements {
   template <bool kWithEnergy, bool kWithGradient>
   double Evaluate(const Vertices& x, double* grad) const;
   double HingeTerms(const Vertices& x, int h, double* d_energy, double* d2_energy) const;
-  double DihedralTerms(double cos_term, double sin_term, int h, double* d_energy,
-                       double* d2_energy, bool want_energy) const;
+  double DihedralTerms(double cos_term, double sin_term, int h, double* d_energy, double* d2_energy,
+                       bool want_energy) const;
   double LawEnergy(const HingeRest& r, double kappa) const;
   double LawMoment(const HingeRest& r, double kappa) const;
   double LawStiffness(const HingeRest& r, double kappa) const;
@@ -157,8 +157,8 @@ class BendingElements {
   std::vector<Hinge> hinges_;
   std::vector<HingeRest> rest_;
   std::vector<double> edge_length_, multiplier_;
-  std::vector<double> half_angle_;     // Bridson: {sin θ̄/2, cos θ̄/2} per hinge
-  std::vector<LinearRest> linear_;     // Volino and isometric only
+  std::vector<double> half_angle_;  // Bridson: {sin θ̄/2, cos θ̄/2} per hinge
+  std::vector<LinearRest> linear_;  // Volino and isometric only
   // Threaded gradient: per-hinge 12-vectors gathered per vertex (CSR of (hinge, slot)).
   std::vector<int> vertex_offsets_, vertex_slots_;
   mutable std::vector<double> hinge_gradient_;  // scratch: not for concurrent threaded calls

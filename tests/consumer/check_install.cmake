@@ -12,8 +12,7 @@ run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
 # A sanitizer build installs instrumented libraries; the consumer must link the runtime too.
 set(flags "")
 if(SANITIZE)
-  string(REPLACE ";" "," san "${SANITIZE}")
-  set(flags "-fsanitize=${san}")
+  set(flags "-fsanitize=${SANITIZE}")
 endif()
 run(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${WORK_DIR}/build -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix
     -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS=${flags}" "-DCMAKE_EXE_LINKER_FLAGS=${flags}")

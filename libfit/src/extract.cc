@@ -1,0 +1,1320 @@
+// The photo extractor: strip detection on a reduced image, rig recognition, sub-pixel
+// silhouette boundaries at full resolution, and the profile in the frame of cantilever.md.
+// The method and its choices are described in docs/extraction.md.
+
+#include "textile/fit/extract.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <opencv2/imgproc.hpp>
+#include <queue>
+#include <sstream>
+
+#include "extract_internal.h"
+#include "textile/sim/error.h"
+
+namespace textile {
+namespace {
+
+using extract_internal::Block;
+using extract_internal::Median;
+using extract_internal::PlatformFit;
+using extract_internal::ResampleByArc;
+using extract_internal::SampleGray;
+using extract_internal::SmoothPolyline;
+using extract_internal::Vec2;
+namespace border = extract_internal;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kDeg = M_PI / 180.0;
+
+// The silhouette is where the contrast exceeds this fraction of the section's peak: low enough
+// to keep an oblique face that is 10 % as bright as a lit edge (the real photos), and the
+// boundary itself is then placed on the steepest point of the transition, not at this level.
+constexpr double kSilhouetteFraction = 0.06;
+// Sample spacing across the strip [px]; bilinear interpolation in between.
+constexpr double kAcrossStep = 0.5;
+// A strip is at least this many times longer than thick, and at least this fraction of the
+// reduced image's diagonal long.
+constexpr double kMinElongation = 5.0;
+constexpr double kMinLengthFraction = 0.08;
+
+// ---------------------------------------------------------------- reduced-image detection
+
+// Geodesic distance inside `mask` from `seeds`, 8-connected (steps 1 and √2) [px]; +inf outside
+// or unreachable.
+cv::Mat GeodesicDistance(const cv::Mat& mask, const std::vector<cv::Point>& seeds) {
+  const float inf = std::numeric_limits<float>::infinity();
+  cv::Mat dist(mask.size(), CV_32F, cv::Scalar(inf));
+  using Item = std::pair<float, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  const int w = mask.cols, h = mask.rows;
+  for (const cv::Point& s : seeds) {
+    if (!mask.at<uchar>(s)) continue;
+    dist.at<float>(s) = 0.0f;
+    queue.push({0.0f, s.y * w + s.x});
+  }
+  static const int dx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
+  static const int dy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+  static const float step[8] = {
+      1, 1, 1, 1, float(M_SQRT2), float(M_SQRT2), float(M_SQRT2), float(M_SQRT2)};
+  while (!queue.empty()) {
+    const auto [d, i] = queue.top();
+    queue.pop();
+    const int x = i % w, y = i / w;
+    if (d > dist.at<float>(y, x)) continue;
+    for (int k = 0; k < 8; ++k) {
+      const int nx = x + dx[k], ny = y + dy[k];
+      if (nx < 0 || ny < 0 || nx >= w || ny >= h || !mask.at<uchar>(ny, nx)) continue;
+      const float nd = d + step[k];
+      if (nd < dist.at<float>(ny, nx)) {
+        dist.at<float>(ny, nx) = nd;
+        queue.push({nd, ny * w + nx});
+      }
+    }
+  }
+  return dist;
+}
+
+cv::Point Farthest(const cv::Mat& dist, const cv::Rect& box, float* value) {
+  cv::Point best(-1, -1);
+  float top = -1.0f;
+  for (int y = box.y; y < box.y + box.height; ++y) {
+    const float* row = dist.ptr<float>(y);
+    for (int x = box.x; x < box.x + box.width; ++x) {
+      if (std::isfinite(row[x]) && row[x] > top) {
+        top = row[x];
+        best = {x, y};
+      }
+    }
+  }
+  *value = top;
+  return best;
+}
+
+// The two ends of a band-like mask (a double sweep of geodesic distances) and its length.
+struct Sweep {
+  cv::Rect box;  // bounding box of the mask
+  cv::Point a, b;
+  cv::Mat dist_a, dist_b;
+  double length = 0.0;
+};
+
+Sweep DoubleSweep(const cv::Mat& mask) {
+  Sweep s;
+  s.box = cv::boundingRect(mask);
+  if (s.box.empty()) return s;
+  cv::Point any(-1, -1);
+  for (int x = s.box.x; any.x < 0 && x < s.box.x + s.box.width; ++x) {
+    if (mask.at<uchar>(s.box.y, x)) any = {x, s.box.y};
+  }
+  float v;
+  s.a = Farthest(GeodesicDistance(mask, {any}), s.box, &v);
+  s.dist_a = GeodesicDistance(mask, {s.a});
+  s.b = Farthest(s.dist_a, s.box, &v);
+  s.length = v;
+  s.dist_b = GeodesicDistance(mask, {s.b});
+  return s;
+}
+
+// Threshold of a top-/black-hat image: Otsu's, but never within the noise of the flat
+// background (median + 6 robust σ).
+double HatThreshold(const cv::Mat& hat) {
+  std::vector<int> hist(256, 0);
+  for (int y = 0; y < hat.rows; ++y) {
+    const uchar* row = hat.ptr<uchar>(y);
+    for (int x = 0; x < hat.cols; ++x) ++hist[row[x]];
+  }
+  const auto median_of = [](const std::vector<int>& h, long total) {
+    long seen = 0;
+    for (int v = 0; v < 256; ++v) {
+      seen += h[v];
+      if (2 * seen >= total) return v;
+    }
+    return 255;
+  };
+  const long total = static_cast<long>(hat.total());
+  const int med = median_of(hist, total);
+  std::vector<int> dev(256, 0);
+  for (int v = 0; v < 256; ++v) dev[std::abs(v - med)] += hist[v];
+  const double spread = std::max(0.5, 1.4826 * median_of(dev, total));
+  cv::Mat unused;
+  const double otsu = cv::threshold(hat, unused, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
+  return std::max({otsu, med + 6.0 * spread, med + 3.0});
+}
+
+// A strip candidate on the reduced image.
+struct Strip {
+  int polarity = 0;        // +1 lighter than the background, -1 darker
+  cv::Mat mask;            // CV_8U, reduced-image size
+  double score = 0.0;      // contrast mass (sum of the hat over the component)
+  double length = 0.0;     // geodesic length [reduced px]
+  double thickness = 0.0;  // area / length [reduced px]
+};
+
+void CollectStrips(const cv::Mat& hat, int polarity, std::vector<Strip>* out) {
+  const double min_length = kMinLengthFraction * std::hypot(hat.cols, hat.rows);
+  cv::Mat binary = hat > HatThreshold(hat);
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(binary, labels, stats, centroids, 8, CV_32S);
+  std::vector<double> mass(n, 0.0);
+  for (int y = 0; y < hat.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    const uchar* v = hat.ptr<uchar>(y);
+    for (int x = 0; x < hat.cols; ++x) mass[l[x]] += v[x];
+  }
+  std::vector<int> order;
+  for (int l = 1; l < n; ++l) {
+    const double diag =
+        std::hypot(stats.at<int>(l, cv::CC_STAT_WIDTH), stats.at<int>(l, cv::CC_STAT_HEIGHT));
+    if (diag >= min_length) order.push_back(l);
+  }
+  std::sort(order.begin(), order.end(), [&](int p, int q) { return mass[p] > mass[q]; });
+  if (order.size() > 8) order.resize(8);
+  for (const int l : order) {
+    Strip s;
+    s.polarity = polarity;
+    s.mask = labels == l;
+    const Sweep sweep = DoubleSweep(s.mask);
+    s.length = sweep.length;
+    s.thickness = stats.at<int>(l, cv::CC_STAT_AREA) / std::max(1.0, s.length);
+    s.score = mass[l];
+    if (s.length >= min_length && s.length >= kMinElongation * s.thickness)
+      out->push_back(std::move(s));
+  }
+}
+
+// Direction in which a band leaves its end: from the centroid of the pixels 2-4 thicknesses
+// back (by geodesic distance from the end) to the end.
+Vec2 EndDirection(const cv::Mat& mask, const cv::Mat& dist, const cv::Rect& box,
+                  const cv::Point& end, double thickness) {
+  Vec2 sum = Vec2::Zero();
+  int count = 0;
+  for (int y = box.y; y < box.y + box.height; ++y) {
+    for (int x = box.x; x < box.x + box.width; ++x) {
+      const float d = dist.at<float>(y, x);
+      if (mask.at<uchar>(y, x) && d >= 2.0 * thickness && d <= 4.0 * thickness + 2.0) {
+        sum += Vec2(x, y);
+        ++count;
+      }
+    }
+  }
+  if (count == 0) return Vec2::Zero();
+  const Vec2 d = Vec2(end.x, end.y) - sum / count;
+  return d.norm() > 0 ? Vec2(d.normalized()) : Vec2::Zero();
+}
+
+// Bridges gaps in the strip (a dim spot, a shadowed stretch): other pieces of the thresholded
+// hat that continue the band beyond one of its ends, within a cone of ±30° and a gap of at most
+// six thicknesses (or 5 % of the image diagonal), are joined to it, repeatedly.
+void MergeContinuations(const cv::Mat& hat, Strip* strip) {
+  cv::Mat binary = hat > HatThreshold(hat);
+  cv::Mat labels;
+  cv::connectedComponents(binary, labels, 8, CV_32S);
+  const double gap = std::max(6.0 * strip->thickness, 0.05 * std::hypot(hat.cols, hat.rows));
+  for (int round = 0; round < 12; ++round) {
+    const Sweep sweep = DoubleSweep(strip->mask);
+    bool merged = false;
+    for (int e = 0; e < 2 && !merged; ++e) {
+      const cv::Point end = e == 0 ? sweep.a : sweep.b;
+      const Vec2 dir = EndDirection(strip->mask, e == 0 ? sweep.dist_a : sweep.dist_b, sweep.box,
+                                    end, strip->thickness);
+      if (dir.norm() == 0.0) continue;
+      const int r = static_cast<int>(std::ceil(gap));
+      double best = 1e300;
+      cv::Point best_p;
+      for (int y = std::max(0, end.y - r); y <= std::min(hat.rows - 1, end.y + r); ++y) {
+        for (int x = std::max(0, end.x - r); x <= std::min(hat.cols - 1, end.x + r); ++x) {
+          if (!labels.at<int>(y, x) || strip->mask.at<uchar>(y, x)) continue;
+          const Vec2 v(x - end.x, y - end.y);
+          const double d = v.norm();
+          if (d > gap || d < 1.0 || v.dot(dir) < d * std::cos(30.0 * kDeg)) continue;
+          if (d < best) {
+            best = d;
+            best_p = {x, y};
+          }
+        }
+      }
+      if (best > gap) continue;
+      strip->mask |= labels == labels.at<int>(best_p);
+      cv::line(strip->mask, end, best_p, cv::Scalar(255),
+               std::max(1, static_cast<int>(strip->thickness / 2)));
+      merged = true;
+    }
+    if (!merged) break;
+  }
+  strip->length = DoubleSweep(strip->mask).length;
+}
+
+// Which image borders a set of mask pixels (those within `radius` of an end) touches.
+int BordersNear(const cv::Mat& mask, const cv::Mat& dist, const cv::Rect& box, double radius) {
+  int borders = border::kNoBorder;
+  for (int y = box.y; y < box.y + box.height; ++y) {
+    for (int x = box.x; x < box.x + box.width; ++x) {
+      if (!mask.at<uchar>(y, x) || !(dist.at<float>(y, x) <= radius)) continue;
+      if (x == 0) borders |= border::kLeft;
+      if (x == mask.cols - 1) borders |= border::kRight;
+      if (y == 0) borders |= border::kTop;
+      if (y == mask.rows - 1) borders |= border::kBottom;
+    }
+  }
+  return borders;
+}
+
+// Centre line of a band: centroids of the level sets of the geodesic distance from the root,
+// in 1 px bins (level sets of a band cut straight across it). Widths [px] per point.
+std::vector<Vec2> LevelSetCentreline(const cv::Mat& mask, const std::vector<cv::Point>& seeds,
+                                     std::vector<double>* widths) {
+  const cv::Mat d = GeodesicDistance(mask, seeds);
+  std::vector<Vec2> sum;
+  std::vector<int> count;
+  for (int y = 0; y < d.rows; ++y) {
+    const float* row = d.ptr<float>(y);
+    for (int x = 0; x < d.cols; ++x) {
+      if (!std::isfinite(row[x])) continue;
+      const size_t k = static_cast<size_t>(row[x]);
+      if (k >= sum.size()) {
+        sum.resize(k + 1, Vec2::Zero());
+        count.resize(k + 1, 0);
+      }
+      sum[k] += Vec2(x, y);
+      ++count[k];
+    }
+  }
+  std::vector<Vec2> line;
+  widths->clear();
+  for (size_t k = 0; k < sum.size(); ++k) {
+    if (count[k] == 0) continue;
+    line.push_back(sum[k] / count[k]);
+    widths->push_back(count[k]);
+  }
+  return line;
+}
+
+// A hanging strip bends gently (radii of many thicknesses); a centre line that turns sharply
+// has wandered into a brush of fibres or along a lit end face. Cuts the line (1 px spacing)
+// where its direction over `base` px turns by more than 35° from the stretch before.
+// Moreover the moment, hence the curvature, of a cantilever falls towards its free end: in the
+// outer half of the line the turn per `base` may not grow by more than 12° over the least turn
+// seen before; where it does, the line is cut.
+void CutAtSharpTurn(std::vector<Vec2>* line, double base, bool check_growth) {
+  const int b = static_cast<int>(base);
+  const int n = static_cast<int>(line->size());
+  double least = 1e9;
+  for (int i = b; i + b < n; ++i) {
+    const Vec2 before = ((*line)[i] - (*line)[i - b]).normalized();
+    const Vec2 after = ((*line)[i + b] - (*line)[i]).normalized();
+    const double turn = std::acos(std::clamp(before.dot(after), -1.0, 1.0));
+    if (i > n / 2) least = std::min(least, turn);
+    if (turn > 35.0 * kDeg || (check_growth && turn > least + 12.0 * kDeg)) {
+      line->resize(i + 1);
+      return;
+    }
+  }
+}
+
+// ---------------------------------------------------------------- full-resolution sections
+
+struct Section {
+  double n_lo = kNaN, n_up = kNaN;    // boundaries along the normal [px] (n_up on the top side)
+  double peak = 0.0;                  // contrast at the core [grey levels]
+  double bg = 0.0;                    // background level (mean of both sides)
+  bool present = false;               // the strip is there (clear contrast at the core)
+  bool valid = false;                 // ... and both boundaries were measured
+  bool lo_ok = false, up_ok = false;  // each boundary measured and not an outlier
+  double solid = 0.0;                 // longest run above half the peak contrast [px]: the
+                                      // strip's body, where loose fibres give only short runs
+  double solid_mid = kNaN;            // centre of that run along the normal [px]: a steadier
+                                      // guide than the mid-line when a faint face comes and goes
+  double width() const { return n_up - n_lo; }
+  // Whether the line to trace is known here.
+  bool Usable(TraceLine line) const {
+    return line == TraceLine::kUpper ? up_ok : line == TraceLine::kLower ? lo_ok : lo_ok && up_ok;
+  }
+};
+
+// Cross-sections of the strip at stations along a guide line.
+struct SectionSet {
+  std::vector<Vec2> p, t, n;  // station [px], unit tangent (root -> tip), unit normal (top side)
+  std::vector<Section> s;
+  double noise = 0.0;     // σ of the smoothed background [grey levels]
+  double contrast = 0.0;  // median peak contrast of valid sections
+  double width = 0.0;     // median width of valid sections [px]
+  int rejected = 0;       // sections dropped as outliers
+};
+
+// Sub-sample edge position: the first local maximum of the inward derivative of the contrast
+// c, from `start` (just outside the silhouette) towards `core`, that is at least `min_slope`
+// per sample; parabola through the maximum. Falls back to `fallback` when there is none.
+double RefineEdge(const std::vector<double>& c, int start, int core, double min_slope,
+                  double fallback) {
+  const int step = core > start ? 1 : -1;
+  const auto slope = [&](int j) { return step * (c[j + 1] - c[j - 1]) / 2.0; };
+  const int last = static_cast<int>(c.size()) - 2;
+  for (int j = start; j != core; j += step) {
+    if (j < 2 || j > last - 1) continue;
+    const double here = slope(j), before = slope(j - step), after = slope(j + step);
+    if (here >= min_slope && here >= before && here > after) {
+      const double den = before - 2.0 * here + after;
+      const double delta = den < 0.0 ? 0.5 * (before - after) / den : 0.0;
+      return j + step * std::clamp(delta, -0.5, 0.5);
+    }
+  }
+  return fallback;
+}
+
+SectionSet AnalyseSections(const cv::Mat& gray, const std::vector<Vec2>& line, int direction,
+                           int polarity, double half_width, double core_half_width) {
+  SectionSet set;
+  const int m = static_cast<int>(line.size());
+  set.p = line;
+  set.t.resize(m);
+  set.n.resize(m);
+  set.s.resize(m);
+  for (int i = 0; i < m; ++i) {
+    Vec2 d = line[std::min(i + 3, m - 1)] - line[std::max(i - 3, 0)];
+    if (d.norm() < 1e-9) d = Vec2(direction, 0.0);
+    set.t[i] = d.normalized();
+    set.n[i] = direction * Vec2(set.t[i].y(), -set.t[i].x());
+  }
+  const int half = static_cast<int>(std::lround(half_width / kAcrossStep));
+  const int cols = 2 * half + 1;
+  cv::Mat raw(m, cols, CV_32F), inside(m, cols, CV_8U);
+  for (int i = 0; i < m; ++i) {
+    for (int j = 0; j < cols; ++j) {
+      const Vec2 q = line[i] + (j - half) * kAcrossStep * set.n[i];
+      double v;
+      const bool in = SampleGray(gray, q.x(), q.y(), &v);
+      if (!in) {
+        SampleGray(gray, std::clamp(q.x(), 0.0, gray.cols - 1.0),
+                   std::clamp(q.y(), 0.0, gray.rows - 1.0), &v);
+      }
+      raw.at<float>(i, j) = static_cast<float>(v);
+      inside.at<uchar>(i, j) = in;
+    }
+  }
+  // Noise is smoothed across (σ = 1 px) and along (σ = 1.5 stations) the strip; both are far
+  // below the scale of the strip's shape.
+  cv::Mat u;
+  cv::GaussianBlur(raw, u, cv::Size(0, 0), 1.0 / kAcrossStep, 1.5, cv::BORDER_REPLICATE);
+
+  const int margin = std::max(4, static_cast<int>(std::lround(0.12 * cols)));
+  std::vector<double> deviations;
+  std::vector<double> bg_lo(m), bg_up(m);
+  for (int i = 0; i < m; ++i) {
+    const float* row = u.ptr<float>(i);
+    std::vector<double> lo(row, row + margin), up(row + cols - margin, row + cols);
+    bg_lo[i] = Median(lo);
+    bg_up[i] = Median(up);
+    if (i % 4 == 0) {
+      for (double v : lo) deviations.push_back(std::abs(v - bg_lo[i]));
+      for (double v : up) deviations.push_back(std::abs(v - bg_up[i]));
+    }
+  }
+  set.noise = std::max(0.2, 1.4826 * Median(deviations));
+  const double jl = (margin - 1) / 2.0, ju = cols - 1 - (margin - 1) / 2.0;
+  const int core_reach = std::max(2, static_cast<int>(std::lround(core_half_width / kAcrossStep)));
+  std::vector<double> c(cols);
+  for (int i = 0; i < m; ++i) {
+    Section& sec = set.s[i];
+    const float* row = u.ptr<float>(i);
+    for (int j = 0; j < cols; ++j) {
+      const double bg = bg_lo[i] + (bg_up[i] - bg_lo[i]) * (j - jl) / (ju - jl);
+      c[j] = polarity * (row[j] - bg);
+    }
+    sec.bg = 0.5 * (bg_lo[i] + bg_up[i]);
+    if (!inside.at<uchar>(i, half)) continue;
+    int core = half;
+    for (int j = half - core_reach; j <= half + core_reach; ++j) {
+      if (j > 0 && j < cols - 1 && c[j] > c[core]) core = j;
+    }
+    sec.peak = c[core];
+    if (sec.peak < 4.0 * set.noise) continue;
+    sec.present = true;
+    {
+      int lo = core, hi = core;
+      while (lo > 0 && c[lo - 1] > 0.5 * sec.peak) --lo;
+      while (hi < cols - 1 && c[hi + 1] > 0.5 * sec.peak) ++hi;
+      sec.solid = (hi - lo + 1) * kAcrossStep;
+      sec.solid_mid = (0.5 * (lo + hi) - half) * kAcrossStep;
+    }
+    const double threshold = std::max(kSilhouetteFraction * sec.peak, 4.0 * set.noise);
+    int a = core, b = core;
+    while (a > 0 && c[a - 1] > threshold) --a;
+    while (b < cols - 1 && c[b + 1] > threshold) ++b;
+    // The silhouette must end inside the window with background on both sides.
+    if (a <= margin || b >= cols - 1 - margin) continue;
+    if (std::abs(bg_up[i] - bg_lo[i]) > 0.5 * sec.peak) continue;
+    bool all_inside = true;
+    for (int j = std::max(0, a - 4); j <= std::min(cols - 1, b + 4); ++j)
+      all_inside &= inside.at<uchar>(i, j) != 0;
+    if (!all_inside) continue;
+    const double cross_lo = (a - 1) + (threshold - c[a - 1]) / (c[a] - c[a - 1]);
+    const double cross_up = (b + 1) - (threshold - c[b + 1]) / (c[b] - c[b + 1]);
+    const double min_slope = threshold * kAcrossStep / 4.0;
+    const double e_lo = RefineEdge(c, a - 1, core, min_slope, cross_lo);
+    const double e_up = RefineEdge(c, b + 1, core, min_slope, cross_up);
+    sec.n_lo = (e_lo - half) * kAcrossStep;
+    sec.n_up = (e_up - half) * kAcrossStep;
+    sec.valid = sec.lo_ok = sec.up_ok = sec.n_up > sec.n_lo;
+  }
+  return set;
+}
+
+// Running quantile q (0.5: median) of values[i] over valid stations within ±reach.
+std::vector<double> RunningQuantile(const std::vector<double>& values, const std::vector<char>& ok,
+                                    int reach, double q = 0.5) {
+  const int m = static_cast<int>(values.size());
+  std::vector<double> out(m, kNaN);
+  std::vector<double> window;
+  for (int i = 0; i < m; ++i) {
+    window.clear();
+    for (int k = std::max(0, i - reach); k <= std::min(m - 1, i + reach); ++k) {
+      if (ok[k]) window.push_back(values[k]);
+    }
+    if (window.empty()) continue;
+    if (q == 0.5) {
+      out[i] = Median(window);
+    } else {
+      const size_t at = static_cast<size_t>(std::lround(q * (window.size() - 1)));
+      std::nth_element(window.begin(), window.begin() + at, window.end());
+      out[i] = window[at];
+    }
+  }
+  return out;
+}
+
+// Drops sections whose contrast is weak, and boundaries that jump away from their neighbours'
+// (a loose fibre lying against the strip, a speck), then records the typical contrast and width.
+// Each boundary is judged on its own, so a frayed lower edge does not cost the upper one.
+void RejectOutliers(SectionSet* set) {
+  const int m = static_cast<int>(set->s.size());
+  std::vector<double> peaks;
+  for (const auto& s : set->s)
+    if (s.present) peaks.push_back(s.peak);
+  if (peaks.empty()) return;
+  const double ref = Median(peaks);
+  int before = 0;
+  for (auto& s : set->s) {
+    if (s.peak < 0.3 * ref) s.present = s.valid = s.lo_ok = s.up_ok = false;
+    before += s.valid;
+  }
+  std::vector<double> lo(m), up(m), width(m);
+  std::vector<char> ok(m);
+  std::vector<double> widths;
+  for (int i = 0; i < m; ++i) {
+    lo[i] = set->s[i].n_lo;
+    up[i] = set->s[i].n_up;
+    width[i] = set->s[i].width();
+    ok[i] = set->s[i].valid;
+    if (ok[i]) widths.push_back(width[i]);
+  }
+  if (widths.empty()) return;
+  // Silhouettes widen or narrow slowly: half the width or twice it, within a few widths, is a
+  // fibre or a speck, not the strip.
+  const double w_med = Median(widths);
+  const std::vector<double> width_med =
+      RunningQuantile(width, ok, std::max(20, static_cast<int>(2.0 * w_med)));
+  for (int i = 0; i < m; ++i) {
+    Section& s = set->s[i];
+    if (s.valid && (width[i] < 0.5 * width_med[i] || width[i] > 2.0 * width_med[i])) {
+      s.valid = s.lo_ok = s.up_ok = false;
+    }
+  }
+  // Boundaries follow a smooth curve along the guide: twice, a running reference over ±1.5
+  // widths, and points farther from it than 3 robust σ (at least 1 px, at most 15 % of the
+  // width or 2 px) are dropped. Fibres only ever push a boundary outwards, so the reference is
+  // a quantile on the inner side (30 %) rather than the median: it stays on the edge even
+  // where fibres are the local majority.
+  const int reach = std::max(15, static_cast<int>(1.5 * w_med));
+  for (int side = 0; side < 2; ++side) {
+    const std::vector<double>& v = side == 0 ? lo : up;
+    for (int iter = 0; iter < 2; ++iter) {
+      for (int i = 0; i < m; ++i) ok[i] = side == 0 ? set->s[i].lo_ok : set->s[i].up_ok;
+      const std::vector<double> med = RunningQuantile(v, ok, reach, side == 0 ? 0.7 : 0.3);
+      std::vector<double> dev;
+      for (int i = 0; i < m; ++i)
+        if (ok[i]) dev.push_back(std::abs(v[i] - med[i]));
+      if (dev.empty()) break;
+      const double tol = std::clamp(3.0 * 1.4826 * Median(dev), 1.0, std::max(2.0, 0.15 * w_med));
+      for (int i = 0; i < m; ++i) {
+        if (ok[i] && std::abs(v[i] - med[i]) > tol)
+          (side == 0 ? set->s[i].lo_ok : set->s[i].up_ok) = false;
+      }
+    }
+  }
+  int after = 0;
+  peaks.clear();
+  widths.clear();
+  for (auto& s : set->s) {
+    s.valid = s.lo_ok && s.up_ok;
+    after += s.valid;
+    if (!s.valid) continue;
+    peaks.push_back(s.peak);
+    widths.push_back(s.width());
+  }
+  set->rejected = before - after;
+  if (!peaks.empty()) {
+    set->contrast = Median(peaks);
+    set->width = Median(widths);
+  }
+}
+
+// The longest stretch of sections showing the strip, with gaps of at most max_gap stations.
+std::pair<int, int> LongestRun(const SectionSet& set, int max_gap) {
+  std::pair<int, int> best(-1, -2);
+  int first = -1, last = -1;
+  for (int i = 0; i < static_cast<int>(set.s.size()); ++i) {
+    if (!set.s[i].present) continue;
+    if (first < 0 || i - last > max_gap + 1) first = i;
+    last = i;
+    if (last - first > best.second - best.first) best = {first, last};
+  }
+  return best;
+}
+
+// The strip's measured stretch: the longest run, without unmeasured sections at its ends and
+// without a frayed end, where the strip's solid body gives way to fibres (a brush of bright
+// fibres is as contrasted as the strip but has no solid core). *end_width is the typical width
+// just before the end [px]. {-1, -2} if nothing usable.
+std::pair<int, int> TrimmedRun(const SectionSet& set, TraceLine line, double* end_width) {
+  auto [first, last] = LongestRun(set, std::max(15, static_cast<int>(1.5 * set.width)));
+  if (last - first < 10) return {-1, -2};
+  {
+    std::vector<double> solid;
+    for (int i = first; i <= last; ++i)
+      if (set.s[i].present) solid.push_back(set.s[i].solid);
+    const double ref = Median(solid);
+    const int k = std::max(5, static_cast<int>(0.5 * set.width));
+    while (last > first + 10) {
+      std::vector<double> tail;
+      for (int i = std::max(first, last - k); i <= last; ++i)
+        if (set.s[i].present) tail.push_back(set.s[i].solid);
+      if (!tail.empty() && Median(tail) >= 0.5 * ref && set.s[last].solid >= 0.5 * ref) break;
+      --last;
+    }
+  }
+  std::vector<double> widths;
+  const int want = std::max(10, static_cast<int>(2 * set.width));
+  for (int i = last; i >= first && static_cast<int>(widths.size()) < want; --i) {
+    if (set.s[i].valid) widths.push_back(set.s[i].width());
+  }
+  if (widths.empty()) return {-1, -2};
+  *end_width = Median(widths);
+  while (first < last - 10 && !set.s[first].Usable(line)) ++first;
+  return {first, last};
+}
+
+// Per-station offsets along the normal for stations first..last: valid values, gaps filled by
+// linear interpolation, ends by the nearest valid value.
+std::vector<double> FilledOffsets(const SectionSet& set, int first, int last, TraceLine which) {
+  std::vector<double> out(last - first + 1, kNaN);
+  for (int i = first; i <= last; ++i) {
+    const Section& s = set.s[i];
+    if (!s.Usable(which)) continue;
+    out[i - first] = which == TraceLine::kUpper   ? s.n_up
+                     : which == TraceLine::kLower ? s.n_lo
+                                                  : 0.5 * (s.n_lo + s.n_up);
+  }
+  int prev = -1;
+  for (int k = 0; k < static_cast<int>(out.size()); ++k) {
+    if (std::isnan(out[k])) continue;
+    for (int g = prev + 1; prev >= 0 && g < k; ++g) {
+      out[g] = out[prev] + (out[k] - out[prev]) * (g - prev) / double(k - prev);
+    }
+    prev = k;
+  }
+  if (prev < 0) return out;
+  for (int k = prev + 1; k < static_cast<int>(out.size()); ++k) out[k] = out[prev];
+  for (int k = 0; std::isnan(out[k]); ++k) {
+    int next = k;
+    while (std::isnan(out[next])) ++next;
+    out[k] = out[next];
+  }
+  return out;
+}
+
+// Extends a polyline at its start and end along its end tangents (measured over `base` px).
+std::vector<Vec2> Extend(const std::vector<Vec2>& line, double at_start, double at_end,
+                         double base) {
+  if (line.size() < 2) return line;
+  const auto tangent = [&](bool start) {
+    double run = 0.0;
+    size_t k = 1;
+    if (start) {
+      while (k + 1 < line.size() && run < base) run += (line[k] - line[k - 1]).norm(), ++k;
+      return Vec2((line[0] - line[k - 1]).normalized());
+    }
+    const size_t n = line.size();
+    while (k + 1 < n && run < base) run += (line[n - k] - line[n - k - 1]).norm(), ++k;
+    return Vec2((line[n - 1] - line[n - k]).normalized());
+  };
+  std::vector<Vec2> out;
+  const Vec2 ts = tangent(true), te = tangent(false);
+  for (int k = static_cast<int>(std::floor(at_start)); k >= 1; --k)
+    out.push_back(line.front() + k * ts);
+  out.insert(out.end(), line.begin(), line.end());
+  for (int k = 1; k <= static_cast<int>(std::floor(at_end)); ++k)
+    out.push_back(line.back() + k * te);
+  return out;
+}
+
+enum class TipStatus { kFound, kLeftImage, kNoEnd };
+
+// Axial position of the tip beyond a station [px along the tangent from `centre`; may be
+// negative]: where the solid width of the strip falls to half of its value just before. The
+// solid width of a cross-section is its longest run of samples above half the strip's peak
+// contrast: a loose fibre adds a run of a pixel or two, the band a run of its whole width, so
+// a frayed end is not followed. *status says whether the image or the search range ended first.
+double FindTip(const cv::Mat& gray, const Vec2& centre, const Vec2& tangent, const Vec2& normal,
+               double width, double bg, double peak, int polarity, TipStatus* status) {
+  *status = TipStatus::kFound;
+  const double w = std::max(width, 3.0);
+  std::vector<double> t_at, a_at;
+  for (double t = -2.0 * w; t <= 3.0 * w + 20.0; t += 0.5) {
+    int count = 0, run = 0, longest = 0;
+    for (double u = -0.75 * w; u <= 0.75 * w + 1e-9; u += 0.5) {
+      const Vec2 q = centre + t * tangent + u * normal;
+      double v;
+      if (!SampleGray(gray, q.x(), q.y(), &v)) {
+        run = 0;
+        continue;
+      }
+      ++count;
+      run = polarity * (v - bg) > 0.5 * peak ? run + 1 : 0;
+      longest = std::max(longest, run);
+    }
+    if (count == 0) {
+      if (t > -0.5 * w) {
+        *status = TipStatus::kLeftImage;
+        break;
+      }
+      continue;
+    }
+    t_at.push_back(t);
+    a_at.push_back(0.5 * longest);
+  }
+  std::vector<double> before;
+  for (size_t k = 0; k < t_at.size(); ++k)
+    if (t_at[k] <= -0.5 * w) before.push_back(a_at[k]);
+  if (before.empty()) return 0.0;
+  // Smooth lightly along the axis so that single noisy samples do not end the strip.
+  std::vector<Vec2> pts;
+  for (double v : a_at) pts.emplace_back(v, 0.0);
+  pts = SmoothPolyline(pts, 2.0);
+  const double half = 0.5 * Median(before);
+  for (size_t k = 1; k < t_at.size(); ++k) {
+    if (t_at[k] < -0.5 * w) continue;
+    if (pts[k].x() < half) {
+      const double a0 = pts[k - 1].x(), a1 = pts[k].x();
+      const double f = a0 > a1 ? (a0 - half) / (a0 - a1) : 0.0;
+      *status = TipStatus::kFound;  // the strip ends before the image does
+      return t_at[k - 1] + f * (t_at[k] - t_at[k - 1]);
+    }
+  }
+  if (*status == TipStatus::kFound) *status = TipStatus::kNoEnd;
+  return 0.0;
+}
+
+std::string Fmt(double v, int precision = 3) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(precision);
+  s << v;
+  return s.str();
+}
+
+const char* BorderName(int b) {
+  return b & border::kLeft    ? "left"
+         : b & border::kRight ? "right"
+         : b & border::kTop   ? "top"
+                              : "bottom";
+}
+
+}  // namespace
+
+bool ExtractOptions::Check(std::string* why) const {
+  if (!(std::isfinite(step_mm) && step_mm > 0.0 && step_mm <= 50.0)) {
+    *why = "step_mm must lie in (0, 50] mm";
+    return false;
+  }
+  if (level_deg && !(std::isfinite(*level_deg) && std::abs(*level_deg) <= 45.0)) {
+    *why = "level_deg must lie in [-45, 45] degrees";
+    return false;
+  }
+  if (edge_px && !(std::isfinite(edge_px->x()) && std::isfinite(edge_px->y()))) {
+    *why = "edge_px must be two finite numbers";
+    return false;
+  }
+  if (detect_side_px < 200 || detect_side_px > 8000) {
+    *why = "detect_side_px must lie in [200, 8000]";
+    return false;
+  }
+  return true;
+}
+
+std::string ExtractionSummary::BriefReport() const {
+  std::ostringstream s;
+  if (!success) {
+    s << source << ": failed: " << message;
+    return s.str();
+  }
+  s << source << ": " << rig_type << " rig (" << rig_detail << "), strip " << polarity
+    << " on its background, overhang to the " << direction << ", trace " << trace << "\n";
+  s << "  " << profile.size() << " points, L = " << Fmt(length_mm, 2) << " mm, tip (x, y) = ("
+    << Fmt(tip_mm.x(), 2) << ", " << Fmt(tip_mm.y(), 2) << ") mm, " << Fmt(mm_per_px, 5)
+    << " mm/px, silhouette " << Fmt(width_px, 1) << " px wide";
+  for (const auto& w : warnings) s << "\n  warning: " << w;
+  return s.str();
+}
+
+ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const ExtractOptions& options,
+                                 const std::string& source) {
+  const auto started = std::chrono::steady_clock::now();
+  if (gray.empty() || gray.type() != CV_8UC1) {
+    throw InputError(source + ": expected an 8-bit grey image");
+  }
+  std::string why;
+  if (!options.Check(&why)) throw InputError(source + ": " + why);
+  const int W = gray.cols, H = gray.rows;
+  if (options.edge_px && !(options.edge_px->x() >= -0.5 && options.edge_px->x() <= W - 0.5 &&
+                           options.edge_px->y() >= -0.5 && options.edge_px->y() <= H - 0.5)) {
+    throw InputError("--edge-px " + Fmt(options.edge_px->x(), 1) + "," +
+                     Fmt(options.edge_px->y(), 1) + " lies outside " + source + " (" +
+                     std::to_string(W) + "x" + std::to_string(H) + " px)");
+  }
+  rig.CheckForImage(W, H, source);
+
+  ExtractionSummary r;
+  r.source = source;
+  r.trace = options.trace == TraceLine::kUpper   ? "upper"
+            : options.trace == TraceLine::kLower ? "lower"
+                                                 : "mid";
+  const auto fail = [&](const std::string& message) {
+    r.success = false;
+    r.message = message;
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    return r;
+  };
+
+  // ---- 1. Find the strip on a reduced image.
+  const double scale = std::min(1.0, options.detect_side_px / double(std::max(W, H)));
+  cv::Mat small;
+  if (scale < 1.0) {
+    cv::resize(gray, small, cv::Size(), scale, scale, cv::INTER_AREA);
+  } else {
+    small = gray;
+  }
+  const auto full = [&](const Vec2& p) {
+    return Vec2((p.x() + 0.5) / scale - 0.5, (p.y() + 0.5) / scale - 0.5);
+  };
+  // Background flattening: hats with a kernel far wider than any strip but smaller than the
+  // light's gradients and broad shadows; a light and a dark strip show in one of the two.
+  const int kernel = std::max(15, static_cast<int>(std::max(small.cols, small.rows) / 10)) | 1;
+  const cv::Mat se = cv::getStructuringElement(cv::MORPH_RECT, {kernel, kernel});
+  cv::Mat light, dark;
+  cv::morphologyEx(small, light, cv::MORPH_TOPHAT, se);
+  cv::morphologyEx(small, dark, cv::MORPH_BLACKHAT, se);
+  std::vector<Strip> strips;
+  CollectStrips(light, +1, &strips);
+  CollectStrips(dark, -1, &strips);
+  if (strips.empty()) {
+    return fail("no strip found: nothing long and thin contrasts with the background");
+  }
+  std::sort(strips.begin(), strips.end(),
+            [](const Strip& a, const Strip& b) { return a.score > b.score; });
+  Strip strip = strips.front();
+  for (size_t k = 1; k < strips.size(); ++k) {
+    if (strips[k].polarity != strip.polarity && strips[k].score > 0.5 * strip.score) {
+      r.warnings.push_back("a " + std::string(strip.polarity > 0 ? "dark" : "light") +
+                           " band almost as prominent as the strip was ignored");
+      break;
+    }
+  }
+  r.polarity = strip.polarity > 0 ? "light" : "dark";
+  MergeContinuations(strip.polarity > 0 ? light : dark, &strip);
+
+  // A clamp of the strip's own shade that is thinner than the hat kernel merges with the strip:
+  // parts much thicker than the strip are split off and kept as a block.
+  std::vector<Block> own_blocks;
+  {
+    cv::Mat dt;
+    cv::distanceTransform(strip.mask, dt, cv::DIST_L2, 3);
+    // The band's width from its ridge (local maxima of the distance to its outside), where a
+    // long band outnumbers a compact block.
+    std::vector<double> ridge;
+    for (int y = 1; y + 1 < dt.rows; ++y) {
+      for (int x = 1; x + 1 < dt.cols; ++x) {
+        const float v = dt.at<float>(y, x);
+        if (v <= 0.0f) continue;
+        bool top = true;
+        for (int k = 0; k < 9 && top; ++k) top = dt.at<float>(y + k / 3 - 1, x + k % 3 - 1) <= v;
+        if (top) ridge.push_back(v);
+      }
+    }
+    const double w_est = ridge.empty() ? strip.thickness : std::max(2.0, 2.0 * Median(ridge) - 1.0);
+    const int blob_d = std::max(5, static_cast<int>(3.0 * w_est)) | 1;
+    cv::Mat blob;
+    cv::morphologyEx(strip.mask, blob, cv::MORPH_OPEN,
+                     cv::getStructuringElement(cv::MORPH_ELLIPSE, {blob_d, blob_d}));
+    cv::Mat labels, stats, centroids;
+    const int n = cv::connectedComponentsWithStats(blob, labels, stats, centroids, 8, CV_32S);
+    cv::Mat removed(strip.mask.size(), CV_8U, cv::Scalar(0));
+    for (int l = 1; l < n; ++l) {
+      const cv::Rect box(stats.at<int>(l, cv::CC_STAT_LEFT), stats.at<int>(l, cv::CC_STAT_TOP),
+                         stats.at<int>(l, cv::CC_STAT_WIDTH), stats.at<int>(l, cv::CC_STAT_HEIGHT));
+      // Only fixtures reaching in from outside the photo count (a frayed tip's brush does not).
+      if (box.x > 0 && box.y > 0 && box.br().x < small.cols && box.br().y < small.rows) continue;
+      Block b;
+      b.mask = labels == l;
+      b.sign = strip.polarity;
+      b.box = box;
+      removed |= b.mask;
+      own_blocks.push_back(std::move(b));
+    }
+    if (!own_blocks.empty()) {
+      cv::dilate(removed, removed, cv::getStructuringElement(cv::MORPH_ELLIPSE, {5, 5}));
+      cv::Mat rest = strip.mask & ~removed;
+      const int m = cv::connectedComponentsWithStats(rest, labels, stats, centroids, 8, CV_32S);
+      int best = 0;
+      for (int l = 1; l < m; ++l) {
+        if (best == 0 || stats.at<int>(l, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA))
+          best = l;
+      }
+      if (best > 0) strip.mask = labels == best;
+      strip.thickness = w_est;
+    }
+  }
+
+  // Loose fibres are thinner than the strip: an opening removes them from the detection mask
+  // (not from the measurement, which is made on the photo itself).
+  // Only a small opening: the strip itself may be much thinner near its root than on average.
+  const int open_d = 3;
+  if (strip.thickness >= 6.0) {
+    cv::Mat opened;
+    cv::morphologyEx(strip.mask, opened, cv::MORPH_OPEN,
+                     cv::getStructuringElement(cv::MORPH_ELLIPSE, {open_d, open_d}));
+    cv::Mat labels, stats, centroids;
+    const int n = cv::connectedComponentsWithStats(opened, labels, stats, centroids, 8, CV_32S);
+    int best = 0;
+    for (int l = 1; l < n; ++l) {
+      if (best == 0 || stats.at<int>(l, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA))
+        best = l;
+    }
+    if (best > 0) {
+      const cv::Mat cleaned = labels == best;
+      if (DoubleSweep(cleaned).length > 0.7 * strip.length) strip.mask = cleaned;
+    }
+  }
+  const Sweep sweep = DoubleSweep(strip.mask);
+  const double t_small = std::max(1.0, cv::countNonZero(strip.mask) / std::max(1.0, sweep.length));
+  cv::Mat strip_zone;
+  cv::dilate(strip.mask, strip_zone,
+             cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * static_cast<int>(t_small) + 3,
+                                                           2 * static_cast<int>(t_small) + 3}));
+  for (const Block& b : own_blocks) strip_zone |= b.mask;
+  std::vector<Block> blocks = extract_internal::FindBlocks(small, strip_zone, t_small);
+  for (Block& b : own_blocks) blocks.push_back(std::move(b));
+
+  // ---- 2. Which end is held? The held end leaves the left or right border, or a block;
+  // a free end that touches any border is a tip cut off by the image.
+  const double end_radius = std::max(2.0, 1.5 * t_small);
+  const int at_a = BordersNear(strip.mask, sweep.dist_a, sweep.box, end_radius);
+  const int at_b = BordersNear(strip.mask, sweep.dist_b, sweep.box, end_radius);
+  const int sides = border::kLeft | border::kRight;
+  // Distance from a reduced-image point to the nearest block pixel (searched within 40 px).
+  const auto near_block = [&](const cv::Point& p) {
+    double best = 1e300;
+    for (const Block& b : blocks) {
+      for (int y = std::max(0, p.y - 40); y < std::min(small.rows, p.y + 41); ++y) {
+        for (int x = std::max(0, p.x - 40); x < std::min(small.cols, p.x + 41); ++x) {
+          if (b.mask.at<uchar>(y, x)) best = std::min(best, std::hypot(x - p.x, y - p.y));
+        }
+      }
+    }
+    return best;
+  };
+  bool root_is_a;
+  std::string root_how;
+  if (options.edge_px) {
+    const Vec2 e = *options.edge_px;
+    root_is_a = (full(Vec2(sweep.a.x, sweep.a.y)) - e).norm() <=
+                (full(Vec2(sweep.b.x, sweep.b.y)) - e).norm();
+    root_how = "edge";
+  } else if ((at_a & sides) && !(at_b & sides)) {
+    root_is_a = true;
+    root_how = "border";
+  } else if ((at_b & sides) && !(at_a & sides)) {
+    root_is_a = false;
+    root_how = "border";
+  } else if ((at_a & sides) && (at_b & sides)) {
+    return fail("the free tip is cut off by the image border (the strip crosses the whole photo)");
+  } else if (at_a != border::kNoBorder || at_b != border::kNoBorder) {
+    root_is_a = at_a == border::kNoBorder;  // the end at the top/bottom border is the cut tip
+    root_how = "block";
+  } else {
+    const double da = near_block(sweep.a), db = near_block(sweep.b);
+    if (std::min(da, db) <= 3.0 * t_small + 5.0) {
+      root_is_a = da <= db;
+      root_how = "block";
+    } else {
+      // Nothing holds either end in view: the held end of a hanging strip is the higher one.
+      root_is_a = sweep.a.y <= sweep.b.y;
+      root_how = "guess";
+      r.warnings.push_back(
+          "no clamp, platform or border holds the strip; took its higher end as the held end");
+    }
+  }
+  const cv::Point root_end = root_is_a ? sweep.a : sweep.b;
+  const int root_borders = root_is_a ? at_a : at_b;
+  const int tip_borders = root_is_a ? at_b : at_a;
+  if (tip_borders != border::kNoBorder) {
+    return fail(std::string("the free tip is cut off by the image border (") +
+                BorderName(tip_borders) + ")");
+  }
+
+  // ---- 3. Coarse centre line from the held end, at full resolution.
+  std::vector<cv::Point> seeds;
+  if (root_how == "border" && (root_borders & sides)) {
+    const int x_border = (root_borders & border::kLeft) ? 0 : small.cols - 1;
+    const cv::Mat& dist_root = root_is_a ? sweep.dist_a : sweep.dist_b;
+    for (int y = 0; y < small.rows; ++y) {
+      if (strip.mask.at<uchar>(y, x_border) &&
+          dist_root.at<float>(y, x_border) <= end_radius + 2.0 * t_small) {
+        seeds.emplace_back(x_border, y);
+      }
+    }
+  }
+  if (seeds.empty()) seeds.push_back(root_end);
+  std::vector<double> widths_small;
+  std::vector<Vec2> coarse = LevelSetCentreline(strip.mask, seeds, &widths_small);
+  if (coarse.size() < 5) return fail("no strip found: the detected band is too short");
+  for (Vec2& p : coarse) p = full(p);
+  coarse = SmoothPolyline(coarse, std::max(2.0, 0.5 * t_small));
+  coarse = ResampleByArc(coarse, 1.0);
+  const double t_full = t_small / scale;
+  CutAtSharpTurn(&coarse, std::max(10.0, 2.0 * t_full), /*check_growth=*/false);
+
+  int direction;
+  if (root_how == "border" && (root_borders & sides)) {
+    direction = (root_borders & border::kLeft) ? +1 : -1;
+  } else {
+    direction = coarse.back().x() >= coarse.front().x() ? +1 : -1;
+  }
+  r.direction = direction > 0 ? "right" : "left";
+
+  // ---- 4. Platform or clamp?
+  PlatformFit platform;
+  std::string platform_why = "no block under the strip's held end";
+  if (options.rig != RigKind::kClamp) {
+    const size_t n_root = std::max<size_t>(5, coarse.size() * 3 / 10);
+    const std::vector<Vec2> root_path(coarse.begin(),
+                                      coarse.begin() + std::min(n_root, coarse.size()));
+    double best_d = 1e300;
+    int best_k = -1;
+    for (size_t k = 0; k < blocks.size(); ++k) {
+      cv::Mat outside;
+      cv::bitwise_not(blocks[k].mask, outside);
+      cv::Mat dist;
+      cv::distanceTransform(outside, dist, cv::DIST_L2, 3);
+      for (const Vec2& p : root_path) {
+        const int x = std::clamp(static_cast<int>(std::lround((p.x() + 0.5) * scale - 0.5)), 0,
+                                 small.cols - 1);
+        const int y = std::clamp(static_cast<int>(std::lround((p.y() + 0.5) * scale - 0.5)), 0,
+                                 small.rows - 1);
+        if (dist.at<float>(y, x) < best_d) {
+          best_d = dist.at<float>(y, x);
+          best_k = static_cast<int>(k);
+        }
+      }
+    }
+    if (best_k >= 0 && best_d <= 3.0 * t_small + 5.0) {
+      platform =
+          extract_internal::FitPlatform(gray, blocks[best_k], scale, direction, root_path, t_full);
+      if (!platform.found) platform_why = platform.why_not;
+    }
+    if (options.rig == RigKind::kPlatform && !platform.found) {
+      return fail("platform not found: " + platform_why);
+    }
+  }
+  for (const Block& b : blocks) {
+    std::vector<std::vector<cv::Point>> contours;
+    cv::findContours(b.mask.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+    for (auto& contour : contours) {
+      for (cv::Point& q : contour) {
+        const Vec2 f = full(Vec2(q.x, q.y));
+        q = cv::Point(static_cast<int>(std::lround(f.x())), static_cast<int>(std::lround(f.y())));
+      }
+      r.blocks_px.push_back(std::move(contour));
+    }
+  }
+
+  // ---- 5. Cross-sections at full resolution: a first pass on the coarse line, then passes on
+  // the measured mid-line (normals then cross the strip squarely), extended along the strip
+  // for as long as it continues (tracking past where the reduced image lost it).
+  // The reduced image may show only the strip's brightest part (a lit edge): the first window
+  // is wide enough for an oblique face several times wider.
+  const double half_1 = std::max({3.0 * t_full + 15.0, 0.06 * std::max(W, H), 20.0});
+  const double root_ext = root_how == "border" ? 3.0 * t_full + 10.0 : 2.0 * t_full + 10.0;
+  std::vector<Vec2> line =
+      Extend(coarse, root_ext, 2.0 * t_full + 20.0, std::max(10.0, 2.0 * t_full));
+  // The coarse line may run along a faint part of the silhouette: look for the core widely.
+  SectionSet set = AnalyseSections(gray, line, direction, strip.polarity, half_1, 0.6 * half_1);
+  RejectOutliers(&set);
+  for (int pass = 0; pass < 8; ++pass) {
+    double w_end;
+    const std::pair<int, int> run = TrimmedRun(set, TraceLine::kMid, &w_end);
+    std::vector<double> w;
+    for (const auto& s : set.s)
+      if (s.valid) w.push_back(s.width());
+    if (run.second - run.first < 10 || w.empty()) break;
+    // The guide must be smooth more than exact: it follows the strip's solid core (a silhouette
+    // whose faint part comes and goes, an oblique face, would make the mid-line jump), through
+    // a running median and a wide Gaussian; the next pass measures the boundaries again anyway.
+    std::vector<double> mid(run.second - run.first + 1);
+    std::vector<char> has(mid.size());
+    for (int i = run.first; i <= run.second; ++i) {
+      mid[i - run.first] = set.s[i].solid_mid;
+      has[i - run.first] = set.s[i].present;
+    }
+    mid = RunningQuantile(mid, has, std::max(10, static_cast<int>(set.width)));
+    for (double& v : mid)
+      if (std::isnan(v)) v = 0.0;
+    std::vector<Vec2> guide;
+    for (int i = run.first; i <= run.second; ++i)
+      guide.push_back(set.p[i] + mid[i - run.first] * set.n[i]);
+    guide = ResampleByArc(SmoothPolyline(guide, std::max(3.0, 0.5 * set.width)), 1.0);
+    // A lit end face or a brush of fibres can still bend the end of the guide away.
+    CutAtSharpTurn(&guide, std::max(20.0, set.width), /*check_growth=*/true);
+    std::sort(w.begin(), w.end());
+    const double w_max = w[static_cast<size_t>(0.95 * (w.size() - 1))];
+    const double half_2 = 0.5 * w_max + std::max(12.0, 0.75 * set.width);
+    const double ahead = std::max(60.0, 4.0 * set.width);
+    line = Extend(guide, root_ext, ahead, std::max(10.0, 2.0 * set.width));
+    set = AnalyseSections(gray, line, direction, strip.polarity, half_2, 0.5 * w_max + 3.0);
+    RejectOutliers(&set);
+    // Done unless the strip still shows at the far end of the extension.
+    double unused;
+    const std::pair<int, int> now = TrimmedRun(set, TraceLine::kMid, &unused);
+    if (pass > 0 && now.second < static_cast<int>(set.s.size()) - 1 - static_cast<int>(0.5 * ahead))
+      break;
+  }
+  double w_end = 0.0;
+  const std::pair<int, int> run = TrimmedRun(set, options.trace, &w_end);
+  if (run.second - run.first < 10) return fail("no strip found: its edges could not be measured");
+  r.contrast = set.contrast;
+  r.noise = set.noise;
+  r.width_px = set.width;
+  int first = run.first, last = run.second;
+
+  // ---- 6. The tip. Sections within ¾ of a width of the end straddle the end face, so the
+  // line is continued straight from the stretch before them, to where the contrast along the
+  // strip's middle falls to half (a frayed end was already trimmed to where sections collapse
+  // to fibre width).
+  const int cut = std::min(static_cast<int>(0.75 * w_end), (last - first) / 4);
+  const int end_i = last - cut;
+  // The traced offsets: a running median over half a core width removes what the outlier test
+  // let through (a fibre crossing a few sections), a Gaussian of half the profile's sample
+  // spacing (at least 2 px) the remaining noise before resampling.
+  std::vector<double> offsets = FilledOffsets(set, first, end_i, options.trace);
+  {
+    std::vector<double> cores;
+    for (int i = first; i <= end_i; ++i)
+      if (set.s[i].present) cores.push_back(set.s[i].solid);
+    const int reach = std::max(2, static_cast<int>(0.5 * Median(cores)));
+    offsets = RunningQuantile(offsets, std::vector<char>(offsets.size(), 1), reach);
+  }
+  const std::vector<double> mids = FilledOffsets(set, first, end_i, TraceLine::kMid);
+  std::vector<Vec2> trace;
+  for (int i = first; i <= end_i; ++i) trace.push_back(set.p[i] + offsets[i - first] * set.n[i]);
+  const double step_px = options.step_mm / rig.MmPerPxAt(trace.front());
+  trace = SmoothPolyline(trace, std::clamp(0.5 * step_px, 2.0, 10.0));
+  for (int i = first; i <= last; ++i) {
+    if (set.s[i].up_ok) r.upper_px.push_back(set.p[i] + set.s[i].n_up * set.n[i]);
+    if (set.s[i].lo_ok) r.lower_px.push_back(set.p[i] + set.s[i].n_lo * set.n[i]);
+  }
+  {
+    const int k = std::min<int>(static_cast<int>(trace.size()) - 1,
+                                std::max(10, static_cast<int>(2.0 * w_end)));
+    const Vec2 tangent = (trace.back() - trace[trace.size() - 1 - k]).normalized();
+    const Vec2 normal = direction * Vec2(tangent.y(), -tangent.x());
+    const Vec2 centre = set.p[end_i] + mids.back() * set.n[end_i];
+    TipStatus status;
+    std::vector<double> peaks;
+    for (int i = end_i; i >= first && peaks.size() < 20; --i)
+      if (set.s[i].valid) peaks.push_back(set.s[i].peak);
+    const double peak = peaks.empty() ? set.contrast : Median(peaks);
+    const double t_tip = FindTip(gray, centre, tangent, normal, w_end, set.s[end_i].bg, peak,
+                                 strip.polarity, &status);
+    if (status == TipStatus::kNoEnd) {
+      r.warnings.push_back(
+          "the tip's end is unclear (the strip's contrast does not fall off); took the last "
+          "measured section");
+    }
+    const Vec2 end = trace.back();
+    while (trace.size() > 2 && (trace.back() - end).dot(tangent) > t_tip) trace.pop_back();
+    const Vec2 tip = end + t_tip * tangent;
+    trace.push_back(tip);
+    r.tip_px = tip;
+    const double clearance =
+        std::min({tip.x() + 0.5, W - 0.5 - tip.x(), tip.y() + 0.5, H - 0.5 - tip.y()});
+    if (status == TipStatus::kLeftImage || clearance < 0.5 * w_end + 2.0) {
+      r.trace_px = trace;
+      return fail("the free tip is cut off by the image border (or lies within " +
+                  Fmt(0.5 * w_end + 2.0, 0) + " px of it)");
+    }
+  }
+
+  // ---- 7. Origin and horizontal.
+  double level = options.level_deg ? *options.level_deg * kDeg : 0.0;
+  if (platform.found) {
+    r.rig_type = "platform";
+    r.rig_detail = "edge at the platform's top/front corner";
+    if (!options.level_deg) level = platform.top_angle;
+    r.platform_px = {platform.top_far, platform.corner, platform.front_low};
+    r.origin_px = platform.corner;
+  } else {
+    r.rig_type = "clamp";
+    if (root_how == "border") {
+      r.rig_detail =
+          std::string("strip leaves the ") + (direction > 0 ? "left" : "right") + " image border";
+      // Extend the first stretch of the traced line to the border.
+      const int k = std::min<int>(static_cast<int>(trace.size()) - 1,
+                                  std::max(10, static_cast<int>(set.width)));
+      const Vec2 d = (trace[k] - trace[0]).normalized();
+      const double x_border = direction > 0 ? -0.5 : W - 0.5;
+      if (std::abs(d.x()) < 0.2)
+        return fail("the strip leaves the image border too steeply to find where");
+      const double gap = (x_border - trace[0].x()) / d.x();
+      if (-gap > std::max(3.0 * set.width, 20.0)) {
+        r.warnings.push_back("the strip's edges are measured only from " + Fmt(-gap, 0) +
+                             " px after the image border (extrapolated)");
+      }
+      r.origin_px = trace[0] + gap * d;
+    } else if (root_how == "block") {
+      r.rig_detail = "strip leaves a clamp inside the photo";
+      r.origin_px = trace.front();
+    } else {
+      r.rig_detail = "held end guessed";
+      r.origin_px = trace.front();
+    }
+  }
+  if (options.edge_px) {
+    r.origin_px = *options.edge_px;
+    r.rig_detail = "origin given by --edge-px; " + r.rig_detail;
+  }
+  r.level_deg = level / kDeg;
+
+  // ---- 8. Millimetres in the frame of cantilever.md.
+  const Vec2 x_img = direction * Vec2(std::cos(level), -std::sin(level));
+  const Vec2 up_img(-std::sin(level), -std::cos(level));
+  const Vec2 o = rig.PlaneFromImage(r.origin_px);
+  const Vec2 hx = (rig.PlaneFromImage(r.origin_px + 20.0 * x_img) - o).normalized();
+  Vec2 hy(-hx.y(), hx.x());
+  if (hy.dot(rig.PlaneFromImage(r.origin_px + 20.0 * up_img) - o) < 0.0) hy = -hy;
+  r.mm_per_px = rig.MmPerPxAt(r.origin_px);
+  std::vector<Vec2> mm;
+  for (const Vec2& p : trace) {
+    const Vec2 q = rig.PlaneFromImage(p) - o;
+    mm.emplace_back(q.dot(hx), q.dot(hy));
+  }
+  if (r.rig_type == "clamp" && root_how == "border" && !options.edge_px) {
+    mm.insert(mm.begin(), Vec2(0.0, 0.0));
+    trace.insert(trace.begin(), r.origin_px);
+  }
+  // The profile starts where the traced line crosses x = 0 (the vertical through the origin).
+  size_t start = 0;
+  Vec2 first_mm;
+  if (mm.front().x() >= 0.0) {
+    const Vec2 d = (mm[std::min<size_t>(5, mm.size() - 1)] - mm[0]).normalized();
+    first_mm = mm[0] - (mm[0].x() / std::max(d.x(), 1e-3)) * d;
+    if (mm[0].x() > std::max(3.0 * set.width * r.mm_per_px, 1.0)) {
+      r.warnings.push_back("the traced line starts " + Fmt(mm[0].x(), 2) +
+                           " mm beyond the edge; extrapolated to it");
+    }
+  } else {
+    while (start + 1 < mm.size() && mm[start + 1].x() < 0.0) ++start;
+    if (start + 1 >= mm.size()) return fail("the strip does not reach past the edge (x > 0)");
+    const double f = -mm[start].x() / (mm[start + 1].x() - mm[start].x());
+    first_mm = mm[start] + f * (mm[start + 1] - mm[start]);
+    ++start;
+  }
+  std::vector<Vec2> curve{first_mm};
+  curve.insert(curve.end(), mm.begin() + start, mm.end());
+  const std::vector<Vec2> resampled = ResampleByArc(curve, options.step_mm);
+  Profile& p = r.profile;
+  p.source = source;
+  double s = 0.0;
+  for (size_t k = 0; k < resampled.size(); ++k) {
+    if (k > 0) s += (resampled[k] - resampled[k - 1]).norm();
+    p.s.push_back(s * 1e-3);
+    p.x.push_back(resampled[k].x() * 1e-3);
+    p.y.push_back(resampled[k].y() * 1e-3);
+  }
+  r.length_mm = s;
+  r.tip_mm = resampled.back();
+  // The overlay shows the part that became the profile.
+  trace.erase(trace.begin(), trace.begin() + std::min(start, trace.size()));
+  r.trace_px = trace;
+
+  // Widening of the silhouette towards the tip: the sign of an oblique view.
+  {
+    std::vector<double> near_root, near_tip;
+    const int n = last - first + 1;
+    for (int i = first; i <= last; ++i) {
+      if (!set.s[i].valid) continue;
+      if (i - first < n / 5) near_root.push_back(set.s[i].width());
+      if (last - i < n / 5) near_tip.push_back(set.s[i].width());
+    }
+    if (!near_root.empty() && !near_tip.empty()) r.widening = Median(near_tip) / Median(near_root);
+  }
+  // An oblique view shows a face that is much fainter than the near edge: the silhouette is
+  // then much wider than its solid core, and often widens towards the tip.
+  {
+    std::vector<double> solid;
+    for (int i = first; i <= last; ++i)
+      if (set.s[i].present) solid.push_back(set.s[i].solid);
+    r.core_width_px = solid.empty() ? 0.0 : Median(solid);
+  }
+  const bool faint_face = r.width_px > 1.6 * r.core_width_px;
+  if (options.trace == TraceLine::kMid && (r.widening > 1.5 || faint_face)) {
+    r.warnings.push_back("the silhouette " +
+                         (r.widening > 1.5 ? "widens " + Fmt(r.widening, 1) + "x towards the tip"
+                                           : "is " + Fmt(r.width_px / r.core_width_px, 1) +
+                                                 "x wider than its solid core") +
+                         " (an oblique view?): its mid-line is biased; --trace upper or lower "
+                         "follows the near edge");
+  }
+  if (r.contrast < 10.0 * r.noise) {
+    r.warnings.push_back("low contrast: strip " + Fmt(r.contrast, 1) + " vs noise " +
+                         Fmt(r.noise, 1) + " grey levels");
+  }
+  const int span = last - first + 1;
+  for (int i = first; i <= last; ++i) r.rejected_sections += !set.s[i].Usable(options.trace);
+  if (r.rejected_sections > span / 5) {
+    r.warnings.push_back(std::to_string(r.rejected_sections) + " of " + std::to_string(span) +
+                         " cross-sections had no usable " + r.trace +
+                         " line (fibres, specks, faint edges)");
+  }
+
+  if (r.profile.size() < static_cast<size_t>(kMinProfilePoints)) {
+    return fail("the profile has only " + std::to_string(r.profile.size()) + " points (strip " +
+                Fmt(r.length_mm, 2) + " mm long at " + Fmt(options.step_mm, 2) + " mm steps)");
+  }
+  try {
+    CheckProfile(r.profile);
+  } catch (const InputError& e) {
+    std::string m = e.what();
+    const auto colon = m.find(": ");
+    return fail("the extracted profile is not a hanging strip: " +
+                (colon == std::string::npos ? m : m.substr(colon + 2)));
+  }
+  r.success = true;
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return r;
+}
+
+}  // namespace textile

@@ -1,0 +1,65 @@
+#ifndef TEXTILE_FIT_SRC_EXTRACT_INTERNAL_H_
+#define TEXTILE_FIT_SRC_EXTRACT_INTERNAL_H_
+
+// Pieces of the photo extractor shared by its source files (extract_*.cc); not public API.
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace textile::extract_internal {
+
+using Vec2 = Eigen::Vector2d;
+
+// Median of a non-empty sample (copied: the caller's order is kept).
+double Median(std::vector<double> v);
+
+// Gaussian smoothing of a sequence, with the window truncated symmetrically at the ends so that
+// straight runs stay straight up to the last point. sigma in samples; <= 0 returns the input.
+std::vector<Vec2> SmoothPolyline(const std::vector<Vec2>& p, double sigma);
+
+// Points every `step` along a polyline's arc length, from its first point to its last (which is
+// always included).
+std::vector<Vec2> ResampleByArc(const std::vector<Vec2>& p, double step);
+
+// Bilinear sample of an 8-bit grey image at (x, y) [px]; false outside the pixel centres' hull.
+bool SampleGray(const cv::Mat& gray, double x, double y, double* value);
+
+// Image borders, as bits.
+enum Border : int { kNoBorder = 0, kLeft = 1, kRight = 2, kTop = 4, kBottom = 8 };
+
+// A large region that differs from the background (clamp, platform, fixture), found on the
+// reduced image.
+struct Block {
+  cv::Mat mask;  // CV_8U, reduced-image size, 255 inside
+  int sign = 0;  // +1 lighter than the background, -1 darker
+  cv::Rect box;  // bounding box on the reduced image
+};
+
+// Blocks of the reduced grey image: a smooth (quadratic) background is fitted robustly, and
+// regions that differ from it by much more than the noise, are thicker than `min_thickness`
+// [px] and cover at least 1 % of the image are returned. `ignore` (CV_8U) marks pixels to leave
+// out of the background fit (the strip).
+std::vector<Block> FindBlocks(const cv::Mat& small, const cv::Mat& ignore, double min_thickness);
+
+// A platform found at full resolution: its top face and front face as lines, and their corner.
+struct PlatformFit {
+  bool found = false;
+  std::string why_not;   // when not found
+  Vec2 corner{0, 0};     // top/front corner [px]
+  Vec2 top_far{0, 0};    // far end of the measured top face [px]
+  Vec2 front_low{0, 0};  // low end of the measured front face [px]
+  double top_angle = 0;  // top face direction, counter-clockwise from the image rows [rad]
+};
+
+// Looks for a platform block under the root of the strip. `block` is on the reduced image
+// (scale = reduced px per full px); `direction` is +1 if the overhang points right, -1 left;
+// `root_path` is the strip's coarse centre line near the root [full px]; `thickness` is the
+// strip's silhouette width [full px].
+PlatformFit FitPlatform(const cv::Mat& gray, const Block& block, double scale, int direction,
+                        const std::vector<Vec2>& root_path, double thickness);
+
+}  // namespace textile::extract_internal
+
+#endif  // TEXTILE_FIT_SRC_EXTRACT_INTERNAL_H_

@@ -1,0 +1,287 @@
+// Blocks (clamps, platforms) on the reduced image, and the platform's top face, front face and
+// corner at full resolution.
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "extract_internal.h"
+
+namespace textile::extract_internal {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// Robust straight line v = a + b·u through (u, v) points: least squares, then points farther
+// than max(1 px, 3σ) are dropped and the line refitted, a few times. Returns the RMS of the
+// kept points; *kept counts them.
+double FitLineRobust(const std::vector<Vec2>& uv, double* a, double* b, int* kept) {
+  std::vector<char> use(uv.size(), 1);
+  double rms = 1e9;
+  for (int iter = 0; iter < 5; ++iter) {
+    Eigen::Matrix2d n = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d r = Eigen::Vector2d::Zero();
+    int count = 0;
+    for (size_t i = 0; i < uv.size(); ++i) {
+      if (!use[i]) continue;
+      const Eigen::Vector2d row(1.0, uv[i].x());
+      n += row * row.transpose();
+      r += row * uv[i].y();
+      ++count;
+    }
+    if (count < 2 || std::abs(n.determinant()) < 1e-9) return 1e9;
+    const Eigen::Vector2d ab = n.ldlt().solve(r);
+    *a = ab(0);
+    *b = ab(1);
+    std::vector<double> res;
+    for (size_t i = 0; i < uv.size(); ++i) res.push_back(std::abs(uv[i].y() - *a - *b * uv[i].x()));
+    std::vector<double> used;
+    for (size_t i = 0; i < uv.size(); ++i)
+      if (use[i]) used.push_back(res[i]);
+    const double sigma = 1.4826 * Median(used);
+    const double cut = std::max(1.0, 3.0 * sigma);
+    double s2 = 0.0;
+    *kept = 0;
+    for (size_t i = 0; i < uv.size(); ++i) {
+      use[i] = res[i] <= cut;
+      if (use[i]) {
+        s2 += res[i] * res[i];
+        ++*kept;
+      }
+    }
+    rms = *kept > 0 ? std::sqrt(s2 / *kept) : 1e9;
+  }
+  return rms;
+}
+
+// Position of the first clear intensity step along a line of samples, searching from the
+// start (inside the block) outwards: the first local maximum of |derivative| that reaches 30 %
+// of the largest one on the line, refined by a parabola. -1 if there is none. Units: samples.
+double FirstStep(const std::vector<double>& v) {
+  const int n = static_cast<int>(v.size());
+  if (n < 5) return -1.0;
+  std::vector<double> d(n, 0.0);
+  for (int i = 1; i + 1 < n; ++i) d[i] = std::abs(v[i + 1] - v[i - 1]) / 2.0;
+  const double top = *std::max_element(d.begin(), d.end());
+  if (top <= 0.0) return -1.0;
+  for (int i = 2; i + 2 < n; ++i) {
+    if (d[i] >= 0.3 * top && d[i] >= d[i - 1] && d[i] > d[i + 1]) {
+      const double den = d[i - 1] - 2.0 * d[i] + d[i + 1];
+      const double delta = den < 0.0 ? 0.5 * (d[i - 1] - d[i + 1]) / den : 0.0;
+      return i + std::clamp(delta, -0.5, 0.5);
+    }
+  }
+  return -1.0;
+}
+
+// Samples of the grey image from `from` towards `to`, every 0.5 px, smoothed with σ = 1 px.
+std::vector<double> LineSamples(const cv::Mat& gray, const Vec2& from, const Vec2& to) {
+  const double len = (to - from).norm();
+  const int n = static_cast<int>(len / 0.5) + 1;
+  std::vector<double> raw;
+  for (int i = 0; i < n; ++i) {
+    double v;
+    const Vec2 p = from + (to - from) * (i * 0.5 / std::max(len, 1e-9));
+    if (!SampleGray(gray, p.x(), p.y(), &v)) break;
+    raw.push_back(v);
+  }
+  std::vector<Vec2> as_points;
+  for (double v : raw) as_points.emplace_back(v, 0.0);
+  const auto smooth = SmoothPolyline(as_points, 2.0);
+  std::vector<double> out;
+  for (const auto& p : smooth) out.push_back(p.x());
+  return out;
+}
+
+}  // namespace
+
+std::vector<Block> FindBlocks(const cv::Mat& small, const cv::Mat& ignore, double min_thickness) {
+  const int w = small.cols, h = small.rows;
+  // Background model: quadratic in normalised coordinates, fitted on a grid of about 20k
+  // samples with outliers (the strip, blocks) trimmed at 2.5σ.
+  const int g = std::max(1, static_cast<int>(std::lround(std::sqrt(w * h / 20000.0))));
+  const auto terms = [&](double x, double y) {
+    const double u = (x - w / 2.0) / (w / 2.0), v = (y - h / 2.0) / (h / 2.0);
+    Eigen::Matrix<double, 6, 1> t;
+    t << 1.0, u, v, u * u, u * v, v * v;
+    return t;
+  };
+  std::vector<Eigen::Matrix<double, 6, 1>> rows;
+  std::vector<double> values;
+  for (int y = g / 2; y < h; y += g) {
+    for (int x = g / 2; x < w; x += g) {
+      if (ignore.at<uchar>(y, x)) continue;
+      rows.push_back(terms(x, y));
+      values.push_back(small.at<uchar>(y, x));
+    }
+  }
+  if (rows.size() < 50) return {};
+  Eigen::Matrix<double, 6, 1> coef = Eigen::Matrix<double, 6, 1>::Zero();
+  std::vector<char> inlier(rows.size(), 1);
+  double sigma = 0.5;
+  for (int iter = 0; iter < 8; ++iter) {
+    Eigen::Matrix<double, 6, 6> n = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> r = Eigen::Matrix<double, 6, 1>::Zero();
+    for (size_t i = 0; i < rows.size(); ++i) {
+      if (!inlier[i]) continue;
+      n += rows[i] * rows[i].transpose();
+      r += rows[i] * values[i];
+    }
+    coef = n.ldlt().solve(r);
+    std::vector<double> res(rows.size());
+    for (size_t i = 0; i < rows.size(); ++i) res[i] = values[i] - coef.dot(rows[i]);
+    std::vector<double> abs_in;
+    for (size_t i = 0; i < rows.size(); ++i)
+      if (inlier[i]) abs_in.push_back(std::abs(res[i]));
+    sigma = std::max(0.5, 1.4826 * Median(abs_in));
+    for (size_t i = 0; i < rows.size(); ++i) inlier[i] = std::abs(res[i]) <= 2.5 * sigma;
+  }
+  const double thr = std::max(5.0 * sigma, 3.0);
+  cv::Mat pos(small.size(), CV_8U, cv::Scalar(0)), neg(small.size(), CV_8U, cv::Scalar(0));
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (ignore.at<uchar>(y, x)) continue;
+      const double r = small.at<uchar>(y, x) - coef.dot(terms(x, y));
+      if (r > thr) pos.at<uchar>(y, x) = 255;
+      if (r < -thr) neg.at<uchar>(y, x) = 255;
+    }
+  }
+  const int d = std::max(3, 2 * static_cast<int>(std::ceil(min_thickness)) + 1);
+  const cv::Mat disk = cv::getStructuringElement(cv::MORPH_ELLIPSE, {d, d});
+  std::vector<Block> blocks;
+  for (int sign : {+1, -1}) {
+    cv::Mat m = sign > 0 ? pos : neg;
+    cv::morphologyEx(m, m, cv::MORPH_OPEN, disk);
+    cv::Mat labels, stats, centroids;
+    const int count = cv::connectedComponentsWithStats(m, labels, stats, centroids, 8, CV_32S);
+    for (int l = 1; l < count; ++l) {
+      if (stats.at<int>(l, cv::CC_STAT_AREA) < 0.01 * w * h) continue;
+      // Fixtures reach into the photo from outside; a region wholly inside it is part of the
+      // scene (an oblique face of the strip, a shadow), not a clamp or a platform.
+      const int x0 = stats.at<int>(l, cv::CC_STAT_LEFT), y0 = stats.at<int>(l, cv::CC_STAT_TOP);
+      if (x0 > 0 && y0 > 0 && x0 + stats.at<int>(l, cv::CC_STAT_WIDTH) < w &&
+          y0 + stats.at<int>(l, cv::CC_STAT_HEIGHT) < h) {
+        continue;
+      }
+      Block b;
+      b.mask = labels == l;
+      b.sign = sign;
+      b.box = cv::Rect(stats.at<int>(l, cv::CC_STAT_LEFT), stats.at<int>(l, cv::CC_STAT_TOP),
+                       stats.at<int>(l, cv::CC_STAT_WIDTH), stats.at<int>(l, cv::CC_STAT_HEIGHT));
+      blocks.push_back(std::move(b));
+    }
+  }
+  return blocks;
+}
+
+PlatformFit FitPlatform(const cv::Mat& gray, const Block& block, double scale, int direction,
+                        const std::vector<Vec2>& root_path, double thickness) {
+  PlatformFit fit;
+  const auto full = [&](double v) { return (v + 0.5) / scale - 0.5; };
+  const cv::Rect& box = block.box;
+  // On the reduced image: the block's highest row per column, its extreme column (towards the
+  // overhang) per row.
+  std::vector<int> top_of(block.mask.cols, -1), front_of(block.mask.rows, -1);
+  for (int y = box.y; y < box.y + box.height; ++y) {
+    const uchar* row = block.mask.ptr<uchar>(y);
+    for (int x = box.x; x < box.x + box.width; ++x) {
+      if (!row[x]) continue;
+      if (top_of[x] < 0) top_of[x] = y;
+      if (front_of[y] < 0 || (direction > 0 ? x > front_of[y] : x < front_of[y])) front_of[y] = x;
+    }
+  }
+  // Coarse corner: the front face from the block's lower half (below where the strip may hang
+  // along it), the top face just behind it.
+  std::vector<double> fronts;
+  for (int y = box.y + box.height / 2; y < box.y + box.height; ++y) {
+    if (front_of[y] >= 0) fronts.push_back(front_of[y]);
+  }
+  if (fronts.size() < 5) {
+    fit.why_not = "the block under the strip has no clear front face";
+    return fit;
+  }
+  const double margin = std::max(3.0 * thickness, 12.0);
+  const double reach_in = std::max(2.0 * thickness, 8.0),
+               reach_out = std::max(3.0 * thickness, 12.0);
+  const double front_x = full(Median(fronts));
+  const auto column = [&](double x_full) {
+    return std::clamp(static_cast<int>(std::lround((x_full + 0.5) * scale - 0.5)), box.x,
+                      box.x + box.width - 1);
+  };
+  const auto row_of = [&](double y_full) {
+    return std::clamp(static_cast<int>(std::lround((y_full + 0.5) * scale - 0.5)), box.y,
+                      box.y + box.height - 1);
+  };
+  const int behind = column(front_x - direction * margin);
+  if (top_of[behind] < 0) {
+    fit.why_not = "the block under the strip has no clear top face";
+    return fit;
+  }
+  const Vec2 corner0(front_x, full(top_of[behind]));
+
+  // Top face: vertical scans from inside the block upwards, spread over its far part.
+  const double x_far = direction > 0 ? full(box.x) + 3.0 : full(box.x + box.width - 1) - 3.0;
+  const double x_near = corner0.x() - direction * margin;
+  std::vector<Vec2> top_pts;  // (x, y)
+  if ((x_near - x_far) * direction > 10.0) {
+    for (int k = 0; k < 60; ++k) {
+      const double x = x_far + (x_near - x_far) * k / 59.0;
+      const int top = top_of[column(x)];
+      if (top < 0) continue;
+      const Vec2 from(x, full(top) + reach_in), to(x, full(top) - reach_out);
+      const double at = FirstStep(LineSamples(gray, from, to));
+      if (at >= 0) top_pts.emplace_back(x, from.y() - 0.5 * at);
+    }
+  }
+  // Front face: horizontal scans from inside the block outwards, below the corner.
+  const double y_low = std::min(full(box.y + box.height - 1), gray.rows - 1.0) - 3.0;
+  const double y_high = corner0.y() + margin;
+  std::vector<Vec2> front_pts;  // (y, x)
+  if (y_low - y_high > 10.0) {
+    for (int k = 0; k < 60; ++k) {
+      const double y = y_high + (y_low - y_high) * k / 59.0;
+      const int front = front_of[row_of(y)];
+      if (front < 0) continue;
+      const Vec2 from(full(front) - direction * reach_in, y),
+          to(full(front) + direction * reach_out, y);
+      const double at = FirstStep(LineSamples(gray, from, to));
+      if (at >= 0) front_pts.emplace_back(y, from.x() + direction * 0.5 * at);
+    }
+  }
+  if (top_pts.size() < 10 || front_pts.size() < 10) {
+    fit.why_not = "the block under the strip is too small to measure its top and front faces";
+    return fit;
+  }
+  double a, b, c, d;
+  int kept_top = 0, kept_front = 0;
+  const double rms_top = FitLineRobust(top_pts, &a, &b, &kept_top);
+  const double rms_front = FitLineRobust(front_pts, &c, &d, &kept_front);
+  // Corner: y = a + b x and x = c + d y.
+  const double x = (c + d * a) / (1.0 - d * b);
+  fit.corner = Vec2(x, a + b * x);
+  fit.top_angle = -std::atan(b);
+  const double xf = top_pts.front().x();
+  fit.top_far = Vec2(xf, a + b * xf);
+  const double yl = front_pts.back().x();
+  fit.front_low = Vec2(c + d * yl, yl);
+  double nearest = 1e300;
+  for (const Vec2& p : root_path) nearest = std::min(nearest, (p - fit.corner).norm());
+
+  if (std::abs(std::atan(b)) > 20 * kDeg) {
+    fit.why_not = "the block's top face is not horizontal (" +
+                  std::to_string(static_cast<int>(std::lround(std::atan(b) / kDeg))) + "°)";
+  } else if (std::abs(std::atan(d)) > 30 * kDeg) {
+    fit.why_not = "the block's front face is not vertical";
+  } else if (rms_top > 1.5 || rms_front > 1.5 || kept_top < 0.6 * top_pts.size() ||
+             kept_front < 0.6 * front_pts.size()) {
+    fit.why_not = "the block's faces are not straight";
+  } else if (nearest > std::max(2.0 * thickness, 10.0) + 3.0) {
+    fit.why_not = "the strip does not pass over the block's corner";
+  } else {
+    fit.found = true;
+  }
+  return fit;
+}
+
+}  // namespace textile::extract_internal

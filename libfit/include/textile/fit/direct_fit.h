@@ -42,7 +42,7 @@ struct DirectFitOptions {
   // much further than this from the curve (stray fibres, specks) lose their pull.
   double robust_scale = 0.5e-3;
   // Elastica samples per profile used to interpolate the model curve.
-  int curve_samples = 61;
+  int curve_samples = 41;
   // Elastica tolerance inside the fit; the final law is independent of it to ~1e-8.
   double elastica_tol = 1e-9;
   int max_iterations = 100;

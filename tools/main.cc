@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
              "Exit codes: 0 ok, 2 bad input or usage, 3 computation failed.");
   cli::RegisterLaw(app);
   cli::RegisterSynth(app);
+  cli::RegisterExtract(app);
   cli::RegisterFit(app);
   cli::RegisterBench(app);
   try {

@@ -1245,16 +1245,19 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   std::vector<Vec2> curve{first_mm};
   curve.insert(curve.end(), mm.begin() + start, mm.end());
   const std::vector<Vec2> resampled = ResampleByArc(curve, options.step_mm);
+  // Arc length along the traced line (not along the chords between samples): k·step, and the
+  // whole length at the tip.
+  double length = 0.0;
+  for (size_t k = 1; k < curve.size(); ++k) length += (curve[k] - curve[k - 1]).norm();
   Profile& p = r.profile;
   p.source = source;
-  double s = 0.0;
   for (size_t k = 0; k < resampled.size(); ++k) {
-    if (k > 0) s += (resampled[k] - resampled[k - 1]).norm();
+    const double s = k + 1 == resampled.size() ? length : k * options.step_mm;
     p.s.push_back(s * 1e-3);
     p.x.push_back(resampled[k].x() * 1e-3);
     p.y.push_back(resampled[k].y() * 1e-3);
   }
-  r.length_mm = s;
+  r.length_mm = length;
   r.tip_mm = resampled.back();
   // The overlay shows the part that became the profile.
   trace.erase(trace.begin(), trace.begin() + std::min(start, trace.size()));

@@ -34,6 +34,7 @@ void RegisterLaw(CLI::App& app);
 void RegisterFit(CLI::App& app);
 void RegisterBench(CLI::App& app);
 void RegisterSynth(CLI::App& app);
+void RegisterExtract(CLI::App& app);
 
 }  // namespace textile::cli
 

@@ -1,0 +1,285 @@
+// `textile extract` through the real executable: synthetic photos give profile CSVs that the
+// rest of the tool chain reads and overlays that OpenCV reads; every kind of bad input exits 2
+// and every detection failure exits 3, with one line on stderr, and neither leaves an output
+// behind or replaces a good one (cli.md).
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <set>
+#include <string>
+
+#include "../fit/synthetic_photo.h"
+#include "run_cli.h"
+#include "textile/fit/profile.h"
+
+namespace textile {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::CountLines;
+using testing::PhotoScene;
+using testing::ReadAll;
+using testing::Scratch;
+
+testing::CliResult Textile(const std::string& args) {
+  const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+  return testing::RunTextile(args, std::string(test->test_suite_name()) + "." + test->name());
+}
+
+std::string Quote(const fs::path& p) { return "'" + p.string() + "'"; }
+
+std::set<std::string> Listing(const fs::path& dir) {
+  std::set<std::string> names;
+  if (!fs::exists(dir)) return names;
+  for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
+  return names;
+}
+
+PhotoScene Strip() {
+  PhotoScene s;
+  s.width = 1000;
+  s.height = 700;
+  s.root_x = -0.5;
+  s.root_y = 200;
+  s.straight = 150;
+  s.radius = 700;
+  return s;
+}
+
+fs::path WritePhoto(const fs::path& dir, const std::string& name, const PhotoScene& scene) {
+  const fs::path p = dir / name;
+  cv::imwrite(p.string(), testing::Render(scene).gray);
+  return p;
+}
+
+void ExpectOneLineError(const testing::CliResult& r, int code, const std::string& words) {
+  EXPECT_EQ(r.exit_code, code) << r.err;
+  EXPECT_EQ(CountLines(r.err), 1) << r.err;
+  EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(words), std::string::npos) << r.err;
+}
+
+TEST(CliExtract, WritesProfileAndOverlayAndAJsonSummary) {
+  const fs::path dir = Scratch("cli_extract_ok");
+  const testing::SyntheticPhoto photo = testing::Render(Strip());
+  const fs::path png = dir / "strip_60mm.png";
+  cv::imwrite(png.string(), photo.gray);
+  const auto r =
+      Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir / "out") + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j.at("photos").size(), 1u);
+  const auto& p = j["photos"][0];
+  EXPECT_EQ(p.at("rig_type"), "clamp");
+  EXPECT_EQ(p.at("polarity"), "dark");
+  EXPECT_EQ(p.at("direction"), "right");
+  EXPECT_EQ(p.at("trace"), "mid");
+  EXPECT_NEAR(p.at("mm_per_px").get<double>(), 0.1, 1e-12);
+  // Length against the truth, to a pixel and a half.
+  EXPECT_NEAR(p.at("length_mm").get<double>(), photo.free_length * 0.1, 0.15);
+  EXPECT_TRUE(p.at("warnings").empty());
+  for (const char* key :
+       {"points", "tip_mm", "origin_px", "tip_px", "level_deg", "width_px", "seconds"}) {
+    EXPECT_TRUE(p.contains(key)) << key;
+  }
+  EXPECT_EQ(Listing(dir / "out"),
+            (std::set<std::string>{"strip_60mm.overlay.png", "strip_60mm.profile.csv"}));
+  const Profile profile = ReadProfileCsv((dir / "out" / "strip_60mm.profile.csv").string());
+  EXPECT_EQ(profile.size(), p.at("points").get<size_t>());
+  EXPECT_NEAR(profile.s.back() * 1e3, p.at("length_mm").get<double>(), 1e-5);
+  EXPECT_EQ(ReadAll(dir / "out" / "strip_60mm.profile.csv").rfind("s_mm,x_mm,y_mm\n", 0), 0u);
+  const cv::Mat overlay = cv::imread((dir / "out" / "strip_60mm.overlay.png").string());
+  EXPECT_EQ(overlay.cols, 1000);
+  EXPECT_EQ(overlay.type(), CV_8UC3);
+  // Text mode says the same in words.
+  const auto text = Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir / "out"));
+  EXPECT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("clamp rig"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("wrote"), std::string::npos) << text.out;
+}
+
+TEST(CliExtract, RigFilesGiveTheSameProfileAsThePlainScale) {
+  const fs::path dir = Scratch("cli_extract_rig");
+  const fs::path png = WritePhoto(dir, "strip.png", Strip());
+  std::ofstream(dir / "scale.json") << R"({"type": "scale", "mm_per_px": 0.1})";
+  std::ofstream(dir / "homography.json")
+      << R"({"type": "homography", "plane_from_image": [[0, -0.1, 50], [0.1, 0, -20], [0, 0, 1]]})";
+  ASSERT_EQ(Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir / "a")).exit_code,
+            0);
+  ASSERT_EQ(Textile("extract " + Quote(png) + " --rig " + Quote(dir / "scale.json") + " -o " +
+                    Quote(dir / "b"))
+                .exit_code,
+            0);
+  const auto r = Textile("extract " + Quote(png) + " --rig " + Quote(dir / "homography.json") +
+                         " -o " + Quote(dir / "c"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Profile a = ReadProfileCsv((dir / "a" / "strip.profile.csv").string());
+  for (const char* other : {"b", "c"}) {
+    const Profile b = ReadProfileCsv((dir / other / "strip.profile.csv").string());
+    ASSERT_EQ(a.size(), b.size()) << other;
+    for (size_t i = 0; i < a.size(); ++i) {
+      EXPECT_NEAR(a.x[i], b.x[i], 2e-9) << other << " " << i;  // CSV: 6 decimals of mm
+      EXPECT_NEAR(a.y[i], b.y[i], 2e-9) << other << " " << i;
+    }
+  }
+}
+
+TEST(CliExtract, OptionsReachTheExtractor) {
+  const fs::path dir = Scratch("cli_extract_options");
+  PhotoScene s = Strip();
+  s.mirror = true;
+  const fs::path png = WritePhoto(dir, "left.png", s);
+  const auto r = Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir) +
+                         " --trace upper --step-mm 1 --level-deg 0.5 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto p = nlohmann::json::parse(r.out)["photos"][0];
+  EXPECT_EQ(p.at("direction"), "left");
+  EXPECT_EQ(p.at("trace"), "upper");
+  EXPECT_DOUBLE_EQ(p.at("level_deg").get<double>(), 0.5);
+  const Profile profile = ReadProfileCsv((dir / "left.profile.csv").string());
+  EXPECT_NEAR((profile.s[1] - profile.s[0]) * 1e3, 1.0, 2e-6);  // CSV: 6 decimals of mm
+  // A manual edge: the profile starts where the line crosses the vertical through it.
+  const auto e = Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir) +
+                         " --edge-px 900,200 --json");
+  ASSERT_EQ(e.exit_code, 0) << e.err;
+  const auto q = nlohmann::json::parse(e.out)["photos"][0];
+  EXPECT_DOUBLE_EQ(q.at("origin_px")[0].get<double>(), 900.0);
+  EXPECT_NE(q.at("rig_detail").get<std::string>().find("--edge-px"), std::string::npos);
+}
+
+TEST(CliExtract, BadInputExitsTwoWithOneLineAndNoOutput) {
+  const fs::path dir = Scratch("cli_extract_bad");
+  const fs::path good = WritePhoto(dir, "good.png", Strip());
+  const std::string whole = ReadAll(good);
+  std::ofstream(dir / "empty.png");
+  std::ofstream(dir / "text.jpg") << "not an image at all\n";
+  std::ofstream(dir / "cut.png", std::ios::binary) << whole.substr(0, whole.size() / 3);
+  cv::imwrite((dir / "tiny.png").string(), cv::Mat(1, 1, CV_8U, cv::Scalar(3)));
+  {
+    std::string huge = ReadAll(good);  // IHDR claims 100000 x 100000
+    for (int k = 0; k < 2; ++k) {
+      for (int b = 0; b < 4; ++b)
+        huge[16 + 4 * k + b] = static_cast<char>((100000u >> (24 - 8 * b)) & 0xFF);
+    }
+    std::ofstream(dir / "huge.png", std::ios::binary) << huge;
+  }
+  std::ofstream(dir / "rig-not-json.json") << "{type: scale";
+  std::ofstream(dir / "rig-missing.json") << R"({"type": "scale"})";
+  std::ofstream(dir / "rig-nan.json") << R"({"type": "scale", "mm_per_px": NaN})";
+  std::ofstream(dir / "rig-negative.json") << R"({"type": "scale", "mm_per_px": -0.1})";
+  std::ofstream(dir / "rig-array.json") << "[0.1]";
+  const std::string out = " -o " + Quote(dir / "out");
+  const std::string scale = " --mm-per-px 0.1";
+  struct Case {
+    std::string args, words;
+  };
+  const std::vector<Case> cases = {
+      {Quote(dir / "missing.png") + scale, "missing.png: cannot open"},
+      {Quote(dir / "empty.png") + scale, "empty.png: empty file"},
+      {Quote(dir / "text.jpg") + scale, "text.jpg: not a supported image"},
+      {Quote(dir / "cut.png") + scale, "cut.png: truncated PNG"},
+      {Quote(dir / "tiny.png") + scale, "tiny.png: 1x1 px is too small"},
+      {Quote(dir / "huge.png") + scale, "huge.png: the header says 100000x100000 px"},
+      {Quote(good) + " --rig " + Quote(dir / "missing.json"), "missing.json: cannot open rig file"},
+      {Quote(good) + " --rig " + Quote(dir / "rig-not-json.json"),
+       "rig-not-json.json: not valid JSON"},
+      {Quote(good) + " --rig " + Quote(dir / "rig-missing.json"),
+       "rig-missing.json: mm_per_px: missing"},
+      {Quote(good) + " --rig " + Quote(dir / "rig-nan.json"), "rig-nan.json: not valid JSON"},
+      {Quote(good) + " --rig " + Quote(dir / "rig-negative.json"),
+       "rig-negative.json: mm_per_px: must be > 0"},
+      {Quote(good) + " --rig " + Quote(dir / "rig-array.json"),
+       "rig-array.json: expected a JSON object"},
+      {Quote(good), "give exactly one of --rig"},
+      {Quote(good) + scale + " --rig " + Quote(dir / "rig-missing.json"),
+       "give exactly one of --rig"},
+      {Quote(good) + " --mm-per-px 0", "--mm-per-px: the scale must be a number > 0"},
+      {Quote(good) + " --mm-per-px -2", "--mm-per-px: the scale must be a number > 0"},
+      {Quote(good) + " --mm-per-px nan", "--mm-per-px"},
+      {Quote(good) + scale + " --edge-px 12", "--edge-px: expected X,Y"},
+      {Quote(good) + scale + " --edge-px 12,abc", "--edge-px: 'abc' is not a number"},
+      {Quote(good) + scale + " --edge-px 5000,10", "--edge-px 5000.0,10.0 lies outside"},
+      {Quote(good) + scale + " --level-deg 60", "--level-deg"},
+      {Quote(good) + scale + " --step-mm 0", "--step-mm"},
+      {Quote(good) + scale + " --trace middle", "--trace"},
+      {Quote(good) + " " + Quote(dir / "sub" / "good.png") + scale, "same file name"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args);
+    ExpectOneLineError(Textile("extract " + c.args + out), 2, c.words);
+    EXPECT_TRUE(Listing(dir / "out").empty());
+  }
+}
+
+TEST(CliExtract, DetectionFailuresExitThreeAndKeepGoodOutputs) {
+  const fs::path dir = Scratch("cli_extract_fail");
+  PhotoScene blank = Strip();
+  blank.strip = blank.background;
+  PhotoScene cut = Strip();
+  cut.root_y = 500;
+  cut.radius = 500;
+  cut.bend_deg = 60;  // leaves the photo at the bottom
+  PhotoScene hook = Strip();
+  hook.radius = 200;
+  hook.bend_deg = 150;
+  struct Case {
+    std::string name;
+    PhotoScene scene;
+    std::string extra, words;
+  };
+  const std::vector<Case> cases = {
+      {"blank.png", blank, "", "no strip found"},
+      {"cut.png", cut, "", "the free tip is cut off by the image border"},
+      {"forced.png", Strip(), " --rig-type platform", "platform not found"},
+      {"hook.png", hook, "", "the extracted profile is not a hanging strip"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const fs::path png = WritePhoto(dir, c.name, c.scene);
+    ExpectOneLineError(
+        Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir / "out") + c.extra), 3,
+        c.name + ": " + c.words);
+  }
+  EXPECT_TRUE(Listing(dir / "out").empty());
+  // A good run, then a failing photo under the same name: the good outputs stay as they were.
+  const fs::path png = WritePhoto(dir, "strip.png", Strip());
+  ASSERT_EQ(
+      Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir / "out")).exit_code, 0);
+  const std::string csv = ReadAll(dir / "out" / "strip.profile.csv");
+  const std::string overlay = ReadAll(dir / "out" / "strip.overlay.png");
+  WritePhoto(dir, "strip.png", blank);
+  EXPECT_EQ(
+      Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir / "out")).exit_code, 3);
+  EXPECT_EQ(ReadAll(dir / "out" / "strip.profile.csv"), csv);
+  EXPECT_EQ(ReadAll(dir / "out" / "strip.overlay.png"), overlay);
+  EXPECT_EQ(Listing(dir / "out"),
+            (std::set<std::string>{"strip.overlay.png", "strip.profile.csv"}));
+}
+
+TEST(CliExtract, RealPhotos) {
+  const fs::path photos = fs::path(TEXTILE_SOURCE_DIR) / ".." / "shared" / "data" / "real-photos";
+  if (!fs::exists(photos / "broberg-example.jpg") || !fs::exists(photos / "broberg-break.jpg")) {
+    GTEST_SKIP() << photos << " is not available";
+  }
+  const fs::path dir = Scratch("cli_extract_real");
+  const auto r = Textile("extract " + Quote(photos / "broberg-example.jpg") + " " +
+                         Quote(photos / "broberg-break.jpg") +
+                         " --mm-per-px 0.1101 --trace upper -o " + Quote(dir) + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j.at("photos").size(), 2u);
+  for (const auto& p : j["photos"]) {
+    EXPECT_EQ(p.at("rig_type"), "clamp");
+    EXPECT_EQ(p.at("polarity"), "light");
+    EXPECT_GT(p.at("length_mm").get<double>(), 230.0);
+    EXPECT_LT(p.at("length_mm").get<double>(), 270.0);
+    EXPECT_NO_THROW(ReadProfileCsv(p.at("profile_csv").get<std::string>()));
+  }
+}
+
+}  // namespace
+}  // namespace textile

@@ -1,0 +1,177 @@
+// textile extract: cantilever photos -> profile CSVs (frame of cantilever.md) and overlays.
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "common/atomic_file.h"
+#include "common/cli.h"
+#include "textile/fit/extract.h"
+#include "textile/fit/profile.h"
+#include "textile/fit/rig.h"
+#include "textile/sim/error.h"
+
+namespace textile::cli {
+namespace {
+
+struct ExtractArgs {
+  std::vector<std::string> photos;
+  std::string rig_file, out_dir, edge, trace = "mid", rig_type = "auto";
+  double mm_per_px = 0.0, level_deg = 0.0, step_mm = 0.5;
+  int overlay_px = 2000;
+  bool level_given = false, json = false;
+};
+
+// "X,Y" in pixels.
+Eigen::Vector2d ParseEdge(const std::string& text) {
+  std::stringstream in(text);
+  std::string a, b, rest;
+  if (!std::getline(in, a, ',') || !std::getline(in, b, ',') || std::getline(in, rest)) {
+    throw InputError("--edge-px: expected X,Y in pixels, got '" + text + "'");
+  }
+  Eigen::Vector2d p;
+  for (int k = 0; k < 2; ++k) {
+    const std::string& s = k == 0 ? a : b;
+    char* end = nullptr;
+    p[k] = std::strtod(s.c_str(), &end);
+    if (s.empty() || *end != '\0' || !std::isfinite(p[k])) {
+      throw InputError("--edge-px: '" + s + "' is not a number (expected X,Y in pixels)");
+    }
+  }
+  return p;
+}
+
+nlohmann::json Point(const Eigen::Vector2d& p) { return {p.x(), p.y()}; }
+
+void Run(const ExtractArgs& a, bool rig_given, bool scale_given) {
+  if (rig_given == scale_given) {
+    throw InputError("give exactly one of --rig RIG.json and --mm-per-px S");
+  }
+  const Rig rig = rig_given ? ReadRigJson(a.rig_file) : Rig::FromScale(a.mm_per_px);
+  ExtractOptions o;
+  o.trace = a.trace == "upper"   ? TraceLine::kUpper
+            : a.trace == "lower" ? TraceLine::kLower
+                                 : TraceLine::kMid;
+  o.rig = a.rig_type == "platform" ? RigKind::kPlatform
+          : a.rig_type == "clamp"  ? RigKind::kClamp
+                                   : RigKind::kAuto;
+  if (!a.edge.empty()) o.edge_px = ParseEdge(a.edge);
+  if (a.level_given) o.level_deg = a.level_deg;
+  o.step_mm = a.step_mm;
+  std::string why;
+  if (!o.Check(&why)) {
+    const std::string flag = why.rfind("step", 0) == 0    ? "--step-mm"
+                             : why.rfind("level", 0) == 0 ? "--level-deg"
+                                                          : "--edge-px";
+    throw InputError(flag + ": " + why.substr(why.find(' ') + 1));
+  }
+  if (a.overlay_px < 200 || a.overlay_px > 20000)
+    throw InputError("--overlay-px must lie in [200, 20000]");
+  // Outputs are named after the photos: two photos with one stem would overwrite each other.
+  std::map<std::string, std::string> stems;
+  for (const auto& photo : a.photos) {
+    const std::string stem = std::filesystem::path(photo).stem().string();
+    if (stems.count(stem)) {
+      throw InputError(photo + ": same file name as " + stems[stem] + " (outputs would collide)");
+    }
+    stems[stem] = photo;
+  }
+  EnsureDirectory(a.out_dir);
+
+  nlohmann::json results = nlohmann::json::array();
+  for (const auto& photo : a.photos) {
+    const cv::Mat gray = ReadPhotoGray(photo);
+    if (a.photos.size() > 1 || gray.total() > 4e6) Info("extracting " + photo + " ...");
+    const ExtractionSummary r = ExtractProfile(gray, rig, o, photo);
+    if (!r.success) throw ComputeError(photo + ": " + r.message);
+    const std::string stem = std::filesystem::path(photo).stem().string();
+    const std::string csv = (std::filesystem::path(a.out_dir) / (stem + ".profile.csv")).string();
+    const std::string png = (std::filesystem::path(a.out_dir) / (stem + ".overlay.png")).string();
+    {
+      // Both files are complete before either is moved into place.
+      AtomicFile profile_file(csv), overlay_file(png);
+      std::ofstream(profile_file.temp_path(), std::ios::binary) << ProfileToCsv(r.profile);
+      if (!cv::imwrite(overlay_file.temp_path(), DrawExtractionOverlay(gray, r, a.overlay_px))) {
+        throw InputError(png + ": cannot write the overlay");
+      }
+      profile_file.Commit();
+      overlay_file.Commit();
+    }
+    results.push_back({{"photo", photo},
+                       {"profile_csv", csv},
+                       {"overlay_png", png},
+                       {"rig_type", r.rig_type},
+                       {"rig_detail", r.rig_detail},
+                       {"polarity", r.polarity},
+                       {"direction", r.direction},
+                       {"trace", r.trace},
+                       {"points", r.profile.size()},
+                       {"length_mm", r.length_mm},
+                       {"tip_mm", Point(r.tip_mm)},
+                       {"origin_px", Point(r.origin_px)},
+                       {"tip_px", Point(r.tip_px)},
+                       {"level_deg", r.level_deg},
+                       {"mm_per_px", r.mm_per_px},
+                       {"image_size_px", {gray.cols, gray.rows}},
+                       {"contrast", r.contrast},
+                       {"noise", r.noise},
+                       {"width_px", r.width_px},
+                       {"widening", r.widening},
+                       {"rejected_sections", r.rejected_sections},
+                       {"warnings", r.warnings},
+                       {"seconds", r.seconds}});
+    if (!a.json) {
+      std::cout << r.BriefReport() << "\n  wrote " << csv << " and " << png << "\n";
+    }
+  }
+  if (a.json) PrintJson({{"output_dir", a.out_dir}, {"rig", rig.source}, {"photos", results}});
+}
+
+}  // namespace
+
+void RegisterExtract(CLI::App& app) {
+  auto a = std::make_shared<ExtractArgs>();
+  CLI::App* sub = AddSubcommand(
+      app, "extract", "Extract cantilever profiles (s_mm,x_mm,y_mm) from photos",
+      "textile extract photos/strip_60mm.jpg --mm-per-px 0.1101 -o out/profiles --trace upper");
+  sub->add_option("photos", a->photos, "Photos (PNG, JPEG, TIFF, BMP) of cantilevered strips")
+      ->required();
+  sub->add_option("--rig", a->rig_file,
+                  "Rig file (from `textile calibrate`): pixels -> mm in the bending plane");
+  sub->add_option("--mm-per-px", a->mm_per_px,
+                  "Plain scale for a perpendicular, distortion-free camera [mm/px]");
+  sub->add_option("-o,--out", a->out_dir, "Folder for <stem>.profile.csv and <stem>.overlay.png")
+      ->required();
+  sub->add_option(
+      "--edge-px", a->edge,
+      "Origin override X,Y [px]: the platform edge, or where the strip leaves the clamp");
+  sub->add_option(
+      "--level-deg", a->level_deg,
+      "Horizontal = image rows turned by this angle [deg], counter-clockwise as seen (default: "
+      "the platform's top face, else the rows)");
+  sub->add_option("--trace", a->trace,
+                  "Line to trace: mid (silhouette mid-line, default), upper or lower boundary "
+                  "(oblique views: the lit near edge)")
+      ->check(CLI::IsMember({"mid", "upper", "lower"}));
+  sub->add_option("--rig-type", a->rig_type,
+                  "auto (default), platform (fail if none is found) or clamp")
+      ->check(CLI::IsMember({"auto", "platform", "clamp"}));
+  sub->add_option("--step-mm", a->step_mm,
+                  "Profile spacing along the arc length [mm] (default 0.5)");
+  sub->add_option("--overlay-px", a->overlay_px,
+                  "Long side of the overlay PNG [px] (default 2000)");
+  sub->add_flag("--json", a->json, "Print one JSON object instead of text");
+  CLI::Option* rig = sub->get_option("--rig");
+  CLI::Option* scale = sub->get_option("--mm-per-px");
+  CLI::Option* level = sub->get_option("--level-deg");
+  sub->callback([a, rig, scale, level] {
+    a->level_given = level->count() > 0;
+    Run(*a, rig->count() > 0, scale->count() > 0);
+  });
+}
+
+}  // namespace textile::cli

@@ -120,6 +120,7 @@ void Run(const ExtractArgs& a, bool rig_given, bool scale_given) {
                        {"contrast", r.contrast},
                        {"noise", r.noise},
                        {"width_px", r.width_px},
+                       {"core_width_px", r.core_width_px},
                        {"widening", r.widening},
                        {"rejected_sections", r.rejected_sections},
                        {"warnings", r.warnings},

@@ -26,7 +26,6 @@ using extract_internal::ResampleByArc;
 using extract_internal::SampleGray;
 using extract_internal::SmoothPolyline;
 using extract_internal::Vec2;
-namespace border = extract_internal;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kDeg = M_PI / 180.0;
@@ -41,6 +40,9 @@ constexpr double kAcrossStep = 0.5;
 // reduced image's diagonal long.
 constexpr double kMinElongation = 5.0;
 constexpr double kMinLengthFraction = 0.08;
+
+// Image borders, as bits.
+enum Border : int { kNoBorder = 0, kLeft = 1, kRight = 2, kTop = 4, kBottom = 8 };
 
 // ---------------------------------------------------------------- reduced-image detection
 
@@ -150,7 +152,7 @@ double HatThreshold(const cv::Mat& hat) {
 struct Strip {
   int polarity = 0;        // +1 lighter than the background, -1 darker
   cv::Mat mask;            // CV_8U, reduced-image size
-  double score = 0.0;      // contrast mass (sum of the hat over the component)
+  double score = 0.0;      // length x mean contrast
   double length = 0.0;     // geodesic length [reduced px]
   double thickness = 0.0;  // area / length [reduced px]
 };
@@ -181,7 +183,9 @@ void CollectStrips(const cv::Mat& hat, int polarity, std::vector<Strip>* out) {
     const Sweep sweep = DoubleSweep(s.mask);
     s.length = sweep.length;
     s.thickness = stats.at<int>(l, cv::CC_STAT_AREA) / std::max(1.0, s.length);
-    s.score = mass[l];
+    // Length times mean contrast: a long, clear band beats a broad faint area (a shadow's rim)
+    // of the same total contrast.
+    s.score = s.length * mass[l] / std::max(1, stats.at<int>(l, cv::CC_STAT_AREA));
     if (s.length >= min_length && s.length >= kMinElongation * s.thickness)
       out->push_back(std::move(s));
   }
@@ -209,9 +213,10 @@ Vec2 EndDirection(const cv::Mat& mask, const cv::Mat& dist, const cv::Rect& box,
 
 // Bridges gaps in the strip (a dim spot, a shadowed stretch): other pieces of the thresholded
 // hat that continue the band beyond one of its ends, within a cone of ±30° and a gap of at most
-// six thicknesses (or 5 % of the image diagonal), are joined to it, repeatedly.
-void MergeContinuations(const cv::Mat& hat, Strip* strip) {
-  cv::Mat binary = hat > HatThreshold(hat);
+// six thicknesses (or 5 % of the image diagonal), are joined to it, repeatedly. `threshold`
+// is the hat level that makes a pixel part of a piece.
+void MergeContinuations(const cv::Mat& hat, double threshold, Strip* strip) {
+  cv::Mat binary = hat > threshold;
   cv::Mat labels;
   cv::connectedComponents(binary, labels, 8, CV_32S);
   const double gap = std::max(6.0 * strip->thickness, 0.05 * std::hypot(hat.cols, hat.rows));
@@ -249,16 +254,102 @@ void MergeContinuations(const cv::Mat& hat, Strip* strip) {
   strip->length = DoubleSweep(strip->mask).length;
 }
 
+// The largest 8-connected component of a mask (empty if there is none).
+cv::Mat LargestComponent(const cv::Mat& mask) {
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  int best = 0;
+  for (int l = 1; l < n; ++l) {
+    if (best == 0 || stats.at<int>(l, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA)) {
+      best = l;
+    }
+  }
+  return best > 0 ? cv::Mat(labels == best) : cv::Mat();
+}
+
+// A clamp of the strip's own shade that is thinner than the hat kernel merges with the strip:
+// parts much thicker than the strip that reach in from the photo's border are split off and
+// returned as blocks; the strip keeps its largest remaining piece.
+std::vector<Block> SplitOffThickParts(Strip* strip) {
+  cv::Mat dt;
+  cv::distanceTransform(strip->mask, dt, cv::DIST_L2, 3);
+  // The band's width from its ridge (local maxima of the distance to its outside), where a long
+  // band outnumbers a compact block.
+  std::vector<double> ridge;
+  for (int y = 1; y + 1 < dt.rows; ++y) {
+    for (int x = 1; x + 1 < dt.cols; ++x) {
+      const float v = dt.at<float>(y, x);
+      if (v <= 0.0f) continue;
+      bool top = true;
+      for (int k = 0; k < 9 && top; ++k) top = dt.at<float>(y + k / 3 - 1, x + k % 3 - 1) <= v;
+      if (top) ridge.push_back(v);
+    }
+  }
+  const double width = ridge.empty() ? strip->thickness : std::max(2.0, 2.0 * Median(ridge) - 1.0);
+  const int d = std::max(5, static_cast<int>(3.0 * width)) | 1;
+  cv::Mat thick;
+  cv::morphologyEx(strip->mask, thick, cv::MORPH_OPEN,
+                   cv::getStructuringElement(cv::MORPH_ELLIPSE, {d, d}));
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(thick, labels, stats, centroids, 8, CV_32S);
+  std::vector<Block> blocks;
+  cv::Mat removed(strip->mask.size(), CV_8U, cv::Scalar(0));
+  for (int l = 1; l < n; ++l) {
+    const cv::Rect box(stats.at<int>(l, cv::CC_STAT_LEFT), stats.at<int>(l, cv::CC_STAT_TOP),
+                       stats.at<int>(l, cv::CC_STAT_WIDTH), stats.at<int>(l, cv::CC_STAT_HEIGHT));
+    // Only fixtures reaching in from outside the photo count (a frayed tip's brush does not).
+    if (box.x > 0 && box.y > 0 && box.br().x < thick.cols && box.br().y < thick.rows) continue;
+    Block b;
+    b.mask = labels == l;
+    b.sign = strip->polarity;
+    b.box = box;
+    removed |= b.mask;
+    blocks.push_back(std::move(b));
+  }
+  if (!blocks.empty()) {
+    cv::dilate(removed, removed, cv::getStructuringElement(cv::MORPH_ELLIPSE, {5, 5}));
+    const cv::Mat rest = LargestComponent(strip->mask & ~removed);
+    if (!rest.empty()) strip->mask = rest;
+    strip->thickness = width;
+  }
+  return blocks;
+}
+
+// Loose fibres are thinner than the strip: a small opening removes them from the detection
+// mask (not from the measurement, which is made on the photo itself). Only a small one: the
+// strip may be much thinner near its root than on average.
+void RemoveLooseFibres(Strip* strip) {
+  if (strip->thickness < 6.0) return;
+  cv::Mat opened;
+  cv::morphologyEx(strip->mask, opened, cv::MORPH_OPEN,
+                   cv::getStructuringElement(cv::MORPH_ELLIPSE, {3, 3}));
+  const cv::Mat cleaned = LargestComponent(opened);
+  if (!cleaned.empty() && DoubleSweep(cleaned).length > 0.7 * strip->length) strip->mask = cleaned;
+}
+
+// Distance from a reduced-image point to the nearest block pixel, searched within 40 px [px].
+double DistanceToBlocks(const std::vector<Block>& blocks, const cv::Point& p) {
+  double best = 1e300;
+  for (const Block& b : blocks) {
+    for (int y = std::max(0, p.y - 40); y < std::min(b.mask.rows, p.y + 41); ++y) {
+      for (int x = std::max(0, p.x - 40); x < std::min(b.mask.cols, p.x + 41); ++x) {
+        if (b.mask.at<uchar>(y, x)) best = std::min(best, std::hypot(x - p.x, y - p.y));
+      }
+    }
+  }
+  return best;
+}
+
 // Which image borders a set of mask pixels (those within `radius` of an end) touches.
 int BordersNear(const cv::Mat& mask, const cv::Mat& dist, const cv::Rect& box, double radius) {
-  int borders = border::kNoBorder;
+  int borders = kNoBorder;
   for (int y = box.y; y < box.y + box.height; ++y) {
     for (int x = box.x; x < box.x + box.width; ++x) {
       if (!mask.at<uchar>(y, x) || !(dist.at<float>(y, x) <= radius)) continue;
-      if (x == 0) borders |= border::kLeft;
-      if (x == mask.cols - 1) borders |= border::kRight;
-      if (y == 0) borders |= border::kTop;
-      if (y == mask.rows - 1) borders |= border::kBottom;
+      if (x == 0) borders |= kLeft;
+      if (x == mask.cols - 1) borders |= kRight;
+      if (y == 0) borders |= kTop;
+      if (y == mask.rows - 1) borders |= kBottom;
     }
   }
   return borders;
@@ -662,6 +753,62 @@ std::vector<Vec2> Extend(const std::vector<Vec2>& line, double at_start, double 
   return out;
 }
 
+// Cross-sections along the strip at full resolution: a first pass on the coarse line (width
+// about t_full px), then passes on the measured line (whose normals cross the strip squarely),
+// extended along the strip for as long as it continues, so that tracking goes on past where the
+// reduced image lost the strip. root_ext: how far to look back beyond the held end [px].
+SectionSet TrackStrip(const cv::Mat& gray, const std::vector<Vec2>& coarse, int direction,
+                      int polarity, double t_full, double root_ext) {
+  // The reduced image may show only the strip's brightest part (a lit edge): the first window is
+  // wide enough for an oblique face several times wider, and the core is looked for widely.
+  const double half_1 =
+      std::max({3.0 * t_full + 15.0, 0.06 * std::max(gray.cols, gray.rows), 20.0});
+  std::vector<Vec2> line =
+      Extend(coarse, root_ext, 2.0 * t_full + 20.0, std::max(10.0, 2.0 * t_full));
+  SectionSet set = AnalyseSections(gray, line, direction, polarity, half_1, 0.6 * half_1);
+  RejectOutliers(&set);
+  for (int pass = 0; pass < 8; ++pass) {
+    double w_end;
+    const std::pair<int, int> run = TrimmedRun(set, TraceLine::kMid, &w_end);
+    std::vector<double> w;
+    for (const auto& s : set.s) {
+      if (s.valid) w.push_back(s.width());
+    }
+    if (run.second - run.first < 10 || w.empty()) break;
+    // The guide must be smooth more than exact: it follows the strip's solid core (a silhouette
+    // whose faint part comes and goes, an oblique face, would make the mid-line jump), through a
+    // running median and a wide Gaussian; the next pass measures the boundaries again anyway.
+    std::vector<double> core(run.second - run.first + 1);
+    std::vector<char> has(core.size());
+    for (int i = run.first; i <= run.second; ++i) {
+      core[i - run.first] = set.s[i].solid_mid;
+      has[i - run.first] = set.s[i].present;
+    }
+    core = RunningQuantile(core, has, std::max(10, static_cast<int>(set.width)));
+    std::vector<Vec2> guide;
+    for (int i = run.first; i <= run.second; ++i) {
+      const double n = core[i - run.first];
+      guide.push_back(set.p[i] + (std::isnan(n) ? 0.0 : n) * set.n[i]);
+    }
+    guide = ResampleByArc(SmoothPolyline(guide, std::max(3.0, 0.5 * set.width)), 1.0);
+    // A lit end face or a brush of fibres can still bend the end of the guide away.
+    CutAtSharpTurn(&guide, std::max(20.0, set.width), /*check_growth=*/true);
+    std::sort(w.begin(), w.end());
+    const double w_max = w[static_cast<size_t>(0.95 * (w.size() - 1))];
+    const double half_2 = 0.5 * w_max + std::max(12.0, 0.75 * set.width);
+    const double ahead = std::max(60.0, 4.0 * set.width);
+    line = Extend(guide, root_ext, ahead, std::max(10.0, 2.0 * set.width));
+    set = AnalyseSections(gray, line, direction, polarity, half_2, 0.5 * w_max + 3.0);
+    RejectOutliers(&set);
+    // Done unless the strip still shows at the far end of the extension.
+    double unused;
+    const std::pair<int, int> now = TrimmedRun(set, TraceLine::kMid, &unused);
+    const int far_end = static_cast<int>(set.s.size()) - 1 - static_cast<int>(0.5 * ahead);
+    if (pass > 0 && now.second < far_end) break;
+  }
+  return set;
+}
+
 enum class TipStatus { kFound, kLeftImage, kNoEnd };
 
 // Axial position of the tip beyond a station [px along the tangent from `centre`; may be
@@ -728,10 +875,7 @@ std::string Fmt(double v, int precision = 3) {
 }
 
 const char* BorderName(int b) {
-  return b & border::kLeft    ? "left"
-         : b & border::kRight ? "right"
-         : b & border::kTop   ? "top"
-                              : "bottom";
+  return b & kLeft ? "left" : b & kRight ? "right" : b & kTop ? "top" : "bottom";
 }
 
 }  // namespace
@@ -835,80 +979,25 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
     }
   }
   r.polarity = strip.polarity > 0 ? "light" : "dark";
-  MergeContinuations(strip.polarity > 0 ? light : dark, &strip);
-
-  // A clamp of the strip's own shade that is thinner than the hat kernel merges with the strip:
-  // parts much thicker than the strip are split off and kept as a block.
-  std::vector<Block> own_blocks;
+  // Faint structures touching the strip (the slanted edge of a platform leaves a thin trace
+  // in the hats, a shadow's rim, a faint face) are cut off at half the strip's own contrast.
+  const cv::Mat& hat = strip.polarity > 0 ? light : dark;
+  double threshold = HatThreshold(hat);
   {
-    cv::Mat dt;
-    cv::distanceTransform(strip.mask, dt, cv::DIST_L2, 3);
-    // The band's width from its ridge (local maxima of the distance to its outside), where a
-    // long band outnumbers a compact block.
-    std::vector<double> ridge;
-    for (int y = 1; y + 1 < dt.rows; ++y) {
-      for (int x = 1; x + 1 < dt.cols; ++x) {
-        const float v = dt.at<float>(y, x);
-        if (v <= 0.0f) continue;
-        bool top = true;
-        for (int k = 0; k < 9 && top; ++k) top = dt.at<float>(y + k / 3 - 1, x + k % 3 - 1) <= v;
-        if (top) ridge.push_back(v);
+    std::vector<double> values;
+    for (int y = 0; y < hat.rows; ++y) {
+      for (int x = 0; x < hat.cols; ++x) {
+        if (strip.mask.at<uchar>(y, x)) values.push_back(hat.at<uchar>(y, x));
       }
     }
-    const double w_est = ridge.empty() ? strip.thickness : std::max(2.0, 2.0 * Median(ridge) - 1.0);
-    const int blob_d = std::max(5, static_cast<int>(3.0 * w_est)) | 1;
-    cv::Mat blob;
-    cv::morphologyEx(strip.mask, blob, cv::MORPH_OPEN,
-                     cv::getStructuringElement(cv::MORPH_ELLIPSE, {blob_d, blob_d}));
-    cv::Mat labels, stats, centroids;
-    const int n = cv::connectedComponentsWithStats(blob, labels, stats, centroids, 8, CV_32S);
-    cv::Mat removed(strip.mask.size(), CV_8U, cv::Scalar(0));
-    for (int l = 1; l < n; ++l) {
-      const cv::Rect box(stats.at<int>(l, cv::CC_STAT_LEFT), stats.at<int>(l, cv::CC_STAT_TOP),
-                         stats.at<int>(l, cv::CC_STAT_WIDTH), stats.at<int>(l, cv::CC_STAT_HEIGHT));
-      // Only fixtures reaching in from outside the photo count (a frayed tip's brush does not).
-      if (box.x > 0 && box.y > 0 && box.br().x < small.cols && box.br().y < small.rows) continue;
-      Block b;
-      b.mask = labels == l;
-      b.sign = strip.polarity;
-      b.box = box;
-      removed |= b.mask;
-      own_blocks.push_back(std::move(b));
-    }
-    if (!own_blocks.empty()) {
-      cv::dilate(removed, removed, cv::getStructuringElement(cv::MORPH_ELLIPSE, {5, 5}));
-      cv::Mat rest = strip.mask & ~removed;
-      const int m = cv::connectedComponentsWithStats(rest, labels, stats, centroids, 8, CV_32S);
-      int best = 0;
-      for (int l = 1; l < m; ++l) {
-        if (best == 0 || stats.at<int>(l, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA))
-          best = l;
-      }
-      if (best > 0) strip.mask = labels == best;
-      strip.thickness = w_est;
-    }
+    threshold = std::max(threshold, 0.5 * Median(values));
+    const cv::Mat core = LargestComponent(strip.mask & (hat > threshold));
+    if (!core.empty()) strip.mask = core;
   }
+  MergeContinuations(hat, threshold, &strip);
 
-  // Loose fibres are thinner than the strip: an opening removes them from the detection mask
-  // (not from the measurement, which is made on the photo itself).
-  // Only a small opening: the strip itself may be much thinner near its root than on average.
-  const int open_d = 3;
-  if (strip.thickness >= 6.0) {
-    cv::Mat opened;
-    cv::morphologyEx(strip.mask, opened, cv::MORPH_OPEN,
-                     cv::getStructuringElement(cv::MORPH_ELLIPSE, {open_d, open_d}));
-    cv::Mat labels, stats, centroids;
-    const int n = cv::connectedComponentsWithStats(opened, labels, stats, centroids, 8, CV_32S);
-    int best = 0;
-    for (int l = 1; l < n; ++l) {
-      if (best == 0 || stats.at<int>(l, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA))
-        best = l;
-    }
-    if (best > 0) {
-      const cv::Mat cleaned = labels == best;
-      if (DoubleSweep(cleaned).length > 0.7 * strip.length) strip.mask = cleaned;
-    }
-  }
+  std::vector<Block> own_blocks = SplitOffThickParts(&strip);
+  RemoveLooseFibres(&strip);
   const Sweep sweep = DoubleSweep(strip.mask);
   const double t_small = std::max(1.0, cv::countNonZero(strip.mask) / std::max(1.0, sweep.length));
   cv::Mat strip_zone;
@@ -924,19 +1013,7 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   const double end_radius = std::max(2.0, 1.5 * t_small);
   const int at_a = BordersNear(strip.mask, sweep.dist_a, sweep.box, end_radius);
   const int at_b = BordersNear(strip.mask, sweep.dist_b, sweep.box, end_radius);
-  const int sides = border::kLeft | border::kRight;
-  // Distance from a reduced-image point to the nearest block pixel (searched within 40 px).
-  const auto near_block = [&](const cv::Point& p) {
-    double best = 1e300;
-    for (const Block& b : blocks) {
-      for (int y = std::max(0, p.y - 40); y < std::min(small.rows, p.y + 41); ++y) {
-        for (int x = std::max(0, p.x - 40); x < std::min(small.cols, p.x + 41); ++x) {
-          if (b.mask.at<uchar>(y, x)) best = std::min(best, std::hypot(x - p.x, y - p.y));
-        }
-      }
-    }
-    return best;
-  };
+  const int sides = kLeft | kRight;
   bool root_is_a;
   std::string root_how;
   if (options.edge_px) {
@@ -952,11 +1029,11 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
     root_how = "border";
   } else if ((at_a & sides) && (at_b & sides)) {
     return fail("the free tip is cut off by the image border (the strip crosses the whole photo)");
-  } else if (at_a != border::kNoBorder || at_b != border::kNoBorder) {
-    root_is_a = at_a == border::kNoBorder;  // the end at the top/bottom border is the cut tip
+  } else if (at_a != kNoBorder || at_b != kNoBorder) {
+    root_is_a = at_a == kNoBorder;  // the end at the top/bottom border is the cut tip
     root_how = "block";
   } else {
-    const double da = near_block(sweep.a), db = near_block(sweep.b);
+    const double da = DistanceToBlocks(blocks, sweep.a), db = DistanceToBlocks(blocks, sweep.b);
     if (std::min(da, db) <= 3.0 * t_small + 5.0) {
       root_is_a = da <= db;
       root_how = "block";
@@ -971,7 +1048,7 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   const cv::Point root_end = root_is_a ? sweep.a : sweep.b;
   const int root_borders = root_is_a ? at_a : at_b;
   const int tip_borders = root_is_a ? at_b : at_a;
-  if (tip_borders != border::kNoBorder) {
+  if (tip_borders != kNoBorder) {
     return fail(std::string("the free tip is cut off by the image border (") +
                 BorderName(tip_borders) + ")");
   }
@@ -979,7 +1056,7 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   // ---- 3. Coarse centre line from the held end, at full resolution.
   std::vector<cv::Point> seeds;
   if (root_how == "border" && (root_borders & sides)) {
-    const int x_border = (root_borders & border::kLeft) ? 0 : small.cols - 1;
+    const int x_border = (root_borders & kLeft) ? 0 : small.cols - 1;
     const cv::Mat& dist_root = root_is_a ? sweep.dist_a : sweep.dist_b;
     for (int y = 0; y < small.rows; ++y) {
       if (strip.mask.at<uchar>(y, x_border) &&
@@ -1000,7 +1077,7 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
 
   int direction;
   if (root_how == "border" && (root_borders & sides)) {
-    direction = (root_borders & border::kLeft) ? +1 : -1;
+    direction = (root_borders & kLeft) ? +1 : -1;
   } else {
     direction = coarse.back().x() >= coarse.front().x() ? +1 : -1;
   }
@@ -1010,30 +1087,25 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   PlatformFit platform;
   std::string platform_why = "no block under the strip's held end";
   if (options.rig != RigKind::kClamp) {
-    const size_t n_root = std::max<size_t>(5, coarse.size() * 3 / 10);
-    const std::vector<Vec2> root_path(coarse.begin(),
-                                      coarse.begin() + std::min(n_root, coarse.size()));
+    // The platform is the block nearest to the held end of the line (a strip lying on a
+    // platform that contrasts with it starts on the platform, else at its corner).
+    const cv::Point held(
+        std::clamp(static_cast<int>(std::lround((coarse.front().x() + 0.5) * scale - 0.5)), 0,
+                   small.cols - 1),
+        std::clamp(static_cast<int>(std::lround((coarse.front().y() + 0.5) * scale - 0.5)), 0,
+                   small.rows - 1));
     double best_d = 1e300;
     int best_k = -1;
     for (size_t k = 0; k < blocks.size(); ++k) {
-      cv::Mat outside;
-      cv::bitwise_not(blocks[k].mask, outside);
-      cv::Mat dist;
-      cv::distanceTransform(outside, dist, cv::DIST_L2, 3);
-      for (const Vec2& p : root_path) {
-        const int x = std::clamp(static_cast<int>(std::lround((p.x() + 0.5) * scale - 0.5)), 0,
-                                 small.cols - 1);
-        const int y = std::clamp(static_cast<int>(std::lround((p.y() + 0.5) * scale - 0.5)), 0,
-                                 small.rows - 1);
-        if (dist.at<float>(y, x) < best_d) {
-          best_d = dist.at<float>(y, x);
-          best_k = static_cast<int>(k);
-        }
+      const double d = DistanceToBlocks({blocks[k]}, held);
+      if (d < best_d) {
+        best_d = d;
+        best_k = static_cast<int>(k);
       }
     }
     if (best_k >= 0 && best_d <= 3.0 * t_small + 5.0) {
       platform =
-          extract_internal::FitPlatform(gray, blocks[best_k], scale, direction, root_path, t_full);
+          extract_internal::FitPlatform(gray, blocks[best_k], scale, direction, coarse, t_full);
       if (!platform.found) platform_why = platform.why_not;
     }
     if (options.rig == RigKind::kPlatform && !platform.found) {
@@ -1052,56 +1124,9 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
     }
   }
 
-  // ---- 5. Cross-sections at full resolution: a first pass on the coarse line, then passes on
-  // the measured mid-line (normals then cross the strip squarely), extended along the strip
-  // for as long as it continues (tracking past where the reduced image lost it).
-  // The reduced image may show only the strip's brightest part (a lit edge): the first window
-  // is wide enough for an oblique face several times wider.
-  const double half_1 = std::max({3.0 * t_full + 15.0, 0.06 * std::max(W, H), 20.0});
+  // ---- 5. Cross-sections at full resolution, along the strip.
   const double root_ext = root_how == "border" ? 3.0 * t_full + 10.0 : 2.0 * t_full + 10.0;
-  std::vector<Vec2> line =
-      Extend(coarse, root_ext, 2.0 * t_full + 20.0, std::max(10.0, 2.0 * t_full));
-  // The coarse line may run along a faint part of the silhouette: look for the core widely.
-  SectionSet set = AnalyseSections(gray, line, direction, strip.polarity, half_1, 0.6 * half_1);
-  RejectOutliers(&set);
-  for (int pass = 0; pass < 8; ++pass) {
-    double w_end;
-    const std::pair<int, int> run = TrimmedRun(set, TraceLine::kMid, &w_end);
-    std::vector<double> w;
-    for (const auto& s : set.s)
-      if (s.valid) w.push_back(s.width());
-    if (run.second - run.first < 10 || w.empty()) break;
-    // The guide must be smooth more than exact: it follows the strip's solid core (a silhouette
-    // whose faint part comes and goes, an oblique face, would make the mid-line jump), through
-    // a running median and a wide Gaussian; the next pass measures the boundaries again anyway.
-    std::vector<double> mid(run.second - run.first + 1);
-    std::vector<char> has(mid.size());
-    for (int i = run.first; i <= run.second; ++i) {
-      mid[i - run.first] = set.s[i].solid_mid;
-      has[i - run.first] = set.s[i].present;
-    }
-    mid = RunningQuantile(mid, has, std::max(10, static_cast<int>(set.width)));
-    for (double& v : mid)
-      if (std::isnan(v)) v = 0.0;
-    std::vector<Vec2> guide;
-    for (int i = run.first; i <= run.second; ++i)
-      guide.push_back(set.p[i] + mid[i - run.first] * set.n[i]);
-    guide = ResampleByArc(SmoothPolyline(guide, std::max(3.0, 0.5 * set.width)), 1.0);
-    // A lit end face or a brush of fibres can still bend the end of the guide away.
-    CutAtSharpTurn(&guide, std::max(20.0, set.width), /*check_growth=*/true);
-    std::sort(w.begin(), w.end());
-    const double w_max = w[static_cast<size_t>(0.95 * (w.size() - 1))];
-    const double half_2 = 0.5 * w_max + std::max(12.0, 0.75 * set.width);
-    const double ahead = std::max(60.0, 4.0 * set.width);
-    line = Extend(guide, root_ext, ahead, std::max(10.0, 2.0 * set.width));
-    set = AnalyseSections(gray, line, direction, strip.polarity, half_2, 0.5 * w_max + 3.0);
-    RejectOutliers(&set);
-    // Done unless the strip still shows at the far end of the extension.
-    double unused;
-    const std::pair<int, int> now = TrimmedRun(set, TraceLine::kMid, &unused);
-    if (pass > 0 && now.second < static_cast<int>(set.s.size()) - 1 - static_cast<int>(0.5 * ahead))
-      break;
-  }
+  const SectionSet set = TrackStrip(gray, coarse, direction, strip.polarity, t_full, root_ext);
   double w_end = 0.0;
   const std::pair<int, int> run = TrimmedRun(set, options.trace, &w_end);
   if (run.second - run.first < 10) return fail("no strip found: its edges could not be measured");
@@ -1179,8 +1204,16 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   } else {
     r.rig_type = "clamp";
     if (root_how == "border") {
-      r.rig_detail =
-          std::string("strip leaves the ") + (direction > 0 ? "left" : "right") + " image border";
+      const char* side = direction > 0 ? "left" : "right";
+      r.rig_detail = std::string("strip leaves the ") + side + " image border";
+      // Say so when a block at that border is in view: most likely the clamp itself.
+      for (const Block& b : blocks) {
+        if (direction > 0 ? b.box.x == 0 : b.box.br().x == small.cols) {
+          r.rig_detail += std::string("; a ") + (b.sign < 0 ? "dark" : "light") +
+                          " block at that border (the clamp?)";
+          break;
+        }
+      }
       // Extend the first stretch of the traced line to the border.
       const int k = std::min<int>(static_cast<int>(trace.size()) - 1,
                                   std::max(10, static_cast<int>(set.width)));

@@ -26,9 +26,6 @@ std::vector<Vec2> ResampleByArc(const std::vector<Vec2>& p, double step);
 // Bilinear sample of an 8-bit grey image at (x, y) [px]; false outside the pixel centres' hull.
 bool SampleGray(const cv::Mat& gray, double x, double y, double* value);
 
-// Image borders, as bits.
-enum Border : int { kNoBorder = 0, kLeft = 1, kRight = 2, kTop = 4, kBottom = 8 };
-
 // A large region that differs from the background (clamp, platform, fixture), found on the
 // reduced image.
 struct Block {
@@ -55,10 +52,10 @@ struct PlatformFit {
 
 // Looks for a platform block under the root of the strip. `block` is on the reduced image
 // (scale = reduced px per full px); `direction` is +1 if the overhang points right, -1 left;
-// `root_path` is the strip's coarse centre line near the root [full px]; `thickness` is the
-// strip's silhouette width [full px].
+// `path` is the strip's coarse centre line [full px], which must pass near the corner; `thickness`
+// is the strip's silhouette width [full px].
 PlatformFit FitPlatform(const cv::Mat& gray, const Block& block, double scale, int direction,
-                        const std::vector<Vec2>& root_path, double thickness);
+                        const std::vector<Vec2>& path, double thickness);
 
 }  // namespace textile::extract_internal
 

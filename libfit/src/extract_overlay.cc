@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
@@ -93,14 +94,16 @@ cv::Mat DrawExtractionOverlay(const cv::Mat& gray, const ExtractionSummary& r, i
 
   // Caption.
   std::vector<std::string> lines;
-  lines.push_back(r.source + ": " +
+  const std::string name = std::filesystem::path(r.source).filename().string();
+  lines.push_back(name + ": " +
                   (r.success ? r.rig_type + " rig, " + r.rig_detail : "FAILED: " + r.message));
   if (r.success) {
     lines.push_back("strip " + r.polarity + ", overhang " + r.direction + ", trace " + r.trace +
                     ", L = " + Fixed1(r.length_mm, 1) + " mm, tip (" + Fixed1(r.tip_mm.x(), 1) +
                     ", " + Fixed1(r.tip_mm.y(), 1) + ") mm, " + Fixed1(r.mm_per_px, 4) + " mm/px");
     lines.push_back(
-        "green: traced line; amber/azure: upper/lower edge; red: origin, x; magenta: up, tip");
+        "green: traced line; amber/azure: upper/lower edge; red: origin, x; magenta: up, tip; " +
+        std::string(r.platform_px.empty() ? "" : "cyan: platform; ") + "orange: blocks");
   }
   for (const auto& w : r.warnings) lines.push_back("warning: " + w);
   const double font = std::max(0.4, side / 2200.0);

@@ -176,7 +176,7 @@ std::vector<Block> FindBlocks(const cv::Mat& small, const cv::Mat& ignore, doubl
 }
 
 PlatformFit FitPlatform(const cv::Mat& gray, const Block& block, double scale, int direction,
-                        const std::vector<Vec2>& root_path, double thickness) {
+                        const std::vector<Vec2>& path, double thickness) {
   PlatformFit fit;
   const auto full = [&](double v) { return (v + 0.5) / scale - 0.5; };
   const cv::Rect& box = block.box;
@@ -266,7 +266,7 @@ PlatformFit FitPlatform(const cv::Mat& gray, const Block& block, double scale, i
   const double yl = front_pts.back().x();
   fit.front_low = Vec2(c + d * yl, yl);
   double nearest = 1e300;
-  for (const Vec2& p : root_path) nearest = std::min(nearest, (p - fit.corner).norm());
+  for (const Vec2& p : path) nearest = std::min(nearest, (p - fit.corner).norm());
 
   if (std::abs(std::atan(b)) > 20 * kDeg) {
     fit.why_not = "the block's top face is not horizontal (" +

@@ -1,6 +1,7 @@
 // Reading photos safely: the dimensions come from the file header, checked before OpenCV
 // decodes anything (a forged 100k x 100k header would otherwise make it allocate tens of GB),
-// and truncated PNG/JPEG files are refused instead of decoded half-grey.
+// and truncated files are refused instead of decoded half-grey (PNG: no IEND; JPEG: no end of
+// image after the scan; BMP, TIFF: pixel data beyond the end of the file).
 
 #include <algorithm>
 #include <cstdint>
@@ -94,6 +95,18 @@ bool ParseTiff(const std::vector<uint8_t>& b, Header* h) {
   const size_t ifd = u32(4);
   if (ifd + 2 > b.size()) return false;
   const size_t n = u16(ifd);
+  // Tag values: inline when they fit in 4 bytes, else at an offset. Returns false if cut off.
+  const auto values = [&](size_t o, std::vector<uint64_t>* out) {
+    const uint32_t type = u16(o + 2), count = u32(o + 4);
+    const size_t size = type == 3 ? 2 : 4;
+    if (count > (1u << 24)) return false;
+    const size_t at = size * count <= 4 ? o + 8 : u32(o + 8);
+    if (at + size * count > b.size()) return false;
+    for (uint32_t k = 0; k < count; ++k)
+      out->push_back(size == 2 ? u16(at + 2 * k) : u32(at + 4 * k));
+    return true;
+  };
+  std::vector<uint64_t> offsets, counts;
   for (size_t e = 0; e < n; ++e) {
     const size_t o = ifd + 2 + 12 * e;
     if (o + 12 > b.size()) return false;
@@ -101,6 +114,13 @@ bool ParseTiff(const std::vector<uint8_t>& b, Header* h) {
     const uint32_t value = type == 3 ? u16(o + 8) : u32(o + 8);
     if (tag == 256) h->width = value;
     if (tag == 257) h->height = value;
+    // Strip or tile offsets and byte counts: all the image data must be in the file.
+    if ((tag == 273 || tag == 324) && !values(o, &offsets)) return false;
+    if ((tag == 279 || tag == 325) && !values(o, &counts)) return false;
+  }
+  h->complete = offsets.size() == counts.size();
+  for (size_t k = 0; h->complete && k < offsets.size(); ++k) {
+    h->complete = offsets[k] + counts[k] <= b.size();
   }
   return h->width > 0 && h->height > 0;
 }
@@ -111,6 +131,16 @@ bool ParseBmp(const std::vector<uint8_t>& b, Header* h) {
   h->width = static_cast<int32_t>(Le32(b.data() + 18));
   h->height = static_cast<int32_t>(Le32(b.data() + 22));
   if (h->height < 0) h->height = -h->height;  // top-down bitmap
+  // Uncompressed pixel rows (padded to 4 bytes) must all be in the file; otherwise the file
+  // must be as long as its header says.
+  if (b.size() >= 34 && Le32(b.data() + 30) == 0) {
+    const uint64_t bits = Le16(b.data() + 28);
+    const uint64_t row =
+        (bits * static_cast<uint64_t>(std::max<int64_t>(h->width, 0)) + 31) / 32 * 4;
+    h->complete = Le32(b.data() + 10) + row * static_cast<uint64_t>(h->height) <= b.size();
+  } else {
+    h->complete = Le32(b.data() + 2) <= b.size();
+  }
   return true;
 }
 
@@ -150,7 +180,8 @@ cv::Mat ReadPhotoGray(const std::string& path) {
                      std::to_string(static_cast<int>(kMaxPhotoPixels / 1e6)) +
                      " MP this tool accepts (damaged or forged header?)");
   }
-  if (!h.complete) throw InputError(path + ": truncated " + h.format + " file (no end of image)");
+  if (!h.complete)
+    throw InputError(path + ": truncated " + h.format + " file (image data missing)");
 
   cv::Mat gray;
   try {

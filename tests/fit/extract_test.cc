@@ -413,11 +413,15 @@ TEST_F(ReadPhoto, RefusesWhatIsNotAPhoto) {
 
 TEST_F(ReadPhoto, RefusesTruncatedFiles) {
   const cv::Mat img = testing::Render(BorderScene()).gray;
-  for (const char* name : {"t.png", "t.jpg"}) {
+  for (const char* name : {"t.png", "t.jpg", "t.bmp"}) {
     const std::string whole = Bytes(Encoded(name, img));
     ExpectRefused(Write(std::string("cut-") + name, whole.substr(0, whole.size() / 2)),
                   "truncated");
   }
+  // OpenCV writes a TIFF's directory after its pixels: cut in half, the header is gone.
+  const std::string tiff = Bytes(Encoded("t.tif", img));
+  ExpectRefused(Write("cut-t.tif", tiff.substr(0, tiff.size() / 2)), "damaged TIFF header");
+  ExpectRefused(Write("cut-t2.tif", tiff.substr(0, tiff.size() - 10)), "TIFF");
 }
 
 TEST_F(ReadPhoto, RefusesAbsurdHeadersBeforeDecoding) {

@@ -218,6 +218,22 @@ TEST(ExtractSynthetic, RolledCameraIsLevelledByThePlatformTop) {
   }
 }
 
+TEST(ExtractSynthetic, MirroredPlatformIsOnTheRightAndLevelsTheOtherWay) {
+  PhotoScene s;
+  s.holder = PhotoScene::Holder::kPlatform;
+  s.root_x = 500.0;
+  s.root_y = 300.0;
+  s.rotate_deg = 3.0;
+  s.mirror = true;  // a counter-clockwise roll, mirrored, is a clockwise one
+  const SyntheticPhoto photo = testing::Render(s);
+  const ExtractionSummary r = Extract(photo.gray);
+  ExpectAccurate(photo, r);
+  EXPECT_EQ(r.rig_type, "platform");
+  EXPECT_EQ(r.direction, "left");
+  EXPECT_NEAR(r.level_deg, -3.0, 0.05);
+  EXPECT_LT((r.origin_px - photo.origin).norm(), kOriginPx);
+}
+
 TEST(ExtractSynthetic, PlatformUnderUnevenLightWithARolledCameraAndFibres) {
   // Each trouble alone passes above; together they once made the platform's slanted front face
   // look like a strip in the hats, and the light's fall-off hide half of the block.

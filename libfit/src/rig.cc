@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "textile/sim/error.h"
+#include "textile/sim/json_text.h"
 
 namespace textile {
 namespace {
@@ -144,15 +145,7 @@ void Rig::CheckForImage(int width, int height, const std::string& photo) const {
 }
 
 Rig ParseRigJson(const std::string& text, const std::string& source) {
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::exception& e) {
-    std::string what = e.what();
-    const auto at = what.find("parse error");
-    throw InputError(source +
-                     ": not valid JSON: " + (at == std::string::npos ? what : what.substr(at)));
-  }
+  const json j = ParseJsonText(text, source);
   if (!j.is_object()) throw InputError(source + ": expected a JSON object (a rig file)");
   const Fields f(j, source);
   const json& type = f.Get("type");

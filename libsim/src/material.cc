@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "textile/sim/error.h"
+#include "textile/sim/json_text.h"
 #include "textile/sim/units.h"
 
 namespace textile {
@@ -104,15 +105,7 @@ class Reader {
 
 Material ParseMaterialJson(const std::string& text, const std::string& source) {
   Reader r(source);
-  json root;
-  try {
-    root = json::parse(text);
-  } catch (const json::exception& e) {  // parse_error, or out_of_range for 1e999
-    // nlohmann's message carries the line and column; keep it to one line.
-    std::string what = e.what();
-    if (auto p = what.find("]"); p != std::string::npos) what = what.substr(p + 2);
-    throw InputError(source + ": not valid JSON: " + what);
-  }
+  const json root = ParseJsonText(text, source);
   if (!root.is_object()) r.Fail("(top level)", "must be a JSON object");
   r.CheckKeys(root, "", {"name", "areal_density_gsm", "bending", "bending_weft", "beta", "stretch",
                          "friction", "fit", "notes", "assumptions", "source"});

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "textile/sim/error.h"
+#include "textile/sim/json_text.h"
 #include "textile/sim/units.h"
 
 namespace textile {
@@ -294,14 +295,7 @@ class SeamReader {
 
 SeamProfile ParseSeamJson(const std::string& text, const std::string& source) {
   SeamReader r(source);
-  json root;
-  try {
-    root = json::parse(text);
-  } catch (const json::exception& e) {  // parse_error, or out_of_range for 1e999
-    std::string what = e.what();
-    if (auto p = what.find("]"); p != std::string::npos) what = what.substr(p + 2);
-    throw InputError(source + ": not valid JSON: " + what);
-  }
+  const json root = ParseJsonText(text, source);
   if (!root.is_object()) r.Fail("(top level)", "must be a JSON object");
   r.CheckKeys(
       root, {"type", "name", "layers", "coefficients_mm", "range_mm", "covariance", "influence_mm",

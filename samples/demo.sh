@@ -26,8 +26,9 @@ echo
 echo "== 3. The fitted law against the truth it was made from (textile law)"
 for f in samples/materials/pabst-fig8.json "$out/pabst-fig8.fitted.json" "$out/pabst-fig8.clapp.json"; do
   printf '%-36s' "$f:"
-  "$textile" law --material "$f" --kappa 0.5 1 1.5 --json |
-    python3 -c 'import json,sys; j=json.load(sys.stdin); print("  ".join("M(%.1f/cm) = %.5f" % (p["kappa_per_cm"], p["M_gfcm_per_cm"]) for p in j["law"]["points"]), "gf·cm/cm")'
+  # The law's table: column 1 is κ [1/cm], column 3 is M [gf·cm/cm].
+  "$textile" law --material "$f" --kappa 0.5 1 1.5 |
+    awk '$1 ~ /^[0-9.]+$/ && NF >= 6 { printf "  M(%s/cm) = %.5f", $1, $3 } END { print "  gf·cm/cm" }'
 done
 echo
 echo "Pictures and outputs: $out"

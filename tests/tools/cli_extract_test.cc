@@ -25,10 +25,7 @@ using testing::PhotoScene;
 using testing::ReadAll;
 using testing::Scratch;
 
-testing::CliResult Textile(const std::string& args) {
-  const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-  return testing::RunTextile(args, std::string(test->test_suite_name()) + "." + test->name());
-}
+using testing::Textile;
 
 std::string Quote(const fs::path& p) { return "'" + p.string() + "'"; }
 

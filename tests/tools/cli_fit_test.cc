@@ -28,12 +28,7 @@ const std::string kFig8 = "samples/materials/pabst-fig8.json";
 const std::string kInterlining = "samples/materials/pabst-interlining.json";
 constexpr double kFig8Gsm = 200.0;  // areal density of pabst-fig8.json [g/m²]
 
-// Runs `textile args`, capturing into files named after the current test, so that tests run
-// in parallel by ctest do not share capture files.
-testing::CliResult Textile(const std::string& args) {
-  const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-  return testing::RunTextile(args, std::string(test->test_suite_name()) + "." + test->name());
-}
+using testing::Textile;
 
 std::string Quote(const fs::path& p) { return "'" + p.string() + "'"; }
 

@@ -56,6 +56,13 @@ inline int CountLines(const std::string& s) {
   return n;
 }
 
+// RunTextile with capture files named after the running test, so that tests run in parallel
+// by ctest never share them.
+inline CliResult Textile(const std::string& args) {
+  const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+  return RunTextile(args, std::string(test->test_suite_name()) + "." + test->name());
+}
+
 // Expects a refusal: exit 2, one line "error: ..." containing `fragment`, nothing on stdout.
 inline void ExpectRefused(const CliResult& r, const std::string& fragment, const std::string& what) {
   EXPECT_EQ(r.exit_code, 2) << what << "\n" << r.err;

@@ -379,7 +379,9 @@ TEST(ExtractFailures, BadInputThrows) {
 class ReadPhoto : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::path(TEXTILE_BINARY_DIR) / "test_scratch" / "read_photo";
+    // One folder per test: ctest runs the tests of this fixture in parallel processes.
+    dir_ = fs::path(TEXTILE_BINARY_DIR) / "test_scratch" /
+           ("read_photo_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }

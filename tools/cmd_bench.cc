@@ -72,4 +72,8 @@ void RegisterBench(CLI::App& app) {
   sub->callback([a] { Run(*a); });
 }
 
+namespace {
+const bool kRegistered = AddCommand(90, RegisterBench);
+}  // namespace
+
 }  // namespace textile::cli

@@ -175,4 +175,8 @@ void RegisterExtract(CLI::App& app) {
   });
 }
 
+namespace {
+const bool kRegistered = AddCommand(30, RegisterExtract);
+}  // namespace
+
 }  // namespace textile::cli

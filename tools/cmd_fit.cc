@@ -298,4 +298,8 @@ void RegisterFit(CLI::App& app) {
   });
 }
 
+namespace {
+const bool kRegistered = AddCommand(40, RegisterFit);
+}  // namespace
+
 }  // namespace textile::cli

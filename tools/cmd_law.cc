@@ -180,4 +180,8 @@ void RegisterLaw(CLI::App& app) {
   sub->callback([args] { Run(*args); });
 }
 
+namespace {
+const bool kRegistered = AddCommand(10, RegisterLaw);
+}  // namespace
+
 }  // namespace textile::cli

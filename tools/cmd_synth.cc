@@ -103,4 +103,8 @@ void RegisterSynth(CLI::App& app) {
   sub->callback([a] { Run(*a); });
 }
 
+namespace {
+const bool kRegistered = AddCommand(20, RegisterSynth);
+}  // namespace
+
 }  // namespace textile::cli

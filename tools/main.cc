@@ -29,11 +29,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.footer("\nRun 'textile SUBCOMMAND --help' for the flags and an example of each.\n"
              "Exit codes: 0 ok, 2 bad input or usage, 3 computation failed.");
-  cli::RegisterLaw(app);
-  cli::RegisterSynth(app);
-  cli::RegisterExtract(app);
-  cli::RegisterFit(app);
-  cli::RegisterBench(app);
+  cli::RegisterAllCommands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -31,7 +31,12 @@ struct Benchmark {
   std::function<Result(const Context&)> run;
 };
 
-// All benchmarks that exist, in the order of benchmarks.md.
+// Benchmarks register themselves, one file each (tools/bench/<name>.cc), with a namespace-scope
+//   const bool kRegistered = AddBenchmark(40, FitAccuracyBenchmark);
+// `order` follows benchmarks.md: bend-force 10, hinge-curve 15, stability 20, acpm-accuracy 30,
+// fit-accuracy 40, elastica 45, extract-accuracy 50, drape-convergence 60, stress 70.
+bool AddBenchmark(int order, Benchmark (*make)());
+// All registered benchmarks, in order.
 const std::vector<Benchmark>& Registry();
 
 // Writes rows as CSV (columns in order; strings quoted if needed) atomically.
@@ -42,11 +47,6 @@ nlohmann::json MachineInfo();
 double Median(std::vector<double> v);
 // Seconds of wall time for one call of f, as the median of `repeats` calls.
 double MedianSeconds(const std::function<void()>& f, int repeats);
-
-// Each benchmark file defines one of these.
-Benchmark ElasticaBenchmark();
-Benchmark FitAccuracyBenchmark();
-Benchmark BendForceBenchmark(); Benchmark HingeCurveBenchmark();
 
 }  // namespace textile::bench
 

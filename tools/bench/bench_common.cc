@@ -1,6 +1,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <utility>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -12,8 +13,27 @@
 
 namespace textile::bench {
 
+namespace {
+std::vector<std::pair<int, Benchmark (*)()>>& Makers() {
+  static std::vector<std::pair<int, Benchmark (*)()>> makers;
+  return makers;
+}
+}  // namespace
+
+bool AddBenchmark(int order, Benchmark (*make)()) {
+  Makers().emplace_back(order, make);
+  return true;
+}
+
 const std::vector<Benchmark>& Registry() {
-  static const std::vector<Benchmark> all = {FitAccuracyBenchmark(), ElasticaBenchmark(), BendForceBenchmark(), HingeCurveBenchmark()};
+  static const std::vector<Benchmark> all = [] {
+    auto makers = Makers();
+    std::stable_sort(makers.begin(), makers.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::vector<Benchmark> list;
+    for (const auto& entry : makers) list.push_back(entry.second());
+    return list;
+  }();
   return all;
 }
 

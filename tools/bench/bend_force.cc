@@ -41,6 +41,12 @@ Vertices HangingSheet(const TriangleMesh& flat, double length) {
 
 }  // namespace
 
+Benchmark BendForceBenchmark();
+
+namespace {
+const bool kRegistered = AddBenchmark(10, BendForceBenchmark);
+}  // namespace
+
 Benchmark BendForceBenchmark() {
   return {
       "bend-force",

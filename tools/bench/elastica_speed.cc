@@ -12,6 +12,12 @@
 
 namespace textile::bench {
 
+Benchmark ElasticaBenchmark();
+
+namespace {
+const bool kRegistered = AddBenchmark(45, ElasticaBenchmark);
+}  // namespace
+
 Benchmark ElasticaBenchmark() {
   return {"elastica", "One heavy-elastica solve: run time against accuracy (tolerance sweep)",
           [](const Context& ctx) {

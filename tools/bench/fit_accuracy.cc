@@ -63,6 +63,12 @@ struct Case {
 
 }  // namespace
 
+Benchmark FitAccuracyBenchmark();
+
+namespace {
+const bool kRegistered = AddBenchmark(40, FitAccuracyBenchmark);
+}  // namespace
+
 Benchmark FitAccuracyBenchmark() {
   return {"fit-accuracy",
           "Synthetic profiles, noise 0-0.5 mm, 1-5 overhangs: Clapp vs direct fit, error vs run time",

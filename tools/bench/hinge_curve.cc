@@ -14,6 +14,12 @@
 
 namespace textile::bench {
 
+Benchmark HingeCurveBenchmark();
+
+namespace {
+const bool kRegistered = AddBenchmark(15, HingeCurveBenchmark);
+}  // namespace
+
 Benchmark HingeCurveBenchmark() {
   return {
       "hinge-curve",

@@ -1,9 +1,12 @@
 #include "common/cli.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 namespace textile::cli {
 
@@ -25,5 +28,24 @@ std::string Num(double v, int digits) {
 }
 
 void Info(const std::string& line) { std::cerr << line << std::endl; }
+
+namespace {
+std::vector<std::pair<int, CommandRegistrar>>& Commands() {
+  static std::vector<std::pair<int, CommandRegistrar>> commands;
+  return commands;
+}
+}  // namespace
+
+bool AddCommand(int order, CommandRegistrar registrar) {
+  Commands().emplace_back(order, registrar);
+  return true;
+}
+
+void RegisterAllCommands(CLI::App& app) {
+  auto commands = Commands();
+  std::stable_sort(commands.begin(), commands.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [order, registrar] : commands) registrar(app);
+}
 
 }  // namespace textile::cli

@@ -29,12 +29,14 @@ std::string Num(double v, int digits = 6);
 // Progress/info line on stderr (never on stdout, which may carry JSON).
 void Info(const std::string& line);
 
-// Each subcommand registers itself here (one file each: tools/cmd_<name>.cc).
-void RegisterLaw(CLI::App& app);
-void RegisterFit(CLI::App& app);
-void RegisterBench(CLI::App& app);
-void RegisterSynth(CLI::App& app);
-void RegisterExtract(CLI::App& app);
+// Subcommands register themselves, one file each (tools/cmd_<name>.cc), with a namespace-scope
+//   const bool kRegistered = AddCommand(40, RegisterFit);
+// `order` sorts them in --help (the pipeline order: law 10, synth-profile 20, calibrate 25,
+// extract 30, render-photo 35, fit 40, fit-seam 45, acpm 50, drape 60, validate 70, bench 90).
+using CommandRegistrar = void (*)(CLI::App& app);
+bool AddCommand(int order, CommandRegistrar registrar);
+// Adds every registered subcommand to app, in order.
+void RegisterAllCommands(CLI::App& app);
 
 }  // namespace textile::cli
 

@@ -10,6 +10,7 @@
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
+#include "common/profile_inputs.h"
 #include "textile/fit/extract.h"
 #include "textile/fit/profile.h"
 #include "textile/fit/rig.h"
@@ -20,55 +21,18 @@ namespace {
 
 struct ExtractArgs {
   std::vector<std::string> photos;
-  std::string rig_file, out_dir, edge, trace = "mid", rig_type = "auto";
-  double mm_per_px = 0.0, level_deg = 0.0, step_mm = 0.5;
+  std::string out_dir;
+  PhotoFlags photo;
   int overlay_px = 2000;
-  bool level_given = false, json = false;
+  bool json = false;
 };
-
-// "X,Y" in pixels.
-Eigen::Vector2d ParseEdge(const std::string& text) {
-  std::stringstream in(text);
-  std::string a, b, rest;
-  if (!std::getline(in, a, ',') || !std::getline(in, b, ',') || std::getline(in, rest)) {
-    throw InputError("--edge-px: expected X,Y in pixels, got '" + text + "'");
-  }
-  Eigen::Vector2d p;
-  for (int k = 0; k < 2; ++k) {
-    const std::string& s = k == 0 ? a : b;
-    char* end = nullptr;
-    p[k] = std::strtod(s.c_str(), &end);
-    if (s.empty() || *end != '\0' || !std::isfinite(p[k])) {
-      throw InputError("--edge-px: '" + s + "' is not a number (expected X,Y in pixels)");
-    }
-  }
-  return p;
-}
 
 nlohmann::json Point(const Eigen::Vector2d& p) { return {p.x(), p.y()}; }
 
-void Run(const ExtractArgs& a, bool rig_given, bool scale_given) {
-  if (rig_given == scale_given) {
-    throw InputError("give exactly one of --rig RIG.json and --mm-per-px S");
-  }
-  const Rig rig = rig_given ? ReadRigJson(a.rig_file) : Rig::FromScale(a.mm_per_px);
-  ExtractOptions o;
-  o.trace = a.trace == "upper"   ? TraceLine::kUpper
-            : a.trace == "lower" ? TraceLine::kLower
-                                 : TraceLine::kMid;
-  o.rig = a.rig_type == "platform" ? RigKind::kPlatform
-          : a.rig_type == "clamp"  ? RigKind::kClamp
-                                   : RigKind::kAuto;
-  if (!a.edge.empty()) o.edge_px = ParseEdge(a.edge);
-  if (a.level_given) o.level_deg = a.level_deg;
-  o.step_mm = a.step_mm;
-  std::string why;
-  if (!o.Check(&why)) {
-    const std::string flag = why.rfind("step", 0) == 0    ? "--step-mm"
-                             : why.rfind("level", 0) == 0 ? "--level-deg"
-                                                          : "--edge-px";
-    throw InputError(flag + ": " + why.substr(why.find(' ') + 1));
-  }
+void Run(const ExtractArgs& a) {
+  const PhotoInputOptions options = a.photo.Options();
+  const Rig rig = RigFromOptions(options, "extract");
+  const ExtractOptions& o = options.extract;
   if (a.overlay_px < 200 || a.overlay_px > 20000)
     throw InputError("--overlay-px must lie in [200, 20000]");
   // Outputs are named after the photos: two photos with one stem would overwrite each other.
@@ -141,38 +105,13 @@ void RegisterExtract(CLI::App& app) {
       "textile extract photos/strip_60mm.jpg --mm-per-px 0.1101 -o out/profiles --trace upper");
   sub->add_option("photos", a->photos, "Photos (PNG, JPEG, TIFF, BMP) of cantilevered strips")
       ->required();
-  sub->add_option("--rig", a->rig_file,
-                  "Rig file (from `textile calibrate`): pixels -> mm in the bending plane");
-  sub->add_option("--mm-per-px", a->mm_per_px,
-                  "Plain scale for a perpendicular, distortion-free camera [mm/px]");
   sub->add_option("-o,--out", a->out_dir, "Folder for <stem>.profile.csv and <stem>.overlay.png")
       ->required();
-  sub->add_option(
-      "--edge-px", a->edge,
-      "Origin override X,Y [px]: the platform edge, or where the strip leaves the clamp");
-  sub->add_option(
-      "--level-deg", a->level_deg,
-      "Horizontal = image rows turned by this angle [deg], counter-clockwise as seen (default: "
-      "the platform's top face, else the rows)");
-  sub->add_option("--trace", a->trace,
-                  "Line to trace: mid (silhouette mid-line, default), upper or lower boundary "
-                  "(oblique views: the lit near edge)")
-      ->check(CLI::IsMember({"mid", "upper", "lower"}));
-  sub->add_option("--rig-type", a->rig_type,
-                  "auto (default), platform (fail if none is found) or clamp")
-      ->check(CLI::IsMember({"auto", "platform", "clamp"}));
-  sub->add_option("--step-mm", a->step_mm,
-                  "Profile spacing along the arc length [mm] (default 0.5)");
+  AddPhotoFlags(sub, &a->photo);
   sub->add_option("--overlay-px", a->overlay_px,
                   "Long side of the overlay PNG [px] (default 2000)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
-  CLI::Option* rig = sub->get_option("--rig");
-  CLI::Option* scale = sub->get_option("--mm-per-px");
-  CLI::Option* level = sub->get_option("--level-deg");
-  sub->callback([a, rig, scale, level] {
-    a->level_given = level->count() > 0;
-    Run(*a, rig->count() > 0, scale->count() > 0);
-  });
+  sub->callback([a] { Run(*a); });
 }
 
 namespace {

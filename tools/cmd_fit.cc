@@ -9,6 +9,7 @@
 #include "common/atomic_file.h"
 #include "common/chart.h"
 #include "common/cli.h"
+#include "common/profile_inputs.h"
 #include "textile/fit/clapp.h"
 #include "textile/fit/direct_fit.h"
 #include "textile/fit/profile.h"
@@ -30,6 +31,7 @@ struct FitArgs {
   bool thickness_given = false;  // else the offset is fitted
   bool no_offset = false, fit_rotation = false, json = false;
   double robust_mm = 0.5;
+  PhotoFlags photo;  // photos among the inputs are extracted first
 };
 
 // JSON null for a value that is not available (an undetermined constant's σ).
@@ -211,8 +213,25 @@ void Run(const FitArgs& a) {
   if (a.thickness_given && a.no_offset)
     throw InputError("--thickness-mm and --no-offset contradict each other (offset t/2 vs 0)");
   const double rho = units::GsmToSi(a.gsm);
+  const std::vector<LoadedProfile> loaded = LoadProfileInputs(a.inputs, a.photo.Options());
   std::vector<Profile> profiles;
-  for (const auto& path : a.inputs) profiles.push_back(ReadProfileCsv(path));
+  nlohmann::json photos = nlohmann::json::array();
+  for (const auto& in : loaded) {
+    profiles.push_back(in.profile);
+    if (!in.extraction) continue;
+    const ExtractionSummary& r = *in.extraction;
+    photos.push_back({{"photo", in.source}, {"rig_type", r.rig_type}, {"polarity", r.polarity},
+                      {"direction", r.direction}, {"trace", r.trace},
+                      {"points", r.profile.size()}, {"length_mm", r.length_mm},
+                      {"tip_mm", {r.tip_mm.x(), r.tip_mm.y()}}, {"mm_per_px", r.mm_per_px},
+                      {"warnings", r.warnings}});
+    if (!a.json) {
+      std::cout << "extracted " << in.source << ": " << r.rig_type << " rig, " << r.polarity
+                << " strip, L = " << Num(r.length_mm, 4) << " mm, tip (" << Num(r.tip_mm.x(), 4)
+                << ", " << Num(r.tip_mm.y(), 4) << ") mm, " << r.profile.size() << " points\n";
+      for (const auto& w : r.warnings) std::cout << "  warning: " << w << "\n";
+    }
+  }
   // Check outputs before the work, so that a bad path fails fast.
   AtomicFile material_file(a.out);
   std::optional<AtomicFile> plot_file;
@@ -232,6 +251,7 @@ void Run(const FitArgs& a) {
 
   AddClassicOutputs(o.law, rho, &o.report);
   o.report["inputs"] = a.inputs;
+  if (!photos.empty()) o.report["photos"] = photos;
   o.report["areal_density_gsm"] = a.gsm;
 
   std::optional<ClappResult> clapp;
@@ -275,9 +295,12 @@ void Run(const FitArgs& a) {
 void RegisterFit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   CLI::App* sub = AddSubcommand(
-      app, "fit", "Fit the bending law {b1, b2, c1} to cantilever profiles of one strip",
-      "textile fit samples/profiles/pabst-fig8_L0*.profile.csv --gsm 200 -o fitted.json --plot fit.png");
-  sub->add_option("inputs", a->inputs, "Profile CSV files (s_mm,x_mm,y_mm) of the same strip")
+      app, "fit", "Fit the bending law {b1, b2, c1} to cantilever profiles or photos of one strip",
+      "textile fit samples/profiles/pabst-fig8_L0*.profile.csv --gsm 200 -o fitted.json --plot fit.png\n"
+      "  textile fit samples/photos/pabst-fig8_L0*.jpg --rig samples/photos/rig.json --gsm 200 -o fitted.json");
+  sub->add_option("inputs", a->inputs,
+                  "Profile CSV files (s_mm,x_mm,y_mm) or photos (PNG, JPEG, TIFF, BMP; need --rig or "
+                  "--mm-per-px) of the same strip")
       ->required();
   sub->add_option("--gsm", a->gsm, "Areal density of the fabric [g/m²]")->required();
   sub->add_option("--method", a->method, "direct (elastica fit, default) or clapp (Clapp et al. 1990)")
@@ -291,6 +314,7 @@ void RegisterFit(CLI::App& app) {
   sub->add_flag("--fit-rotation", a->fit_rotation, "Also fit a small rig rotation");
   sub->add_option("--robust-mm", a->robust_mm, "Cauchy loss scale per point [mm]; 0 = plain least squares (default 0.5)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
+  AddPhotoFlags(sub, &a->photo);
   CLI::Option* thickness = sub->get_option("--thickness-mm");
   sub->callback([a, thickness] {
     a->thickness_given = thickness->count() > 0;

@@ -10,10 +10,12 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "../fit/synthetic_photo.h"
 #include "run_cli.h"
 
 namespace textile {
@@ -401,6 +403,41 @@ TEST(CliFit, StripStifferThanTheTextileRangeFailsInOneLine) {
   EXPECT_EQ(r.err.find("ParameterBlock"), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
   EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(CliFit, PhotoInputsNeedARigAndAreNamedWhenBad) {
+  const auto dir = Scratch("cli_fit_photo_inputs");
+  const std::string good = Synth(kFig8, "60", dir / "profiles");
+  testing::PhotoScene blank;
+  blank.width = 600;
+  blank.height = 400;
+  blank.strip = blank.background;  // nothing to find
+  cv::imwrite((dir / "blank.png").string(), testing::Render(blank).gray);
+  { std::ofstream(dir / "text.jpg") << "not a jpeg"; }
+  const fs::path out = dir / "never.json";
+  const std::string blank_png = Quote(dir / "blank.png");
+  struct Case {
+    std::string args;
+    int code;
+    std::string words;
+  };
+  const Case cases[] = {
+      {good + blank_png, 2, "blank.png is a photo: give exactly one of --rig"},
+      {good + blank_png + " --mm-per-px 0.1 --rig x.json", 2, "give exactly one of --rig"},
+      {good + Quote(dir / "text.jpg") + " --mm-per-px 0.1", 2, "text.jpg: not a supported image"},
+      {good + blank_png + " --mm-per-px 0.1 --trace side", 2, "--trace"},
+      {good + blank_png + " --mm-per-px 0.1 --edge-px 1", 2, "--edge-px: expected X,Y"},
+      {good + blank_png + " --mm-per-px 0.1", 3, "blank.png: "},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args);
+    const auto r = Textile("fit " + c.args + " --gsm 200 -o " + Quote(out));
+    EXPECT_EQ(r.exit_code, c.code) << r.err;
+    EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
+    EXPECT_EQ(CountLines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(c.words), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
 }
 
 }  // namespace

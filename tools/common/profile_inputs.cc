@@ -1,0 +1,150 @@
+#include "common/profile_inputs.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "common/cli.h"
+#include "textile/sim/error.h"
+
+namespace textile::cli {
+namespace {
+
+bool HasImageMagic(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char b[8] = {};
+  in.read(b, sizeof b);
+  const auto n = static_cast<size_t>(in.gcount());
+  const auto starts = [&](const char* magic, size_t m) {
+    return n >= m && std::memcmp(b, magic, m) == 0;
+  };
+  return starts("\x89PNG\r\n\x1a\n", 8) || starts("\xFF\xD8\xFF", 3) || starts("II*\0", 4) ||
+         starts("MM\0*", 4) || starts("BM", 2);
+}
+
+bool HasImageExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".tif" || ext == ".tiff" ||
+         ext == ".bmp";
+}
+
+}  // namespace
+
+bool IsPhotoPath(const std::string& path) { return HasImageMagic(path) || HasImageExtension(path); }
+
+Rig RigFromOptions(const PhotoInputOptions& options, const std::string& what) {
+  if (options.rig_path && options.mm_per_px) {
+    throw InputError(what + ": give exactly one of --rig RIG.json and --mm-per-px S (both given)");
+  }
+  if (options.rig_path) return ReadRigJson(*options.rig_path);
+  if (options.mm_per_px) return Rig::FromScale(*options.mm_per_px);
+  throw InputError(what + ": give exactly one of --rig RIG.json and --mm-per-px S (pixels -> mm)");
+}
+
+std::vector<LoadedProfile> LoadProfileInputs(const std::vector<std::string>& paths,
+                                             const PhotoInputOptions& options) {
+  if (options.rig_path && options.mm_per_px) {
+    throw InputError("give exactly one of --rig RIG.json and --mm-per-px S (both given)");
+  }
+  std::string why;
+  if (!options.extract.Check(&why)) throw InputError("photo options: " + why);
+  std::optional<Rig> rig;  // read once, at the first photo
+  std::vector<LoadedProfile> loaded;
+  for (const auto& path : paths) {
+    LoadedProfile in;
+    in.source = path;
+    if (!IsPhotoPath(path)) {
+      in.profile = ReadProfileCsv(path);
+      in.profile.source = path;
+      loaded.push_back(std::move(in));
+      continue;
+    }
+    if (!rig) rig = RigFromOptions(options, path + " is a photo");
+    cv::Mat gray = ReadPhotoGray(path);
+    if (gray.total() > 4e6) Info("extracting " + path + " ...");
+    ExtractionSummary r = ExtractProfile(gray, *rig, options.extract, path);
+    if (!r.success) throw ComputeError(path + ": " + r.message);
+    in.profile = r.profile;
+    in.profile.source = path;
+    in.from_photo = true;
+    in.extraction = std::move(r);
+    if (options.keep_photos) in.photo = gray;
+    loaded.push_back(std::move(in));
+  }
+  return loaded;
+}
+
+Eigen::Vector2d ParseEdgePx(const std::string& text) {
+  std::stringstream in(text);
+  std::string a, b, rest;
+  if (!std::getline(in, a, ',') || !std::getline(in, b, ',') || std::getline(in, rest)) {
+    throw InputError("--edge-px: expected X,Y in pixels, got '" + text + "'");
+  }
+  Eigen::Vector2d p;
+  for (int k = 0; k < 2; ++k) {
+    const std::string& s = k == 0 ? a : b;
+    char* end = nullptr;
+    p[k] = std::strtod(s.c_str(), &end);
+    if (s.empty() || *end != '\0' || !std::isfinite(p[k])) {
+      throw InputError("--edge-px: '" + s + "' is not a number (expected X,Y in pixels)");
+    }
+  }
+  return p;
+}
+
+PhotoInputOptions PhotoFlags::Options() const {
+  PhotoInputOptions o;
+  const bool rig_given = rig_option && rig_option->count() > 0;
+  const bool scale_given = scale_option && scale_option->count() > 0;
+  if (rig_given && scale_given) {
+    throw InputError("give exactly one of --rig RIG.json and --mm-per-px S (both given)");
+  }
+  if (rig_given) o.rig_path = rig_file;
+  if (scale_given) o.mm_per_px = mm_per_px;
+  ExtractOptions& e = o.extract;
+  e.trace = trace == "upper"   ? TraceLine::kUpper
+            : trace == "lower" ? TraceLine::kLower
+                               : TraceLine::kMid;
+  e.rig = rig_type == "platform" ? RigKind::kPlatform
+          : rig_type == "clamp"  ? RigKind::kClamp
+                                 : RigKind::kAuto;
+  if (!edge.empty()) e.edge_px = ParseEdgePx(edge);
+  if (level_option && level_option->count() > 0) e.level_deg = level_deg;
+  e.step_mm = step_mm;
+  std::string why;
+  if (!e.Check(&why)) {
+    const std::string flag = why.rfind("step", 0) == 0    ? "--step-mm"
+                             : why.rfind("level", 0) == 0 ? "--level-deg"
+                                                          : "--edge-px";
+    throw InputError(flag + ": " + why.substr(why.find(' ') + 1));
+  }
+  return o;
+}
+
+void AddPhotoFlags(CLI::App* sub, PhotoFlags* f) {
+  f->rig_option = sub->add_option(
+      "--rig", f->rig_file, "Rig file (from `textile calibrate`): pixels -> mm in the bending plane");
+  f->scale_option = sub->add_option(
+      "--mm-per-px", f->mm_per_px, "Plain scale for a perpendicular, distortion-free camera [mm/px]");
+  sub->add_option("--edge-px", f->edge,
+                  "Origin override X,Y [px]: the platform edge, or where the strip leaves the clamp");
+  f->level_option = sub->add_option(
+      "--level-deg", f->level_deg,
+      "Horizontal = image rows turned by this angle [deg], counter-clockwise as seen (default: "
+      "the platform's top face, else the rows)");
+  sub->add_option("--trace", f->trace,
+                  "Line to trace: mid (silhouette mid-line, default), upper or lower boundary "
+                  "(oblique views: the lit near edge)")
+      ->check(CLI::IsMember({"mid", "upper", "lower"}));
+  sub->add_option("--rig-type", f->rig_type, "auto (default), platform (fail if none is found) or clamp")
+      ->check(CLI::IsMember({"auto", "platform", "clamp"}));
+  sub->add_option("--step-mm", f->step_mm, "Profile spacing along the arc length [mm] (default 0.5)");
+}
+
+}  // namespace textile::cli

@@ -449,7 +449,7 @@ double BendingElements::EnergyGradient(const Vertices& x, Eigen::Ref<Vertices> g
 
 void BendingElements::AddHessianTriplets(const Vertices& x,
                                          std::vector<Eigen::Triplet<double>>* triplets,
-                                         bool project_psd) const {
+                                         HessianProjection projection) const {
   assert(x.rows() == num_vertices_);
   const int nh = num_hinges();
   const bool linear =
@@ -496,9 +496,13 @@ void BendingElements::AddHessianTriplets(const Vertices& x,
       Eigen::Matrix<double, 12, 1> gv;
       for (int i = 0; i < 4; ++i) gv.segment<3>(3 * i) = g[i];
       // ∇²E = E''(θ) ∇θ ∇θᵀ + E'(θ) ∇²θ.
-      block.noalias() = d2_energy * gv * gv.transpose();
-      AddAngleHessian(x, r.v, d_energy, &block);
-      if (project_psd) {
+      if (projection == HessianProjection::kGaussNewton) {
+        block.noalias() = std::max(d2_energy, 0.0) * gv * gv.transpose();
+      } else {
+        block.noalias() = d2_energy * gv * gv.transpose();
+        AddAngleHessian(x, r.v, d_energy, &block);
+      }
+      if (projection == HessianProjection::kEigen) {
         eigen.compute(block);
         const auto& values = eigen.eigenvalues();
         if (values.minCoeff() < 0.0) {

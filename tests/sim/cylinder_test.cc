@@ -187,7 +187,9 @@ TEST(CylinderTest, RegularGridsConvergeToPsiForEveryLawAlongBothAxes) {
     if (r.family != "regular") continue;
     for (int k = 0; k < kNumLevels; ++k) {
       EXPECT_NEAR(r.ratio[k] - 1.0, -1.0 / kLevels[k], 1e-9) << r.law << " n = " << kLevels[k];
-      if (k > 0) EXPECT_LT(std::abs(r.ratio[k] - 1.0), std::abs(r.ratio[k - 1] - 1.0));
+      if (k > 0) {
+        EXPECT_LT(std::abs(r.ratio[k] - 1.0), std::abs(r.ratio[k - 1] - 1.0));
+      }
     }
     EXPECT_LE(std::abs(r.ratio.back() - 1.0), kRegularBoundAtFinest) << r.law;
   }

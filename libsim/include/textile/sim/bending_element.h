@@ -51,6 +51,15 @@ namespace textile {
 
 enum class BendingModel { kPabst, kBridson, kVolino, kIsometric };
 
+// How a hinge's Hessian block is made positive semi-definite for Newton-type solvers.
+enum class HessianProjection {
+  kNone,         // the exact Hessian E''(θ) ∇θ ∇θᵀ + E'(θ) ∇²θ (indefinite in general)
+  kEigen,        // the exact block with its negative eigenvalues set to 0 (12×12 eigen-solve)
+  kGaussNewton,  // max(E'', 0) ∇θ ∇θᵀ: drops the E' ∇²θ term; PSD, ~20× cheaper than kEigen,
+                 // exact at rest and wherever E' = 0 (Newton then converges linearly, not
+                 // quadratically, in strongly bent states)
+};
+
 // "pabst", "bridson", "volino", "isometric".
 std::string BendingModelName(BendingModel model);
 // Inverse of BendingModelName; throws InputError listing the known names.
@@ -107,7 +116,14 @@ class BendingElements {
   // eigenvalues set to 0 (Newton needs a positive semi-definite matrix; the linear models are
   // PSD already).
   void AddHessianTriplets(const Vertices& x, std::vector<Eigen::Triplet<double>>* triplets,
-                          bool project_psd) const;
+                          bool project_psd) const {
+    AddHessianTriplets(x, triplets,
+                       project_psd ? HessianProjection::kEigen : HessianProjection::kNone);
+  }
+  // The same with a choice of projection; the triplet count and order never depend on it or on x
+  // (so a fixed sparsity pattern can be filled by position).
+  void AddHessianTriplets(const Vertices& x, std::vector<Eigen::Triplet<double>>* triplets,
+                          HessianProjection projection) const;
 
   // Per-hinge views, for tests, plots and seams.
   int num_hinges() const { return static_cast<int>(rest_.size()); }

@@ -1,0 +1,158 @@
+#ifndef TEXTILE_SIM_CLOTH_PROBLEM_H_
+#define TEXTILE_SIM_CLOTH_PROBLEM_H_
+
+// The total potential of a piece of cloth in a static scene (physics.md, "Static equilibrium";
+// Sensitive Couture eq. 1): membrane + bending + gravity + contact penalty + friction anchor
+// springs, with fixed (or prescribed) vertices. Solvers (static_solver.h) minimise it.
+//
+//   textile::TriangleMesh sheet = textile::RegularGridMesh(0.5, 0.5, 30, 30);
+//   textile::ClothProblem problem(sheet, material, {}, textile::ClothOptions{});
+//   problem.FixVertices({0, 30}, sheet.vertices({0, 30}, Eigen::all));   // two corners
+//   problem.AddSupport(textile::Support::Plane({0, 0, -0.3}, {0, 0, 1}));
+//   textile::Vertices x = sheet.vertices;                      // start flat
+//   textile::SolveSummary s = textile::SolveStatic(&problem, &x, {});
+//
+// Degrees of freedom are the 3V vertex coordinates (dof 3 i + c); fixed vertices keep the
+// positions given to FixVertices (move them with SetFixedPositions for a prescribed motion)
+// and their rows of the gradient and Hessian are those of the identity.
+//
+// Contact (contact.h): node i inside support s (signed distance φ < 0) feels the penalty
+// ½ k_i φ² with k_i = m_i g / sink. With friction μ > 0 a node in contact is tied to an anchor
+// point a on the support by the tangential spring ½ k_t |P (x_i - a)|² (k_t = tangential_ratio
+// × the stretch stiffness), P = I - n nᵀ (n the normal at the anchor): the node sticks. When that
+// spring pulls harder than μ f_n (Coulomb) the node slides: the spring is replaced by a constant
+// force μ f_n against the slip direction (potential f t̂·x), and when a sliding node stops or is
+// pulled back it sticks again where it is. UpdateAnchors makes these switches and creates and
+// drops anchors where contact starts and ends. Between two updates the energy is a fixed,
+// differentiable function, which is what Newton's line search needs; an active set of sliding
+// nodes moves as far as the forces say in one Newton solve (a lagged spring would creep).
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <string>
+#include <vector>
+
+#include "textile/sim/bending_element.h"
+#include "textile/sim/contact.h"
+#include "textile/sim/material.h"
+#include "textile/sim/membrane.h"
+#include "textile/sim/mesh.h"
+#include "textile/sim/seam.h"
+
+namespace textile {
+
+struct ClothOptions {
+  MembraneModel membrane = MembraneModel::kStVK;  // stabilised StVK (Sensitive Couture)
+  BendingOptions bending;                         // Pabst's law by default
+  Eigen::Vector3d gravity{0.0, 0.0, -9.80665};    // [m/s²]
+  ContactOptions contact;                         // used when supports are added
+  // Multiplies the material's bending law (the 100× plate of the stability benchmark); > 0.
+  double bending_scale = 1.0;
+
+  bool Check(std::string* why) const;
+};
+
+class ClothProblem {
+ public:
+  // @param rest      the pattern: #V×3 rest positions [m] (flat: z = 0), #F×3 triangles;
+  //                  must pass CheckMesh (it is called)
+  // @param material  areal density, bending law(s), β, stretch stiffness, Poisson ratio;
+  //                  the friction coefficient of options.contact is used, not material.friction
+  //                  (callers copy it over when they want the material's)
+  // @param seams     seam lines on the pattern: bending multipliers S(d) per hinge and the
+  //                  seam-band mass (seam.h)
+  // Throws InputError for a bad mesh, material, seam or option.
+  ClothProblem(const TriangleMesh& rest, const Material& material, const std::vector<Seam>& seams,
+               const ClothOptions& options);
+
+  // Holds vertices at positions (#K×3 [m]); replaces any previous set. Ids must be distinct and
+  // in range; positions finite.
+  void FixVertices(const std::vector<int>& vertices, const Vertices& positions);
+  // New positions for the fixed vertices, in FixVertices' order (a prescribed motion).
+  void SetFixedPositions(const Vertices& positions);
+  void AddSupport(const Support& support);
+
+  // Total potential energy [J] at x (#V×3 [m]), with the current anchors.
+  double Energy(const Vertices& x) const;
+  // Fills grad (#V×3, resized) with ∇E [N], zero on fixed vertices; returns E [J].
+  double EnergyGradient(const Vertices& x, Vertices* grad) const;
+  // ∇²E [N/m] (3V×3V, fixed sparsity, full symmetric storage) with fixed vertices' rows and
+  // columns replaced by identity rows scaled to the matrix's mean diagonal. The reference stays
+  // valid until the next call.
+  const Eigen::SparseMatrix<double>& Hessian(const Vertices& x, HessianProjection projection);
+
+  // Creates, releases and slides friction anchors for state x (see the file comment); a new
+  // anchor goes where the node was in `previous` (the state before the step that brought it into
+  // contact), projected onto the support, so a step cannot slide a landing node for free.
+  // Returns the largest slip of a sliding node since `previous` [m] (0 when every node sticks).
+  double UpdateAnchors(const Vertices& x, const Vertices& previous);
+  void ClearAnchors();
+  int num_anchors() const;
+  // Incremented whenever an anchor is created, released or moved: the energy changed.
+  long anchor_version() const { return anchor_version_; }
+  int num_contacts(const Vertices& x) const;  // nodes with φ < 0 against some support
+
+  // The largest α ≤ 1 for which the step x + α d (d: 3V) moves no node deeper than half a
+  // support's TunnelDepth past its surface: a step may not jump through a thin support.
+  double ContactStepLimit(const Vertices& x, const Eigen::VectorXd& d) const;
+  // Sets the fixed vertices of x to their prescribed positions.
+  void ApplyFixed(Vertices* x) const;
+  // RMS of the force on free vertices over the RMS of their weights m_i |g| [-]: the
+  // convergence measure of every solver (physics.md: "relative to the weight").
+  double RelativeResidual(const Vertices& grad) const;
+
+  const TriangleMesh& rest() const { return rest_; }
+  const Eigen::VectorXd& masses() const { return masses_; }  // #V [kg]
+  const std::vector<Support>& supports() const { return supports_; }
+  const std::vector<int>& fixed_vertices() const { return fixed_; }
+  const std::vector<char>& is_fixed() const { return is_fixed_; }
+  const MembraneElements& membrane() const { return membrane_; }
+  const BendingElements& bending() const { return bending_; }
+  const ClothOptions& options() const { return options_; }
+  int num_vertices() const { return rest_.num_vertices(); }
+  double total_mass() const { return masses_.sum(); }
+  // Σ m_i |g| over free vertices [N].
+  double FreeWeight() const;
+
+ private:
+  struct Anchor {
+    int support = -1;  // -1: no anchor
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();   // sticking: the anchor; sliding: x then
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+    bool sliding = false;
+    Eigen::Vector3d slip = Eigen::Vector3d::Zero();  // sliding: unit slip direction
+    double friction_force = 0.0;                     // sliding: μ f_n [N]
+    bool stopped = false;  // it slid and stopped since contact began (hysteresis)
+  };
+  // The deepest support node i touches (φ < limit), or -1; *phi and *normal filled.
+  int Touching(const Eigen::Vector3d& p, double limit, double* phi, Eigen::Vector3d* normal) const;
+  double ContactEnergyGradient(const Vertices& x, Vertices* grad) const;
+  void BuildPattern();
+
+  TriangleMesh rest_;
+  ClothOptions options_;
+  Eigen::VectorXd masses_;
+  MembraneElements membrane_;
+  std::vector<Hinge> hinges_;
+  BendingElements bending_;
+  std::vector<Support> supports_;
+  std::vector<int> fixed_;
+  std::vector<char> is_fixed_;
+  Vertices fixed_positions_;
+  std::vector<Anchor> anchors_;  // #V
+  long anchor_version_ = 0;
+  Eigen::VectorXd penalty_;      // #V normal spring k_i [N/m]
+  double tangential_stiffness_ = 0.0;  // anchor spring k_t [N/m]
+
+  // Hessian with a fixed pattern: element triplets land in value slots found once.
+  Eigen::SparseMatrix<double> hessian_;
+  std::vector<Eigen::Triplet<double>> triplets_;
+  std::vector<int> triplet_slot_;
+  std::vector<int> diagonal_block_slot_;  // #V×9: slot of (3i+a, 3i+b)
+  std::vector<int> fixed_slots_;          // entries in a fixed dof's row or column
+  std::vector<int> fixed_diagonal_slots_;
+};
+
+}  // namespace textile
+
+#endif  // TEXTILE_SIM_CLOTH_PROBLEM_H_

@@ -1,0 +1,377 @@
+#include "textile/sim/cloth_problem.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "textile/sim/error.h"
+
+namespace textile {
+namespace {
+
+std::optional<BendingLaw> WeftLaw(const Material& m, double scale) {
+  if (!m.bending_weft) return std::nullopt;
+  return m.EffectiveWeftLaw().Scaled(scale);
+}
+
+std::vector<double> Multipliers(const TriangleMesh& rest, const std::vector<Hinge>& hinges,
+                                const std::vector<Seam>& seams) {
+  if (seams.empty()) return {};
+  return HingeSeamMultipliers(rest, hinges, seams);
+}
+
+const TriangleMesh& Checked(const TriangleMesh& mesh) {
+  CheckMesh(mesh);
+  return mesh;
+}
+
+const ClothOptions& Checked(const ClothOptions& options) {
+  std::string why;
+  if (!options.Check(&why)) throw InputError(why);
+  return options;
+}
+
+}  // namespace
+
+bool ClothOptions::Check(std::string* why) const {
+  if (!bending.Check(why)) return false;
+  if (!contact.Check(why)) return false;
+  if (!gravity.allFinite()) {
+    *why = "gravity must be finite";
+    return false;
+  }
+  if (!(bending_scale > 0.0) || !std::isfinite(bending_scale)) {
+    *why = "bending_scale must be > 0 and finite";
+    return false;
+  }
+  return true;
+}
+
+ClothProblem::ClothProblem(const TriangleMesh& rest, const Material& material,
+                           const std::vector<Seam>& seams, const ClothOptions& options)
+    : rest_(Checked(rest)),
+      options_(Checked(options)),
+      masses_(LumpedMasses(rest, material.areal_density, seams)),
+      membrane_(rest, material, options.membrane),
+      hinges_(BuildHinges(rest)),
+      bending_(rest, hinges_, material.EffectiveLaw().Scaled(options.bending_scale),
+               WeftLaw(material, options.bending_scale), options.bending,
+               Multipliers(rest, hinges_, seams)),
+      is_fixed_(rest.num_vertices(), 0),
+      anchors_(rest.num_vertices()) {
+  const double g = options_.gravity.norm();
+  // Without gravity the penalty still needs a scale: use standard gravity's.
+  const double g_scale = g > 0.0 ? g : 9.80665;
+  penalty_ = masses_ * (g_scale / options_.contact.sink_under_own_weight);
+  tangential_stiffness_ = options_.contact.tangential_ratio * material.stretch_stiffness;
+  BuildPattern();
+}
+
+void ClothProblem::BuildPattern() {
+  const int n = 3 * num_vertices();
+  triplets_.clear();
+  const Vertices& x = rest_.vertices;
+  membrane_.AddHessianTriplets(x, &triplets_, false);
+  bending_.AddHessianTriplets(x, &triplets_, HessianProjection::kNone);
+  const size_t element_count = triplets_.size();
+  std::vector<Eigen::Triplet<double>> all = triplets_;
+  for (int i = 0; i < num_vertices(); ++i)
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) all.emplace_back(3 * i + a, 3 * i + b, 1.0);
+  hessian_.resize(n, n);
+  hessian_.setFromTriplets(all.begin(), all.end());
+  hessian_.makeCompressed();
+  const int* outer = hessian_.outerIndexPtr();
+  const int* inner = hessian_.innerIndexPtr();
+  auto slot = [&](int row, int col) {
+    const int* begin = inner + outer[col];
+    const int* end = inner + outer[col + 1];
+    const int* it = std::lower_bound(begin, end, row);
+    assert(it != end && *it == row);
+    return static_cast<int>(it - inner);
+  };
+  triplet_slot_.resize(element_count);
+  for (size_t k = 0; k < element_count; ++k)
+    triplet_slot_[k] = slot(triplets_[k].row(), triplets_[k].col());
+  diagonal_block_slot_.resize(9 * static_cast<size_t>(num_vertices()));
+  for (int i = 0; i < num_vertices(); ++i)
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) diagonal_block_slot_[9 * i + 3 * a + b] = slot(3 * i + a, 3 * i + b);
+}
+
+void ClothProblem::FixVertices(const std::vector<int>& vertices, const Vertices& positions) {
+  if (static_cast<long>(vertices.size()) != positions.rows())
+    throw InputError("fixed vertices: " + std::to_string(vertices.size()) + " ids but " +
+                     std::to_string(positions.rows()) + " positions");
+  std::vector<char> seen(num_vertices(), 0);
+  for (size_t k = 0; k < vertices.size(); ++k) {
+    const int v = vertices[k];
+    if (v < 0 || v >= num_vertices())
+      throw InputError("fixed vertex " + std::to_string(v) + " is not a vertex of the mesh");
+    if (seen[v]) throw InputError("fixed vertex " + std::to_string(v) + " is given twice");
+    if (!positions.row(static_cast<long>(k)).allFinite())
+      throw InputError("fixed vertex " + std::to_string(v) + " has a non-finite position");
+    seen[v] = 1;
+  }
+  fixed_ = vertices;
+  is_fixed_ = seen;
+  fixed_positions_ = positions;
+  // Slots of the fixed dofs' rows and columns, for the identity rows of Hessian().
+  fixed_slots_.clear();
+  fixed_diagonal_slots_.clear();
+  const int* outer = hessian_.outerIndexPtr();
+  const int* inner = hessian_.innerIndexPtr();
+  for (int col = 0; col < hessian_.cols(); ++col) {
+    for (int k = outer[col]; k < outer[col + 1]; ++k) {
+      const int row = inner[k];
+      if (is_fixed_[col / 3] || is_fixed_[row / 3]) {
+        fixed_slots_.push_back(k);
+        if (row == col) fixed_diagonal_slots_.push_back(k);
+      }
+    }
+  }
+}
+
+void ClothProblem::SetFixedPositions(const Vertices& positions) {
+  if (positions.rows() != fixed_positions_.rows() || !positions.allFinite())
+    throw InputError("fixed positions: expected " + std::to_string(fixed_positions_.rows()) +
+                     " finite rows");
+  fixed_positions_ = positions;
+}
+
+void ClothProblem::AddSupport(const Support& support) { supports_.push_back(support); }
+
+void ClothProblem::ApplyFixed(Vertices* x) const {
+  for (size_t k = 0; k < fixed_.size(); ++k)
+    x->row(fixed_[k]) = fixed_positions_.row(static_cast<long>(k));
+}
+
+int ClothProblem::Touching(const Eigen::Vector3d& p, double limit, double* phi,
+                           Eigen::Vector3d* normal) const {
+  int best = -1;
+  double best_phi = limit;
+  for (size_t s = 0; s < supports_.size(); ++s) {
+    Eigen::Vector3d n;
+    const double d = supports_[s].SignedDistance(p, &n);
+    if (d < best_phi) {
+      best_phi = d;
+      best = static_cast<int>(s);
+      *normal = n;
+    }
+  }
+  *phi = best_phi;
+  return best;
+}
+
+double ClothProblem::ContactEnergyGradient(const Vertices& x, Vertices* grad) const {
+  if (supports_.empty()) return 0.0;  // a scene without obstacles pays nothing for contact
+  double energy = 0.0;
+  const double kt = tangential_stiffness_;
+  for (int i = 0; i < num_vertices(); ++i) {
+    if (is_fixed_[i]) continue;
+    const Eigen::Vector3d p = x.row(i).transpose();
+    for (const Support& s : supports_) {
+      Eigen::Vector3d n;
+      const double phi = s.SignedDistance(p, &n);
+      if (phi >= 0.0) continue;
+      energy += 0.5 * penalty_(i) * phi * phi;
+      if (grad) grad->row(i) += (penalty_(i) * phi) * n.transpose();
+    }
+    const Anchor& a = anchors_[i];
+    if (a.support >= 0 && a.sliding) {
+      // Sliding (Coulomb): a constant force of μ f_n against the slip, potential f t̂·x.
+      energy += a.friction_force * a.slip.dot(p - a.point);
+      if (grad) grad->row(i) += a.friction_force * a.slip.transpose();
+    } else if (a.support >= 0) {
+      const Eigen::Vector3d d = p - a.point;
+      const Eigen::Vector3d dt = d - a.normal * a.normal.dot(d);
+      energy += 0.5 * kt * dt.squaredNorm();
+      if (grad) grad->row(i) += kt * dt.transpose();
+    }
+  }
+  return energy;
+}
+
+double ClothProblem::Energy(const Vertices& x) const {
+  double e = membrane_.Energy(x) + bending_.Energy(x);
+  for (int i = 0; i < num_vertices(); ++i) e -= masses_(i) * options_.gravity.dot(x.row(i));
+  return e + ContactEnergyGradient(x, nullptr);
+}
+
+double ClothProblem::EnergyGradient(const Vertices& x, Vertices* grad) const {
+  grad->setZero(x.rows(), 3);
+  membrane_.AddGradient(x, *grad);
+  double e = membrane_.Energy(x) + bending_.EnergyGradient(x, *grad);
+  for (int i = 0; i < num_vertices(); ++i) {
+    e -= masses_(i) * options_.gravity.dot(x.row(i));
+    grad->row(i) -= masses_(i) * options_.gravity.transpose();
+  }
+  e += ContactEnergyGradient(x, grad);
+  for (int v : fixed_) grad->row(v).setZero();
+  return e;
+}
+
+const Eigen::SparseMatrix<double>& ClothProblem::Hessian(const Vertices& x,
+                                                         HessianProjection projection) {
+  triplets_.clear();
+  const bool project = projection != HessianProjection::kNone;
+  membrane_.AddHessianTriplets(x, &triplets_, project);
+  bending_.AddHessianTriplets(x, &triplets_, projection);
+  assert(triplets_.size() == triplet_slot_.size());
+  double* values = hessian_.valuePtr();
+  std::fill(values, values + hessian_.nonZeros(), 0.0);
+  for (size_t k = 0; k < triplets_.size(); ++k) values[triplet_slot_[k]] += triplets_[k].value();
+  if (!supports_.empty()) {
+    for (int i = 0; i < num_vertices(); ++i) {
+      if (is_fixed_[i]) continue;
+      Eigen::Matrix3d block = Eigen::Matrix3d::Zero();
+      const Eigen::Vector3d p = x.row(i).transpose();
+      for (const Support& s : supports_) {
+        Eigen::Vector3d n;
+        if (s.SignedDistance(p, &n) < 0.0) block += penalty_(i) * n * n.transpose();
+      }
+      const Anchor& a = anchors_[i];
+      if (a.support >= 0 && !a.sliding)
+        block += tangential_stiffness_ *
+                 (Eigen::Matrix3d::Identity() - a.normal * a.normal.transpose());
+      if (block.isZero(0.0)) continue;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) values[diagonal_block_slot_[9 * i + 3 * r + c]] += block(r, c);
+    }
+  }
+  if (!fixed_.empty()) {
+    double diag_sum = 0.0;
+    for (int i = 0; i < num_vertices(); ++i)
+      for (int a = 0; a < 3; ++a) diag_sum += values[diagonal_block_slot_[9 * i + 4 * a]];
+    const double scale = diag_sum > 0.0 ? diag_sum / hessian_.cols() : 1.0;
+    for (int k : fixed_slots_) values[k] = 0.0;
+    for (int k : fixed_diagonal_slots_) values[k] = scale;
+  }
+  return hessian_;
+}
+
+double ClothProblem::UpdateAnchors(const Vertices& x, const Vertices& previous) {
+  const double mu = options_.contact.friction;
+  if (supports_.empty() || mu <= 0.0) return 0.0;
+  const double keep = options_.contact.anchor_keep_distance;
+  double slid = 0.0;
+  for (int i = 0; i < num_vertices(); ++i) {
+    Anchor& a = anchors_[i];
+    if (is_fixed_[i]) {
+      a.support = -1;
+      continue;
+    }
+    const Eigen::Vector3d p = x.row(i).transpose();
+    double phi;
+    Eigen::Vector3d n;
+    const int s = Touching(p, a.support >= 0 ? keep : 0.0, &phi, &n);
+    if (s < 0) {
+      if (a.support >= 0) ++anchor_version_;
+      a.support = -1;  // contact ended: the anchor is released
+      continue;
+    }
+    const Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity() - n * n.transpose();
+    const double limit = mu * penalty_(i) * std::max(-phi, 0.0);  // μ f_n
+    ++anchor_version_;
+    if (a.support < 0) {  // contact starts: sticking, anchored under where the node came from
+      const Eigen::Vector3d before = previous.row(i).transpose();
+      Eigen::Vector3d n_before;
+      const double phi_before = supports_[s].SignedDistance(before, &n_before);
+      a = Anchor{s, before - phi_before * n_before, n_before, false, Eigen::Vector3d::Zero(), 0.0,
+                 false};
+      continue;
+    }
+    if (a.sliding) {
+      const Eigen::Vector3d motion = tangent * (p - previous.row(i).transpose());
+      if (motion.dot(a.slip) <= 0.0 || motion.norm() < 1e-12) {
+        // Stopped or pulled back by the friction force: it sticks where it is.
+        a = Anchor{s, p - phi * n, n, false, Eigen::Vector3d::Zero(), 0.0, true};
+      } else {
+        a.slip = motion.normalized();
+        a.friction_force = limit;
+        a.point = p;
+        a.normal = n;
+        a.support = s;
+        slid = std::max(slid, motion.norm());
+      }
+      continue;
+    }
+    const Eigen::Vector3d dt = tangent * (p - a.point);
+    const double tangential = tangential_stiffness_ * dt.norm();
+    // A node that stopped sliding must be pulled 5 % past the limit to slide again: without
+    // this hysteresis a node at the limit can flip between the two states forever.
+    const double margin = a.stopped ? 1.05 : 1.0 + 1e-6;
+    if (tangential > limit * margin && dt.norm() > 0.0) {
+      // The spring pulls harder than friction can hold: it slides (Coulomb), from now on
+      // against a constant force μ f_n.
+      slid = std::max(slid, dt.norm() - limit / tangential_stiffness_);
+      a = Anchor{s, p, n, true, dt.normalized(), limit, a.stopped};
+      continue;
+    }
+    // Sticking: keep the anchor on the surface under the node (curved shapes turn the normal).
+    const Eigen::Vector3d on_surface = p - phi * n;
+    a.point += n * n.dot(on_surface - a.point);
+    a.normal = n;
+    a.support = s;
+  }
+  return slid;
+}
+
+double ClothProblem::ContactStepLimit(const Vertices& x, const Eigen::VectorXd& d) const {
+  if (supports_.empty()) return 1.0;
+  double depth = std::numeric_limits<double>::infinity();
+  for (const Support& s : supports_) depth = std::min(depth, s.TunnelDepth());
+  if (!std::isfinite(depth)) return 1.0;
+  double alpha = 1.0;
+  for (int i = 0; i < num_vertices(); ++i) {
+    const double length = d.segment<3>(3 * i).norm();
+    if (length == 0.0) continue;
+    double phi = std::numeric_limits<double>::infinity();
+    for (const Support& s : supports_) phi = std::min(phi, s.SignedDistance(x.row(i).transpose(), nullptr));
+    const double allowed = std::max(phi, 0.0) + 0.5 * depth;
+    if (length > allowed) alpha = std::min(alpha, allowed / length);
+  }
+  return alpha;
+}
+
+void ClothProblem::ClearAnchors() {
+  ++anchor_version_;
+  for (Anchor& a : anchors_) a.support = -1;
+}
+
+int ClothProblem::num_anchors() const {
+  return static_cast<int>(
+      std::count_if(anchors_.begin(), anchors_.end(), [](const Anchor& a) { return a.support >= 0; }));
+}
+
+int ClothProblem::num_contacts(const Vertices& x) const {
+  int count = 0;
+  for (int i = 0; i < num_vertices(); ++i) {
+    double phi;
+    Eigen::Vector3d n;
+    if (Touching(x.row(i).transpose(), 0.0, &phi, &n) >= 0) ++count;
+  }
+  return count;
+}
+
+double ClothProblem::FreeWeight() const {
+  double w = 0.0;
+  for (int i = 0; i < num_vertices(); ++i)
+    if (!is_fixed_[i]) w += masses_(i);
+  return w * options_.gravity.norm();
+}
+
+double ClothProblem::RelativeResidual(const Vertices& grad) const {
+  double force2 = 0.0, weight2 = 0.0;
+  const double g = options_.gravity.norm() > 0.0 ? options_.gravity.norm() : 9.80665;
+  for (int i = 0; i < num_vertices(); ++i) {
+    if (is_fixed_[i]) continue;
+    force2 += grad.row(i).squaredNorm();
+    weight2 += masses_(i) * masses_(i) * g * g;
+  }
+  if (weight2 <= 0.0) return 0.0;
+  return std::sqrt(force2 / weight2);
+}
+
+}  // namespace textile

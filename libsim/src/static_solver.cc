@@ -1,0 +1,494 @@
+#include "textile/sim/static_solver.h"
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/IterativeLinearSolvers>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <sstream>
+
+#include "textile/sim/error.h"
+
+namespace textile {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+double Since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// The state as one vector; Vertices is row-major, so entry 3 i + c is coordinate c of vertex i.
+Eigen::Map<Eigen::VectorXd> Flat(Vertices& x) { return {x.data(), x.size()}; }
+
+double PatternDiagonal(const TriangleMesh& rest) {
+  const Eigen::Vector3d lo = rest.vertices.colwise().minCoeff();
+  const Eigen::Vector3d hi = rest.vertices.colwise().maxCoeff();
+  return (hi - lo).norm();
+}
+
+double CentreHeight(const ClothProblem& p, const Vertices& x, const Eigen::Vector3d& down) {
+  return -(p.masses().transpose() * (x * down)).value() / p.total_mass();
+}
+
+// Solves A d = b with CHOLMOD (shifting the diagonal when A is singular) or with conjugate
+// gradients. The sparsity of A is the same on every call, so CHOLMOD analyses it once.
+class LinearSolver {
+ public:
+  explicit LinearSolver(const SolveOptions& options) : options_(options) {
+    if (options.linear == LinearSolverKind::kCholmod) {
+      cholmod_ = std::make_unique<Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower>>();
+      cholmod_->cholmod().print = 0;  // failures are handled here, not printed by CHOLMOD
+    } else {
+      cg_ = std::make_unique<
+          Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper,
+                                   Eigen::IncompleteCholesky<double>>>();
+      cg_->setTolerance(options.cg_tolerance);
+      cg_->setMaxIterations(options.cg_max_iterations);
+    }
+  }
+
+  // False when no usable direction came out (the caller falls back to steepest descent).
+  bool Solve(const SparseMatrix& a, const Eigen::VectorXd& b, Eigen::VectorXd* d,
+             SolveSummary* summary) {
+    if (cg_) {
+      cg_->compute(a);
+      if (cg_->info() != Eigen::Success) return Shifted(a, b, d, summary);
+      *d = cg_->solve(b);
+      summary->linear_iterations += static_cast<int>(cg_->iterations());
+      return d->allFinite();
+    }
+    if (!analysed_) {
+      cholmod_->analyzePattern(a);
+      analysed_ = true;
+    }
+    cholmod_->factorize(a);
+    ++summary->factorizations;
+    if (cholmod_->info() == Eigen::Success) {
+      *d = cholmod_->solve(b);
+      if (d->allFinite()) return true;
+    }
+    return Shifted(a, b, d, summary);
+  }
+
+ private:
+  // Singular or indefinite: add λ I, λ growing from 1e-10 to 1e-2 of the mean diagonal.
+  bool Shifted(const SparseMatrix& a, const Eigen::VectorXd& b, Eigen::VectorXd* d,
+               SolveSummary* summary) {
+    const double mean_diag = std::max(a.diagonal().cwiseAbs().mean(), 1e-300);
+    SparseMatrix shifted = a;
+    for (double lambda = 1e-10; lambda <= 1e-2; lambda *= 100.0) {
+      shifted = a;
+      for (int i = 0; i < shifted.cols(); ++i) shifted.coeffRef(i, i) += lambda * mean_diag;
+      if (cg_) {
+        cg_->compute(shifted);
+        if (cg_->info() != Eigen::Success) continue;
+        *d = cg_->solve(b);
+        summary->linear_iterations += static_cast<int>(cg_->iterations());
+      } else {
+        cholmod_->factorize(shifted);
+        ++summary->factorizations;
+        if (cholmod_->info() != Eigen::Success) continue;
+        *d = cholmod_->solve(b);
+      }
+      if (d->allFinite()) return true;
+    }
+    return false;
+  }
+
+  const SolveOptions& options_;
+  std::unique_ptr<Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower>> cholmod_;
+  std::unique_ptr<Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper,
+                                           Eigen::IncompleteCholesky<double>>>
+      cg_;
+  bool analysed_ = false;
+};
+
+// What every method shares: start checks, the stop tests, the summary.
+struct Run {
+  ClothProblem* problem;
+  Vertices* x;
+  const SolveOptions& options;
+  SolveSummary summary;
+  Clock::time_point start = Clock::now();
+  Eigen::Vector3d down = Eigen::Vector3d::UnitZ() * -1.0;
+  double start_height = 0.0;
+  double diagonal = 1.0;
+
+  Run(ClothProblem* p, Vertices* state, const SolveOptions& o) : problem(p), x(state), options(o) {}
+
+  // False (with the message set) when the problem cannot have a static equilibrium.
+  bool Start() {
+    std::string why;
+    if (!options.Check(&why)) throw InputError("solver options: " + why);
+    if (x->rows() != problem->num_vertices())
+      throw InputError("solver: the start state has " + std::to_string(x->rows()) +
+                       " vertices, the mesh " + std::to_string(problem->num_vertices()));
+    if (!x->allFinite()) throw InputError("solver: the start state is not finite");
+    problem->ApplyFixed(x);
+    const Eigen::Vector3d g = problem->options().gravity;
+    if (g.norm() > 0.0) down = g.normalized();
+    start_height = CentreHeight(*problem, *x, down);
+    diagonal = PatternDiagonal(problem->rest());
+    if (problem->fixed_vertices().empty() && problem->supports().empty() && g.norm() > 0.0) {
+      summary.message =
+          "nothing holds the cloth (no fixed vertex, no support): under gravity it has no static "
+          "equilibrium";
+      return false;
+    }
+    return true;
+  }
+
+  // Non-empty message when the run must stop unconverged.
+  std::string Stop(double energy, double residual) const {
+    if (!std::isfinite(energy) || !std::isfinite(residual) || !x->allFinite())
+      return "the state became non-finite (NaN or inf)";
+    if (Since(start) > options.max_seconds)
+      return "time cap of " + std::to_string(options.max_seconds) + " s reached";
+    if (start_height - CentreHeight(*problem, *x, down) > options.fall_limit * diagonal)
+      return "the cloth falls: nothing holds it (it sank " + std::to_string(options.fall_limit) +
+             " pattern diagonals)";
+    return {};
+  }
+
+  SolveSummary Finish(double energy, double residual) {
+    summary.energy = energy;
+    summary.residual = residual;
+    summary.seconds = Since(start);
+    summary.contacts = problem->num_contacts(*x);
+    summary.anchors = problem->num_anchors();
+    return summary;
+  }
+
+  std::string CapMessage(double slid) const {
+    std::string m = "iteration cap of " + std::to_string(options.max_iterations) + " reached";
+    if (slid > options.anchor_tolerance)
+      m += " with friction anchors still sliding: the cloth slides, no static equilibrium";
+    return m;
+  }
+
+  void Trace(int it, double energy, double residual, double step) const {
+    if (options.verbose)
+      std::fprintf(stderr, "%s %4d  E %.9e J  residual %.3e  step %.3e\n", summary.method.c_str(),
+                   it, energy, residual, step);
+  }
+};
+
+SolveSummary Newton(Run& run) {
+  ClothProblem& p = *run.problem;
+  Vertices& x = *run.x;
+  const SolveOptions& o = run.options;
+  const double max_step = o.max_step > 0.0 ? o.max_step : 0.1 * run.diagonal;
+  LinearSolver linear(o);
+  p.UpdateAnchors(x, x);
+  Vertices grad, trial, trial_grad;
+  double energy = p.EnergyGradient(x, &grad);
+  double residual = p.RelativeResidual(grad);
+  double slid = 0.0;
+  Eigen::VectorXd d;
+  for (int it = 0;; ++it) {
+    run.summary.iterations = it;
+    run.Trace(it, energy, residual, slid);
+    if (const std::string stop = run.Stop(energy, residual); !stop.empty()) {
+      run.summary.message = stop;
+      return run.Finish(energy, residual);
+    }
+    if (residual < o.tolerance && slid <= o.anchor_tolerance) {
+      run.summary.converged = true;
+      run.summary.message = "converged: residual below tolerance";
+      return run.Finish(energy, residual);
+    }
+    if (it >= o.max_iterations) {
+      run.summary.message = run.CapMessage(slid);
+      return run.Finish(energy, residual);
+    }
+    const SparseMatrix& h = p.Hessian(x, o.projection);
+    const Eigen::VectorXd g = Flat(grad);
+    if (!linear.Solve(h, -g, &d, &run.summary) || d.dot(g) >= 0.0) d = -g;
+    // Step cap: no vertex moves further than max_step in one iteration.
+    double largest = 0.0;
+    for (int i = 0; i < p.num_vertices(); ++i) largest = std::max(largest, d.segment<3>(3 * i).norm());
+    if (largest > max_step) d *= max_step / largest;
+    d *= p.ContactStepLimit(x, d);
+    // Armijo backtracking; near convergence, where E is flat to round-off, a full step that
+    // lowers the residual is taken as well.
+    const double slope = d.dot(g);
+    double alpha = 1.0;
+    bool accepted = false;
+    double trial_energy = 0.0;
+    for (int k = 0; k < 40; ++k, alpha *= 0.5) {
+      trial = x;
+      Flat(trial) += alpha * d;
+      trial_energy = p.EnergyGradient(trial, &trial_grad);
+      if (!std::isfinite(trial_energy)) continue;
+      if (trial_energy <= energy + 1e-4 * alpha * slope ||
+          (k == 0 && p.RelativeResidual(trial_grad) < residual &&
+           trial_energy <= energy + 1e-12 * std::abs(energy))) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) {
+      run.summary.message = "line search failed: no step lowers the energy";
+      return run.Finish(energy, residual);
+    }
+    const long anchors_before = p.anchor_version();
+    slid = p.UpdateAnchors(trial, x);
+    x = trial;
+    if (p.anchor_version() != anchors_before) {
+      energy = p.EnergyGradient(x, &grad);  // the anchor springs changed
+    } else {
+      energy = trial_energy;
+      grad = trial_grad;
+    }
+    residual = p.RelativeResidual(grad);
+  }
+}
+
+SolveSummary KineticDamping(Run& run) {
+  ClothProblem& p = *run.problem;
+  Vertices& x = *run.x;
+  const SolveOptions& o = run.options;
+  const double h = o.time_step;
+  const int n = 3 * p.num_vertices();
+  Eigen::VectorXd mass(n);
+  for (int i = 0; i < p.num_vertices(); ++i) mass.segment<3>(3 * i).setConstant(p.masses()(i));
+  LinearSolver linear(o);
+  p.UpdateAnchors(x, x);
+  Vertices grad, previous;
+  double energy = p.EnergyGradient(x, &grad);
+  double residual = p.RelativeResidual(grad);
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(n), dv;
+  double kinetic_prev = 0.0;
+  double slid = 0.0;
+  SparseMatrix a;
+  for (int it = 0;; ++it) {
+    run.summary.iterations = it;
+    run.Trace(it, energy, residual, slid);
+    if (const std::string stop = run.Stop(energy, residual); !stop.empty()) {
+      run.summary.message = stop;
+      return run.Finish(energy, residual);
+    }
+    if (residual < o.tolerance && slid <= o.anchor_tolerance) {
+      run.summary.converged = true;
+      run.summary.message = "converged: residual below tolerance";
+      return run.Finish(energy, residual);
+    }
+    if (it >= o.max_iterations) {
+      run.summary.message = run.CapMessage(slid);
+      return run.Finish(energy, residual);
+    }
+    const SparseMatrix& hess = p.Hessian(x, o.projection);
+    // (M + h² H) Δv = h (f - h H v), f = -∇E (Baraff and Witkin 1998, eq. 16, no damping).
+    a = hess * (h * h);
+    for (int i = 0; i < n; ++i) a.coeffRef(i, i) += p.is_fixed()[i / 3] ? 0.0 : mass(i);
+    const Eigen::VectorXd rhs = h * (-Flat(grad) - h * (hess * v));
+    if (!linear.Solve(a, rhs, &dv, &run.summary)) {
+      run.summary.message = "the implicit step's linear system could not be solved";
+      return run.Finish(energy, residual);
+    }
+    v += dv;
+    for (int vtx : p.fixed_vertices()) v.segment<3>(3 * vtx).setZero();
+    previous = x;
+    Flat(x) += h * v;
+    const double kinetic = 0.5 * v.dot(mass.asDiagonal() * v);
+    // Kinetic damping: at a peak of the kinetic energy the potential is near a minimum along
+    // the path; zero the velocities (Barnes 1988).
+    if (kinetic < kinetic_prev) {
+      v.setZero();
+      kinetic_prev = 0.0;
+    } else {
+      kinetic_prev = kinetic;
+    }
+    slid = p.UpdateAnchors(x, previous);
+    energy = p.EnergyGradient(x, &grad);
+    residual = p.RelativeResidual(grad);
+  }
+}
+
+// Barycentric coordinates of p in triangle (a, b, c) in the x-y plane.
+Eigen::Vector3d Barycentric2d(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                              const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+  const Eigen::Vector2d v0 = b - a, v1 = c - a, v2 = p - a;
+  const double den = v0.x() * v1.y() - v1.x() * v0.y();
+  const double l1 = (v2.x() * v1.y() - v1.x() * v2.y()) / den;
+  const double l2 = (v0.x() * v2.y() - v2.x() * v0.y()) / den;
+  return {1.0 - l1 - l2, l1, l2};
+}
+
+// The point of triangle (a, b, c) nearest to p, as clamped barycentric coordinates.
+Eigen::Vector3d ClampedBarycentric(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                                   const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                                   double* distance) {
+  Eigen::Vector3d l = Barycentric2d(p, a, b, c);
+  if (l.minCoeff() >= 0.0) {
+    *distance = 0.0;
+    return l;
+  }
+  // Nearest point on the three edges.
+  const Eigen::Vector2d corners[3] = {a, b, c};
+  double best = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d best_l = l;
+  for (int e = 0; e < 3; ++e) {
+    const Eigen::Vector2d& u = corners[e];
+    const Eigen::Vector2d& w = corners[(e + 1) % 3];
+    const double t = std::clamp((p - u).dot(w - u) / (w - u).squaredNorm(), 0.0, 1.0);
+    const double dist = (p - (u + t * (w - u))).norm();
+    if (dist < best) {
+      best = dist;
+      best_l.setZero();
+      best_l(e) = 1.0 - t;
+      best_l((e + 1) % 3) = t;
+    }
+  }
+  *distance = best;
+  return best_l;
+}
+
+}  // namespace
+
+std::string SolverMethodName(SolverMethod method) {
+  return method == SolverMethod::kNewton ? "newton" : "kinetic";
+}
+
+SolverMethod ParseSolverMethod(const std::string& name) {
+  if (name == "newton") return SolverMethod::kNewton;
+  if (name == "kinetic") return SolverMethod::kKineticDamping;
+  throw InputError("unknown solver '" + name + "' (newton, kinetic)");
+}
+
+bool SolveOptions::Check(std::string* why) const {
+  auto fail = [&](const std::string& w) {
+    *why = w;
+    return false;
+  };
+  if (!(tolerance > 0.0) || !std::isfinite(tolerance)) return fail("tolerance must be > 0");
+  if (max_iterations < 0) return fail("max_iterations must be >= 0");
+  if (!(max_seconds > 0.0)) return fail("max_seconds must be > 0");
+  if (!(max_step >= 0.0) || !std::isfinite(max_step)) return fail("max_step must be >= 0");
+  if (!(time_step > 0.0) || !std::isfinite(time_step)) return fail("time_step must be > 0");
+  if (!(cg_tolerance > 0.0) || cg_tolerance >= 1.0) return fail("cg_tolerance must be in (0, 1)");
+  if (cg_max_iterations < 1) return fail("cg_max_iterations must be >= 1");
+  if (!(anchor_tolerance >= 0.0)) return fail("anchor_tolerance must be >= 0");
+  if (!(fall_limit > 0.0)) return fail("fall_limit must be > 0");
+  return true;
+}
+
+std::string SolveSummary::BriefReport() const {
+  std::ostringstream out;
+  out << method << ": " << (converged ? "converged" : "NOT converged") << " after " << iterations
+      << " iterations in " << seconds << " s, residual " << residual << " of the weight, energy "
+      << energy << " J";
+  if (contacts > 0) out << ", " << contacts << " nodes in contact";
+  if (!converged) out << " (" << message << ")";
+  return out.str();
+}
+
+SolveSummary SolveStatic(ClothProblem* problem, Vertices* x, const SolveOptions& options) {
+  Run run(problem, x, options);
+  run.summary.method = SolverMethodName(options.method);
+  if (!run.Start()) {
+    Vertices grad;
+    const double e = problem->EnergyGradient(*x, &grad);
+    return run.Finish(e, problem->RelativeResidual(grad));
+  }
+  return options.method == SolverMethod::kNewton ? Newton(run) : KineticDamping(run);
+}
+
+Eigen::SparseMatrix<double> BarycentricProlongation(const TriangleMesh& coarse_rest,
+                                                    const TriangleMesh& fine_rest) {
+  if (coarse_rest.num_triangles() == 0 || fine_rest.num_vertices() == 0)
+    throw InputError("prolongation: empty mesh");
+  const int nc = coarse_rest.num_triangles();
+  // Bucket grid over the coarse triangles' bounding boxes.
+  const Eigen::Vector2d lo = coarse_rest.vertices.leftCols<2>().colwise().minCoeff();
+  const Eigen::Vector2d hi = coarse_rest.vertices.leftCols<2>().colwise().maxCoeff();
+  const int cells = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(nc))));
+  const Eigen::Vector2d size = ((hi - lo) / cells).cwiseMax(1e-12);
+  auto cell_of = [&](const Eigen::Vector2d& p) {
+    const Eigen::Vector2d c = ((p - lo).array() / size.array()).floor();
+    return Eigen::Vector2i(std::clamp(static_cast<int>(c.x()), 0, cells - 1),
+                           std::clamp(static_cast<int>(c.y()), 0, cells - 1));
+  };
+  std::vector<std::vector<int>> bucket(static_cast<size_t>(cells) * cells);
+  auto corner = [&](int f, int k) -> Eigen::Vector2d {
+    return coarse_rest.vertices.row(coarse_rest.triangles(f, k)).head<2>().transpose();
+  };
+  for (int f = 0; f < nc; ++f) {
+    Eigen::Vector2d a = corner(f, 0), b = a;
+    for (int k = 1; k < 3; ++k) {
+      a = a.cwiseMin(corner(f, k));
+      b = b.cwiseMax(corner(f, k));
+    }
+    const Eigen::Vector2i c0 = cell_of(a), c1 = cell_of(b);
+    for (int i = c0.x(); i <= c1.x(); ++i)
+      for (int j = c0.y(); j <= c1.y(); ++j) bucket[static_cast<size_t>(i) * cells + j].push_back(f);
+  }
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (int v = 0; v < fine_rest.num_vertices(); ++v) {
+    const Eigen::Vector2d p = fine_rest.vertices.row(v).head<2>().transpose();
+    const Eigen::Vector2i c = cell_of(p);
+    int best_f = -1;
+    double best_d = std::numeric_limits<double>::infinity();
+    Eigen::Vector3d best_l;
+    // Search the point's cell, then rings around it until a containing triangle is found or
+    // the ring is further away than the nearest candidate.
+    for (int ring = 0; ring <= cells && best_d > 0.0; ++ring) {
+      if (best_f >= 0 && (ring - 1) * size.minCoeff() > best_d) break;
+      for (int i = c.x() - ring; i <= c.x() + ring; ++i) {
+        for (int j = c.y() - ring; j <= c.y() + ring; ++j) {
+          if (i < 0 || j < 0 || i >= cells || j >= cells) continue;
+          if (std::max(std::abs(i - c.x()), std::abs(j - c.y())) != ring) continue;
+          for (int f : bucket[static_cast<size_t>(i) * cells + j]) {
+            double d;
+            const Eigen::Vector3d l = ClampedBarycentric(p, corner(f, 0), corner(f, 1), corner(f, 2), &d);
+            if (d < best_d) {
+              best_d = d;
+              best_f = f;
+              best_l = l;
+            }
+          }
+        }
+      }
+    }
+    for (int k = 0; k < 3; ++k)
+      if (best_l(k) != 0.0) triplets.emplace_back(v, coarse_rest.triangles(best_f, k), best_l(k));
+  }
+  Eigen::SparseMatrix<double> prolongation(fine_rest.num_vertices(), coarse_rest.num_vertices());
+  prolongation.setFromTriplets(triplets.begin(), triplets.end());
+  return prolongation;
+}
+
+SolveSummary SolveCascadic(ClothProblem* coarse, ClothProblem* fine, Vertices* x_coarse,
+                           Vertices* x_fine, const SolveOptions& options) {
+  const auto start = Clock::now();
+  SolveOptions coarse_options = options;
+  coarse_options.tolerance = 10.0 * options.tolerance;
+  const SolveSummary c = SolveStatic(coarse, x_coarse, coarse_options);
+  if (!c.converged) {
+    SolveSummary s = c;
+    s.method = "cascadic";
+    s.message = "coarse level: " + c.message;
+    s.coarse_iterations = c.iterations;
+    s.coarse_seconds = c.seconds;
+    s.iterations = 0;
+    return s;
+  }
+  const Eigen::SparseMatrix<double> prolongation =
+      BarycentricProlongation(coarse->rest(), fine->rest());
+  *x_fine = prolongation * (*x_coarse);
+  SolveOptions fine_options = options;
+  fine_options.max_seconds = std::max(1e-3, options.max_seconds - c.seconds);
+  SolveSummary f = SolveStatic(fine, x_fine, fine_options);
+  f.method = "cascadic";
+  f.coarse_iterations = c.iterations;
+  f.coarse_seconds = c.seconds;
+  f.seconds = Since(start);
+  return f;
+}
+
+}  // namespace textile

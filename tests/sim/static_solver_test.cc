@@ -1,0 +1,448 @@
+#include "textile/sim/static_solver.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "textile/sim/error.h"
+#include "textile/sim/units.h"
+
+namespace textile {
+namespace {
+
+// The paper's cotton (Pabst Table 1 row used throughout), 200 g/m².
+Material Cotton() {
+  Material m;
+  m.areal_density = 0.2;
+  m.bending = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+  return m;
+}
+
+std::vector<int> VerticesWhere(const TriangleMesh& mesh, const std::function<bool(double, double)>& f) {
+  std::vector<int> ids;
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    if (f(mesh.vertices(v, 0), mesh.vertices(v, 1))) ids.push_back(v);
+  return ids;
+}
+
+Vertices Rows(const Vertices& x, const std::vector<int>& ids) {
+  Vertices out(static_cast<long>(ids.size()), 3);
+  for (size_t k = 0; k < ids.size(); ++k) out.row(static_cast<long>(k)) = x.row(ids[k]);
+  return out;
+}
+
+// A 0.2 m × 0.12 m sheet held along its edge x = 0, hanging under gravity.
+struct HangingSheet {
+  TriangleMesh mesh;
+  std::unique_ptr<ClothProblem> problem;
+  explicit HangingSheet(int nx = 10, int ny = 6, ClothOptions options = {}) {
+    mesh = CrissCrossGridMesh(0.2, 0.12, nx, ny);
+    problem = std::make_unique<ClothProblem>(mesh, Cotton(), std::vector<Seam>{}, options);
+    const auto edge = VerticesWhere(mesh, [](double x, double) { return x < 1e-12; });
+    problem->FixVertices(edge, Rows(mesh.vertices, edge));
+  }
+};
+
+// A smooth random start: the flat sheet turned about the held edge by up to ±60° plus a few
+// low-frequency random displacement waves (amplitude up to `amplitude` [m]) that vanish at the
+// held edge. No tangles: every such start lies in the basin of the hanging state.
+Vertices SmoothRandomStart(const TriangleMesh& mesh, double amplitude, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const double length = mesh.vertices.col(0).maxCoeff();
+  const double width = mesh.vertices.col(1).maxCoeff();
+  const double angle = u(rng) * M_PI / 3.0;
+  Vertices x = mesh.vertices;
+  for (int i = 0; i < x.rows(); ++i) {
+    x(i, 0) = mesh.vertices(i, 0) * std::cos(angle);
+    x(i, 2) = mesh.vertices(i, 0) * std::sin(angle);
+  }
+  for (int k = 0; k < 6; ++k) {
+    const double a = amplitude * u(rng), kx = 1.0 + 2.0 * std::abs(u(rng));
+    const double ky = 2.0 * std::abs(u(rng)), phase = M_PI * u(rng);
+    for (int i = 0; i < x.rows(); ++i) {
+      const double s = mesh.vertices(i, 0) / length, t = mesh.vertices(i, 1) / width;
+      x(i, k % 3) += a * s * std::sin(kx * M_PI * s + phase) * std::cos(ky * M_PI * t);
+    }
+  }
+  return x;
+}
+
+TEST(StaticSolver, HangingSheetReachesOneEquilibriumFromEveryStartWithEverySolver) {
+  struct Variant {
+    std::string name;
+    SolverMethod method;
+    LinearSolverKind linear;
+  };
+  const std::vector<Variant> variants = {
+      {"newton+cholmod", SolverMethod::kNewton, LinearSolverKind::kCholmod},
+      {"newton+cg", SolverMethod::kNewton, LinearSolverKind::kConjugateGradient},
+      {"kinetic", SolverMethod::kKineticDamping, LinearSolverKind::kCholmod},
+  };
+  double reference_energy = 0.0;
+  Vertices reference;
+  for (const Variant& variant : variants) {
+    for (unsigned seed = 0; seed < 3; ++seed) {
+      HangingSheet sheet;
+      Vertices x = seed == 0 ? sheet.mesh.vertices : SmoothRandomStart(sheet.mesh, 0.03, seed);
+      SolveOptions options;
+      options.method = variant.method;
+      options.linear = variant.linear;
+      options.tolerance = 1e-8;
+      options.max_iterations = 3000;
+      const SolveSummary s = SolveStatic(sheet.problem.get(), &x, options);
+      SCOPED_TRACE(variant.name + " seed " + std::to_string(seed) + ": " + s.BriefReport());
+      ASSERT_TRUE(s.converged);
+      if (reference.size() == 0) {
+        reference = x;
+        reference_energy = s.energy;
+        continue;
+      }
+      // 1e-6 relative in energy is the stability benchmark's criterion.
+      EXPECT_NEAR(s.energy, reference_energy, 1e-6 * std::abs(reference_energy));
+      // Positions: a residual of 1e-8 of the weight leaves sub-micrometre differences.
+      EXPECT_LT((x - reference).cwiseAbs().maxCoeff(), 1e-5);
+    }
+  }
+  // The sheet hangs straight down: the far edge lies about its length below the held one
+  // (nearly inextensible at 1000 N/m under 0.24 N; the bending near the edge costs a little).
+  const double lowest = reference.col(2).minCoeff();
+  EXPECT_LT(lowest, -0.19);
+  EXPECT_GT(lowest, -0.2005);
+  // Every vertex below the held edge, none beside it.
+  EXPECT_LT(reference.col(0).cwiseAbs().maxCoeff(), 0.02);
+}
+
+TEST(StaticSolver, ReportedResidualIsTheTrueOneAndHonoursTheTolerance) {
+  for (double tolerance : {1e-3, 1e-7}) {
+    HangingSheet sheet;
+    Vertices x = sheet.mesh.vertices;
+    SolveOptions options;
+    options.tolerance = tolerance;
+    const SolveSummary s = SolveStatic(sheet.problem.get(), &x, options);
+    ASSERT_TRUE(s.converged) << s.BriefReport();
+    Vertices grad;
+    const double energy = sheet.problem->EnergyGradient(x, &grad);
+    EXPECT_LT(sheet.problem->RelativeResidual(grad), tolerance);
+    EXPECT_DOUBLE_EQ(s.residual, sheet.problem->RelativeResidual(grad));
+    EXPECT_DOUBLE_EQ(s.energy, energy);
+    // Fixed vertices stay where they were put.
+    for (int v : sheet.problem->fixed_vertices())
+      EXPECT_EQ((x.row(v) - sheet.mesh.vertices.row(v)).norm(), 0.0);
+  }
+}
+
+TEST(StaticSolver, CapsStopARunAndSayWhyWithoutClaimingConvergence) {
+  HangingSheet sheet;
+  Vertices x = sheet.mesh.vertices;
+  SolveOptions options;
+  options.max_iterations = 2;
+  const SolveSummary s = SolveStatic(sheet.problem.get(), &x, options);
+  EXPECT_FALSE(s.converged);
+  EXPECT_NE(s.message.find("iteration cap of 2"), std::string::npos) << s.message;
+  EXPECT_NE(s.BriefReport().find("NOT converged"), std::string::npos);
+  EXPECT_GT(s.residual, options.tolerance);
+}
+
+TEST(StaticSolver, ImpossibleProblemsAreReportedAsSuch) {
+  const TriangleMesh mesh = CrissCrossGridMesh(0.1, 0.1, 4, 4);
+  {  // nothing at all holds the cloth
+    ClothProblem problem(mesh, Cotton(), {}, {});
+    Vertices x = mesh.vertices;
+    const SolveSummary s = SolveStatic(&problem, &x, {});
+    EXPECT_FALSE(s.converged);
+    EXPECT_NE(s.message.find("nothing holds the cloth"), std::string::npos) << s.message;
+    EXPECT_EQ(s.iterations, 0);
+  }
+  {  // a support that is not under the cloth: it falls past it
+    ClothProblem problem(mesh, Cotton(), {}, {});
+    problem.AddSupport(Support::Box({5.0, 5.0, -0.1}, {0.05, 0.05, 0.05}, 0.0));
+    Vertices x = mesh.vertices;
+    SolveOptions options;
+    options.max_iterations = 100000;
+    const SolveSummary s = SolveStatic(&problem, &x, options);
+    EXPECT_FALSE(s.converged);
+    EXPECT_NE(s.message.find("falls"), std::string::npos) << s.message;
+  }
+}
+
+TEST(StaticSolver, BadInputIsRefused) {
+  HangingSheet sheet;
+  Vertices wrong(3, 3);
+  wrong.setZero();
+  EXPECT_THROW(SolveStatic(sheet.problem.get(), &wrong, {}), InputError);
+  Vertices x = sheet.mesh.vertices;
+  x(5, 2) = std::nan("");
+  EXPECT_THROW(SolveStatic(sheet.problem.get(), &x, {}), InputError);
+  x = sheet.mesh.vertices;
+  SolveOptions bad;
+  bad.tolerance = -1.0;
+  try {
+    SolveStatic(sheet.problem.get(), &x, bad);
+    FAIL() << "negative tolerance accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("tolerance"), std::string::npos);
+  }
+  EXPECT_THROW(ParseSolverMethod("gauss-seidel"), InputError);
+  EXPECT_THROW(sheet.problem->FixVertices({0, 0}, Rows(sheet.mesh.vertices, {0, 0})), InputError);
+  EXPECT_THROW(sheet.problem->FixVertices({-1}, Rows(sheet.mesh.vertices, {0})), InputError);
+}
+
+// A 0.1 m square sheet lying on a plane tilted by `degrees` about the y axis.
+struct SheetOnSlope {
+  TriangleMesh mesh = CrissCrossGridMesh(0.1, 0.1, 5, 5);
+  std::unique_ptr<ClothProblem> problem;
+  Vertices start;
+  Eigen::Vector3d downhill;
+  explicit SheetOnSlope(double degrees, double friction) {
+    ClothOptions options;
+    options.contact.friction = friction;
+    problem = std::make_unique<ClothProblem>(mesh, Cotton(), std::vector<Seam>{}, options);
+    const double a = degrees * M_PI / 180.0;
+    const Eigen::Vector3d normal(-std::sin(a), 0.0, std::cos(a));
+    downhill = Eigen::Vector3d(-std::cos(a), 0.0, -std::sin(a));
+    problem->AddSupport(Support::Plane(Eigen::Vector3d::Zero(), normal));
+    // The sheet lies in the slope, 0.1 mm above it, so it lands on it in the first step.
+    start.resize(mesh.num_vertices(), 3);
+    for (int i = 0; i < mesh.num_vertices(); ++i) {
+      const double u = mesh.vertices(i, 0), v = mesh.vertices(i, 1);
+      start.row(i) = (-u * downhill + Eigen::Vector3d(0, v, 0) + 1e-4 * normal).transpose();
+    }
+  }
+  // Mean displacement down the slope [m].
+  double Slid(const Vertices& x) const {
+    return ((x - start) * downhill).mean();
+  }
+};
+
+TEST(StaticSolver, FrictionHoldsASheetBelowTheFrictionAngleAndLetsItSlideAbove) {
+  const double mu = 0.3;  // friction angle atan(0.3) = 16.7°
+  {
+    SheetOnSlope slope(10.0, mu);
+    Vertices x = slope.start;
+    const SolveSummary s = SolveStatic(slope.problem.get(), &x, {});
+    ASSERT_TRUE(s.converged) << s.BriefReport();
+    EXPECT_EQ(s.contacts, slope.mesh.num_vertices());
+    // It stays put: the anchor springs stretch by about sink × tan 10° (1e-5 m × 0.18).
+    EXPECT_LT(std::abs(slope.Slid(x)), 1e-4);
+  }
+  {
+    SheetOnSlope slope(25.0, mu);
+    Vertices x = slope.start;
+    SolveOptions options;
+    options.max_iterations = 200;
+    const SolveSummary s = SolveStatic(slope.problem.get(), &x, options);
+    EXPECT_FALSE(s.converged) << s.BriefReport();
+    EXPECT_NE(s.message.find("slides"), std::string::npos) << s.BriefReport();
+    EXPECT_GT(slope.Slid(x), 1e-4);
+  }
+  {  // frictionless: a sheet on any slope slides
+    SheetOnSlope slope(5.0, 0.0);
+    Vertices x = slope.start;
+    SolveOptions options;
+    options.max_iterations = 50;
+    const SolveSummary s = SolveStatic(slope.problem.get(), &x, options);
+    EXPECT_FALSE(s.converged);
+    EXPECT_GT(slope.Slid(x), 1e-2);
+  }
+}
+
+TEST(StaticSolver, NothingPassesThroughASupport) {
+  // A 0.3 m square of cloth dropped onto a 0.09 m disk support 1 cm thick (the drapemeter's
+  // support), its centre pinned sideways only by symmetry: the centre vertex is fixed at the
+  // support's height, as in the clamped drapemeter; frictionless so every other node is free to
+  // slide over the support and the rim. Then the same cloth dropped flat onto a box with friction.
+  const TriangleMesh mesh = CrissCrossGridMesh(0.3, 0.3, 8, 8);
+  const std::vector<int> centre =
+      VerticesWhere(mesh, [](double x, double y) { return std::hypot(x - 0.15, y - 0.15) < 1e-9; });
+  ASSERT_EQ(centre.size(), 1u);
+  {
+    ClothOptions options;
+    options.contact.friction = 0.0;
+    ClothProblem problem(mesh, Cotton(), {}, options);
+    const Support table = Support::Disk({0.15, 0.15, 0.0}, 0.09, 0.01, 0.001);
+    problem.AddSupport(table);
+    Vertices pin(1, 3);
+    pin << 0.15, 0.15, 0.0;
+    problem.FixVertices(centre, pin);
+    Vertices x = mesh.vertices;
+    x.col(2).array() += 0.002;
+    SolveOptions solve;
+    solve.max_iterations = 2000;
+    const SolveSummary s = SolveStatic(&problem, &x, solve);
+    ASSERT_TRUE(s.converged) << s.BriefReport();
+    EXPECT_GT(s.contacts, 10);
+    double deepest = 0.0;
+    for (int i = 0; i < x.rows(); ++i)
+      deepest = std::min(deepest, table.SignedDistance(x.row(i).transpose(), nullptr));
+    // The penalty lets a node sink by its load / k: a few times the 1e-5 m of its own weight.
+    EXPECT_GT(deepest, -2e-4);
+    EXPECT_LT(x.col(2).minCoeff(), -0.03);  // the part off the support hangs down
+  }
+  {
+    ClothOptions options;
+    options.contact.friction = 0.3;
+    ClothProblem problem(mesh, Cotton(), {}, options);
+    const Support box = Support::Box({0.15, 0.15, -0.05}, {0.2, 0.2, 0.05}, 0.002);
+    problem.AddSupport(box);
+    Vertices x = mesh.vertices;
+    x.col(2).array() += 0.005;
+    const SolveSummary s = SolveStatic(&problem, &x, {});
+    ASSERT_TRUE(s.converged) << s.BriefReport();
+    EXPECT_EQ(s.contacts, mesh.num_vertices());
+    double deepest = 0.0;
+    for (int i = 0; i < x.rows(); ++i)
+      deepest = std::min(deepest, box.SignedDistance(x.row(i).transpose(), nullptr));
+    EXPECT_GT(deepest, -2e-5);  // each node carries only its own weight: 1e-5 m
+    EXPECT_LT((x.leftCols<2>() - mesh.vertices.leftCols<2>()).cwiseAbs().maxCoeff(), 1e-4);
+  }
+}
+
+TEST(StaticSolver, CascadicCoarseToFineReachesTheFineSolution) {
+  HangingSheet coarse(6, 4), fine(12, 8);
+  Vertices x_coarse = coarse.mesh.vertices, x_fine;
+  SolveOptions options;
+  options.tolerance = 1e-8;
+  const SolveSummary s =
+      SolveCascadic(coarse.problem.get(), fine.problem.get(), &x_coarse, &x_fine, options);
+  ASSERT_TRUE(s.converged) << s.BriefReport();
+  EXPECT_EQ(s.method, "cascadic");
+  EXPECT_GT(s.coarse_iterations, 0);
+  Vertices direct = fine.mesh.vertices;
+  const SolveSummary d = SolveStatic(fine.problem.get(), &direct, options);
+  ASSERT_TRUE(d.converged) << d.BriefReport();
+  EXPECT_NEAR(s.energy, d.energy, 1e-6 * std::abs(d.energy));
+  EXPECT_LT((x_fine - direct).cwiseAbs().maxCoeff(), 1e-5);
+  // A warm start near the solution needs fewer fine iterations than the cold one.
+  EXPECT_LT(s.iterations, d.iterations);
+}
+
+TEST(Prolongation, InterpolatesAffineFieldsExactlyAndRowsSumToOne) {
+  const TriangleMesh coarse = CrissCrossGridMesh(0.2, 0.1, 3, 2);
+  const TriangleMesh fine = RegularGridMesh(0.2, 0.1, 17, 9);
+  const Eigen::SparseMatrix<double> p = BarycentricProlongation(coarse, fine);
+  ASSERT_EQ(p.rows(), fine.num_vertices());
+  ASSERT_EQ(p.cols(), coarse.num_vertices());
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(coarse.num_vertices());
+  EXPECT_LT((p * ones - Eigen::VectorXd::Ones(fine.num_vertices())).cwiseAbs().maxCoeff(), 1e-12);
+  auto field = [](const Eigen::RowVector3d& v) { return 3.0 * v.x() - 2.0 * v.y() + 0.5; };
+  Eigen::VectorXd fc(coarse.num_vertices()), ff(fine.num_vertices());
+  for (int i = 0; i < coarse.num_vertices(); ++i) fc(i) = field(coarse.vertices.row(i));
+  for (int i = 0; i < fine.num_vertices(); ++i) ff(i) = field(fine.vertices.row(i));
+  EXPECT_LT((p * fc - ff).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_THROW(BarycentricProlongation(TriangleMesh{}, fine), InputError);
+}
+
+TEST(ClothProblem, GradientAndHessianMatchFiniteDifferencesWithContactAndAnchors) {
+  const TriangleMesh mesh = CrissCrossGridMesh(0.05, 0.05, 3, 3);
+  ClothOptions options;
+  options.membrane = MembraneModel::kStVK;
+  ClothProblem problem(mesh, Cotton(), {}, options);
+  problem.AddSupport(Support::Plane({0, 0, 0}, {0, 0, 1}));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Vertices x = mesh.vertices;
+  for (int i = 0; i < x.rows(); ++i) {
+    x.row(i) += 2e-3 * Eigen::RowVector3d(u(rng), u(rng), u(rng));
+    x(i, 2) = -2e-4 * std::abs(u(rng)) - 1e-5;  // every node inside the plane: penalties act
+  }
+  Vertices moved = x;
+  moved.col(0).array() += 1e-4;  // anchors set at x, springs stretched at moved
+  problem.UpdateAnchors(x, x);
+  ASSERT_EQ(problem.num_anchors(), mesh.num_vertices());
+  Vertices grad;
+  problem.EnergyGradient(moved, &grad);
+  const double h = 1e-7;
+  for (int i = 0; i < moved.rows(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      Vertices plus = moved, minus = moved;
+      plus(i, c) += h;
+      minus(i, c) -= h;
+      const double fd = (problem.Energy(plus) - problem.Energy(minus)) / (2 * h);
+      EXPECT_NEAR(grad(i, c), fd, 1e-6 * (1.0 + std::abs(fd))) << "vertex " << i << " coord " << c;
+    }
+  }
+  // Hessian (exact bending blocks; the plane's penalty Hessian is exact too) against finite
+  // differences of the gradient.
+  const Eigen::MatrixXd hess = Eigen::MatrixXd(problem.Hessian(moved, HessianProjection::kNone));
+  for (int j = 0; j < 3 * moved.rows(); ++j) {
+    Vertices plus = moved, minus = moved;
+    plus(j / 3, j % 3) += h;
+    minus(j / 3, j % 3) -= h;
+    Vertices gp, gm;
+    problem.EnergyGradient(plus, &gp);
+    problem.EnergyGradient(minus, &gm);
+    const Eigen::Map<const Eigen::VectorXd> fp(gp.data(), gp.size()), fm(gm.data(), gm.size());
+    const Eigen::VectorXd column = (fp - fm) / (2 * h);
+    EXPECT_LT((hess.col(j) - column).cwiseAbs().maxCoeff(), 1e-4 * (1.0 + column.cwiseAbs().maxCoeff()))
+        << "column " << j;
+  }
+}
+
+TEST(ClothProblem, FixedVerticesHaveIdentityRowsAndZeroForce) {
+  HangingSheet sheet;
+  Vertices x = sheet.mesh.vertices;
+  x.col(2).array() -= 0.01;
+  sheet.problem->ApplyFixed(&x);
+  Vertices grad;
+  sheet.problem->EnergyGradient(x, &grad);
+  const Eigen::SparseMatrix<double>& h = sheet.problem->Hessian(x, HessianProjection::kGaussNewton);
+  for (int v : sheet.problem->fixed_vertices()) {
+    EXPECT_EQ(grad.row(v).norm(), 0.0);
+    for (int c = 0; c < 3; ++c) {
+      const int dof = 3 * v + c;
+      for (Eigen::SparseMatrix<double>::InnerIterator it(h, dof); it; ++it) {
+        if (it.row() != dof) {
+          EXPECT_EQ(it.value(), 0.0);
+        }
+      }
+      EXPECT_GT(h.coeff(dof, dof), 0.0);
+    }
+  }
+}
+
+TEST(ClothProblem, WeightAndMassDoNotDependOnTheMesh) {
+  const double area = 0.2 * 0.12;
+  for (int n : {4, 9}) {
+    const TriangleMesh mesh = CrissCrossGridMesh(0.2, 0.12, n, n);
+    ClothProblem problem(mesh, Cotton(), {}, {});
+    EXPECT_NEAR(problem.total_mass(), 0.2 * area, 1e-15);
+    EXPECT_NEAR(problem.FreeWeight(), 0.2 * area * units::kGravity, 1e-12);
+  }
+}
+
+TEST(Support, DistancesAndNormalsAreConsistent) {
+  const std::vector<Support> shapes = {
+      Support::Plane({0, 0, 0.1}, {0, 1, 1}),
+      Support::Box({0, 0, 0}, {0.1, 0.05, 0.02}, 0.005),
+      Support::Disk({0, 0, 0}, 0.09, 0.01, 0.001),
+  };
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-0.15, 0.15);
+  for (const Support& s : shapes) {
+    for (int k = 0; k < 200; ++k) {
+      const Eigen::Vector3d p(u(rng), u(rng), 0.3 * u(rng));
+      Eigen::Vector3d n;
+      const double d = s.SignedDistance(p, &n);
+      EXPECT_NEAR(n.norm(), 1.0, 1e-12) << s.Describe();
+      // The gradient of a distance function: moving along n changes d one for one.
+      const double h = 1e-7;
+      if (std::abs(d) > 1e-4) {  // away from the medial surface
+        EXPECT_NEAR(s.SignedDistance(p + h * n, nullptr) - d, h, 1e-9) << s.Describe();
+      }
+    }
+  }
+  // Known values.
+  const Support& disk = shapes[2];
+  EXPECT_NEAR(disk.SignedDistance({0, 0, 0.003}, nullptr), 0.003, 1e-15);           // above
+  EXPECT_NEAR(disk.SignedDistance({0, 0, -0.004}, nullptr), -0.004, 1e-15);         // inside
+  EXPECT_NEAR(disk.SignedDistance({0.1, 0, -0.005}, nullptr), 0.01, 1e-15);         // beside
+  EXPECT_NEAR(shapes[1].SignedDistance({0.2, 0, 0}, nullptr), 0.1, 1e-15);
+  EXPECT_THROW(Support::Box({0, 0, 0}, {0.1, -0.1, 0.1}, 0.0), InputError);
+  EXPECT_THROW(Support::Disk({0, 0, 0}, 0.09, 0.01, 0.02), InputError);
+  EXPECT_THROW(Support::Plane({0, 0, 0}, {0, 0, 0}), InputError);
+}
+
+}  // namespace
+}  // namespace textile

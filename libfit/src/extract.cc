@@ -388,21 +388,27 @@ std::vector<Vec2> LevelSetCentreline(const cv::Mat& mask, const std::vector<cv::
 // A hanging strip bends gently (radii of many thicknesses); a centre line that turns sharply
 // has wandered into a brush of fibres or along a lit end face. Cuts the line (1 px spacing)
 // where its direction over `base` px turns by more than 35° from the stretch before.
-// Moreover the moment, hence the curvature, of a cantilever falls towards its free end: in the
-// outer half of the line the turn per `base` may not grow by more than 12° over the least turn
-// seen before; where it does, the line is cut.
+// Moreover the moment, hence the curvature, of a cantilever falls from the edge towards its free
+// end: once the turn per `base` has passed its peak (the edge; before it the strip may lie flat
+// on a platform), in the outer half of the line it may not grow again by more than 12° over the
+// least turn seen since that peak; where it does, the line is cut.
 void CutAtSharpTurn(std::vector<Vec2>* line, double base, bool check_growth) {
   const int b = static_cast<int>(base);
   const int n = static_cast<int>(line->size());
-  double least = 1e9;
+  double peak = -1.0, least = 1e9;
   for (int i = b; i + b < n; ++i) {
     const Vec2 before = ((*line)[i] - (*line)[i - b]).normalized();
     const Vec2 after = ((*line)[i + b] - (*line)[i]).normalized();
     const double turn = std::acos(std::clamp(before.dot(after), -1.0, 1.0));
-    if (i > n / 2) least = std::min(least, turn);
-    if (turn > 35.0 * kDeg || (check_growth && turn > least + 12.0 * kDeg)) {
+    if (turn > 35.0 * kDeg || (check_growth && i > n / 2 && turn > least + 12.0 * kDeg)) {
       line->resize(i + 1);
       return;
+    }
+    if (turn >= peak) {
+      peak = turn;  // still rising towards the edge's curvature
+      least = turn;
+    } else {
+      least = std::min(least, turn);
     }
   }
 }

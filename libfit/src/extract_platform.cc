@@ -117,25 +117,60 @@ std::vector<Block> FindBlocks(const cv::Mat& small, const cv::Mat& ignore, doubl
     }
   }
   if (rows.size() < 50) return {};
-  Eigen::Matrix<double, 6, 1> coef = Eigen::Matrix<double, 6, 1>::Zero();
-  std::vector<char> inlier(rows.size(), 1);
-  double sigma = 0.5;
-  for (int iter = 0; iter < 8; ++iter) {
-    Eigen::Matrix<double, 6, 6> n = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> r = Eigen::Matrix<double, 6, 1>::Zero();
-    for (size_t i = 0; i < rows.size(); ++i) {
-      if (!inlier[i]) continue;
-      n += rows[i] * rows[i].transpose();
-      r += rows[i] * values[i];
+  // Trimmed least squares from a starting set of inliers: fit, then keep samples within 2.5σ.
+  const auto robust_fit = [&](std::vector<char> inlier, Eigen::Matrix<double, 6, 1>* coef) {
+    double sigma = 0.5;
+    for (int iter = 0; iter < 8; ++iter) {
+      Eigen::Matrix<double, 6, 6> n = Eigen::Matrix<double, 6, 6>::Zero();
+      Eigen::Matrix<double, 6, 1> r = Eigen::Matrix<double, 6, 1>::Zero();
+      for (size_t i = 0; i < rows.size(); ++i) {
+        if (!inlier[i]) continue;
+        n += rows[i] * rows[i].transpose();
+        r += rows[i] * values[i];
+      }
+      *coef = n.ldlt().solve(r);
+      std::vector<double> abs_in;
+      for (size_t i = 0; i < rows.size(); ++i)
+        if (inlier[i]) abs_in.push_back(std::abs(values[i] - coef->dot(rows[i])));
+      sigma = std::max(0.5, 1.4826 * Median(abs_in));
+      for (size_t i = 0; i < rows.size(); ++i)
+        inlier[i] = std::abs(values[i] - coef->dot(rows[i])) <= 2.5 * sigma;
     }
-    coef = n.ldlt().solve(r);
-    std::vector<double> res(rows.size());
-    for (size_t i = 0; i < rows.size(); ++i) res[i] = values[i] - coef.dot(rows[i]);
-    std::vector<double> abs_in;
-    for (size_t i = 0; i < rows.size(); ++i)
-      if (inlier[i]) abs_in.push_back(std::abs(res[i]));
-    sigma = std::max(0.5, 1.4826 * Median(abs_in));
-    for (size_t i = 0; i < rows.size(); ++i) inlier[i] = std::abs(res[i]) <= 2.5 * sigma;
+    return sigma;
+  };
+  // Two starts: every sample, and the samples near the most common grey (smoothed histogram).
+  // The first settles between background and a platform that covers a third of the photo or
+  // more, and its trimming then keeps both; the second can stay on a patch of a background whose
+  // light falls off strongly. The fit that explains more samples within a tight band wins.
+  std::vector<double> hist(256, 0.0);
+  for (double v : values) {
+    for (int k = -4; k <= 4; ++k) {
+      const int b = static_cast<int>(v) + k;
+      if (b >= 0 && b < 256) hist[b] += 1.0;
+    }
+  }
+  const double mode =
+      static_cast<double>(std::max_element(hist.begin(), hist.end()) - hist.begin());
+  std::vector<char> near_mode(rows.size());
+  size_t count_near = 0;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    near_mode[i] = std::abs(values[i] - mode) <= 20.0;
+    count_near += near_mode[i];
+  }
+  Eigen::Matrix<double, 6, 1> coef, coef_mode;
+  double sigma = robust_fit(std::vector<char>(rows.size(), 1), &coef);
+  if (count_near >= 50) {
+    const double sigma_mode = robust_fit(near_mode, &coef_mode);
+    const double band = std::max(3.0 * std::min(sigma, sigma_mode), 3.0);
+    size_t explained = 0, explained_mode = 0;
+    for (size_t i = 0; i < rows.size(); ++i) {
+      explained += std::abs(values[i] - coef.dot(rows[i])) <= band;
+      explained_mode += std::abs(values[i] - coef_mode.dot(rows[i])) <= band;
+    }
+    if (explained_mode > explained) {
+      coef = coef_mode;
+      sigma = sigma_mode;
+    }
   }
   const double thr = std::max(5.0 * sigma, 3.0);
   cv::Mat pos(small.size(), CV_8U, cv::Scalar(0)), neg(small.size(), CV_8U, cv::Scalar(0));

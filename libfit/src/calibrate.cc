@@ -1,0 +1,239 @@
+// Rig calibration from chessboard photos (calibrate.h).
+
+#include "textile/fit/calibrate.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "textile/sim/error.h"
+
+namespace textile {
+namespace {
+
+double MedianOf(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// Corner spacing along rows and columns [px], median.
+double SquarePx(const std::vector<cv::Point2f>& c, int cols, int rows) {
+  std::vector<double> d;
+  for (int j = 0; j < rows; ++j) {
+    for (int i = 0; i < cols; ++i) {
+      const cv::Point2f p = c[j * cols + i];
+      if (i + 1 < cols) d.push_back(cv::norm(c[j * cols + i + 1] - p));
+      if (j + 1 < rows) d.push_back(cv::norm(c[(j + 1) * cols + i] - p));
+    }
+  }
+  return MedianOf(d);
+}
+
+Eigen::Vector2d Apply(const Eigen::Matrix3d& H, const Eigen::Vector2d& p) {
+  const Eigen::Vector3d q = H * Eigen::Vector3d(p.x(), p.y(), 1.0);
+  return q.head<2>() / q.z();
+}
+
+}  // namespace
+
+bool CalibrateOptions::Check(std::string* why) const {
+  std::ostringstream p;
+  if (cols < 3 || rows < 3 || cols > 100 || rows > 100) {
+    p << "board must have 3..100 inner corners a side, got " << cols << "x" << rows;
+  } else if (cols == rows) {
+    p << "board " << cols << "x" << rows
+      << " is square: use a board with different inner-corner counts (its orientation is then "
+         "unambiguous)";
+  } else if (!(std::isfinite(square_mm) && square_mm > 0.0 && square_mm <= 1000.0)) {
+    p << "square size must lie in (0, 1000] mm";
+  } else if (!(std::isfinite(max_error_px) && max_error_px > 0.0 && max_error_px <= 100.0)) {
+    p << "maximum error must lie in (0, 100] px";
+  } else if (detect_side_px < 400 || detect_side_px > 20000) {
+    p << "detect_side_px must lie in [400, 20000]";
+  }
+  if (why) *why = p.str();
+  return p.str().empty();
+}
+
+std::string CalibrationSummary::BriefReport() const {
+  std::ostringstream s;
+  s.precision(4);
+  if (!success) {
+    s << "calibration failed: " << message;
+    return s.str();
+  }
+  s << "rig from " << boards << " board photo(s)" << (lens_model ? " with lens distortion" : "")
+    << ": " << mm_per_px << " mm/px at the board's centre; reprojection error " << rms_error_px
+    << " px RMS (max " << max_error_px << " px) = " << rms_error_mm << " mm RMS (max "
+    << max_error_mm << " mm)";
+  if (lens_model) s << "; lens fit " << lens_rms_px << " px RMS over all boards";
+  return s.str();
+}
+
+BoardDetection DetectChessboard(const cv::Mat& gray, int cols, int rows, const std::string& source,
+                                int detect_side_px) {
+  if (gray.empty() || gray.type() != CV_8UC1) {
+    throw InputError(source + ": expected an 8-bit grey image");
+  }
+  BoardDetection d;
+  d.source = source;
+  d.image_size = gray.size();
+  const cv::Size pattern(cols, rows);
+  // Detect on a reduced image: the sector-based detector is slow on tens of megapixels, and
+  // the corners are refined at full resolution afterwards.
+  const double scale =
+      std::min(1.0, static_cast<double>(detect_side_px) / std::max(gray.cols, gray.rows));
+  cv::Mat small = gray;
+  if (scale < 1.0) cv::resize(gray, small, cv::Size(), scale, scale, cv::INTER_AREA);
+  std::vector<cv::Point2f> corners;
+  // The sector-based detector alone: the classic cv::findChessboardCorners takes about a minute
+  // to give up on a board whose corner count is wrong (adaptive thresholds tried one by one), and
+  // the exhaustive search takes as long on a photo without a board.
+  const bool found = cv::findChessboardCornersSB(small, pattern, corners, cv::CALIB_CB_NORMALIZE_IMAGE);
+  if (!found || corners.size() != static_cast<size_t>(cols * rows)) return d;
+  for (auto& c : corners) {
+    // Pixel centres at integers in both images: x_full = (x_small + 0.5) / scale - 0.5.
+    c = cv::Point2f(static_cast<float>((c.x + 0.5) / scale - 0.5),
+                    static_cast<float>((c.y + 0.5) / scale - 0.5));
+  }
+  // Sub-pixel refinement at full resolution, in a window of about a third of a square.
+  const double sq = SquarePx(corners, cols, rows);
+  const int win = std::clamp(static_cast<int>(sq / 3.0), 3, 25);
+  cv::cornerSubPix(gray, corners, cv::Size(win, win), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 60, 1e-4));
+  d.found = true;
+  d.square_px = SquarePx(corners, cols, rows);
+  for (const auto& c : corners) d.corners_px.emplace_back(c.x, c.y);
+  return d;
+}
+
+CalibrationSummary CalibrateRig(const std::vector<cv::Mat>& boards,
+                                const std::vector<std::string>& sources,
+                                const CalibrateOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (std::string why; !o.Check(&why)) throw InputError("calibrate: " + why);
+  if (boards.empty()) throw InputError("calibrate: no board photo given");
+  if (sources.size() != boards.size()) throw InputError("calibrate: one source name per photo");
+  for (size_t i = 1; i < boards.size(); ++i) {
+    if (boards[i].size() != boards[0].size()) {
+      throw InputError(sources[i] + ": " + std::to_string(boards[i].cols) + "x" +
+                       std::to_string(boards[i].rows) + " px, but " + sources[0] + " is " +
+                       std::to_string(boards[0].cols) + "x" + std::to_string(boards[0].rows) +
+                       " px (one camera, one size)");
+    }
+  }
+  CalibrationSummary s;
+  s.boards = static_cast<int>(boards.size());
+  for (size_t i = 0; i < boards.size(); ++i) {
+    s.detections.push_back(DetectChessboard(boards[i], o.cols, o.rows, sources[i], o.detect_side_px));
+    if (!s.detections.back().found) {
+      s.message = sources[i] + ": chessboard with " + std::to_string(o.cols) + "x" +
+                  std::to_string(o.rows) + " inner corners not found (check --board: inner corners, "
+                  "not squares)";
+      return s;
+    }
+  }
+  // The board's own frame [mm]: corner (i, j) at (i, j) squares.
+  std::vector<cv::Point3f> object;
+  std::vector<cv::Point2f> plane;
+  for (int j = 0; j < o.rows; ++j) {
+    for (int i = 0; i < o.cols; ++i) {
+      object.emplace_back(static_cast<float>(i * o.square_mm), static_cast<float>(j * o.square_mm), 0.f);
+      plane.emplace_back(static_cast<float>(i * o.square_mm), static_cast<float>(j * o.square_mm));
+    }
+  }
+  const auto to_cv = [](const std::vector<Eigen::Vector2d>& v) {
+    std::vector<cv::Point2f> out;
+    for (const auto& p : v) out.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
+    return out;
+  };
+
+  Rig rig;
+  rig.image_size = Eigen::Vector2i(boards[0].cols, boards[0].rows);
+  std::vector<cv::Point2f> first = to_cv(s.detections[0].corners_px);
+  if (boards.size() > 1 && o.lens) {
+    std::vector<std::vector<cv::Point3f>> objects(boards.size(), object);
+    std::vector<std::vector<cv::Point2f>> images;
+    for (const auto& d : s.detections) images.push_back(to_cv(d.corners_px));
+    cv::Mat K, dist;
+    std::vector<cv::Mat> rvecs, tvecs;
+    try {
+      s.lens_rms_px = cv::calibrateCamera(objects, images, boards[0].size(), K, dist, rvecs, tvecs);
+    } catch (const cv::Exception& e) {
+      s.message = "lens calibration failed: " + e.err;
+      return s;
+    }
+    if (!std::isfinite(s.lens_rms_px) || s.lens_rms_px > o.max_error_px) {
+      std::ostringstream m;
+      m << "lens calibration over " << boards.size() << " boards has an RMS error of "
+        << s.lens_rms_px << " px (more than " << o.max_error_px
+        << " px): the boards or the corner counts are inconsistent";
+      s.message = m.str();
+      return s;
+    }
+    Lens lens;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) lens.camera_matrix(r, c) = K.at<double>(r, c);
+    for (int k = 0; k < static_cast<int>(dist.total()); ++k) lens.distortion.push_back(dist.at<double>(k));
+    rig.lens = lens;
+    s.lens_model = true;
+    // The first board's corners without distortion, in the same camera's pixels.
+    std::vector<cv::Point2f> undistorted;
+    cv::undistortPoints(first, undistorted, K, dist, cv::noArray(), K);
+    first = undistorted;
+  }
+  // Plane <- image, least squares over all corners (no outliers on a found board).
+  const cv::Mat Hcv = cv::findHomography(first, plane, 0);
+  if (Hcv.empty()) {
+    s.message = sources[0] + ": no homography from the corners found (degenerate board view)";
+    return s;
+  }
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) rig.plane_from_image(r, c) = Hcv.at<double>(r, c);
+  rig.plane_from_image /= rig.plane_from_image(2, 2);
+  const Eigen::Matrix3d image_from_plane = rig.plane_from_image.inverse();
+
+  // Errors on the first board: in the photo (reprojected grid vs corners found, undistorted) and
+  // in the plane (corners mapped through the rig vs the true grid).
+  double se_px = 0, se_mm = 0;
+  for (size_t k = 0; k < plane.size(); ++k) {
+    const Eigen::Vector2d found(first[k].x, first[k].y);
+    const Eigen::Vector2d grid(plane[k].x, plane[k].y);
+    const double e_px = (Apply(image_from_plane, grid) - found).norm();
+    const double e_mm = (Apply(rig.plane_from_image, found) - grid).norm();
+    se_px += e_px * e_px;
+    se_mm += e_mm * e_mm;
+    s.max_error_px = std::max(s.max_error_px, e_px);
+    s.max_error_mm = std::max(s.max_error_mm, e_mm);
+  }
+  s.rms_error_px = std::sqrt(se_px / plane.size());
+  s.rms_error_mm = std::sqrt(se_mm / plane.size());
+  rig.reprojection_error_px = s.rms_error_px;
+  rig.source = sources[0];
+  const Eigen::Vector2d centre = Apply(
+      image_from_plane, Eigen::Vector2d((o.cols - 1) * o.square_mm / 2, (o.rows - 1) * o.square_mm / 2));
+  Rig probe = rig;
+  probe.lens.reset();  // the scale of the undistorted homography at the centre
+  s.mm_per_px = probe.MmPerPxAt(centre);
+  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!(s.rms_error_px <= o.max_error_px)) {
+    std::ostringstream m;
+    m.precision(3);
+    m << sources[0] << ": reprojection error " << s.rms_error_px << " px RMS is implausible (more than "
+      << o.max_error_px << " px): the board is not flat, is blurred, or the lens needs several "
+      << "board photos";
+    s.message = m.str();
+    s.rig = rig;
+    return s;
+  }
+  s.rig = rig;
+  s.success = true;
+  return s;
+}
+
+}  // namespace textile

@@ -1,0 +1,91 @@
+// `textile calibrate` through the real executable: a rendered board gives a rig file that
+// `extract` reads and whose scale is the camera's; a board it cannot find exits 3, bad flags
+// and unreadable files exit 2, with one line and no rig written.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+
+#include "run_cli.h"
+#include "textile/fit/rig.h"
+
+namespace textile {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::CountLines;
+using testing::Scratch;
+using testing::Textile;
+
+std::string Quote(const fs::path& p) { return "'" + p.string() + "'"; }
+
+// A rendered strip photo and its board (medium level: a few degrees of pose) into dir; returns the
+// board's square size [mm].
+double Render(const fs::path& dir) {
+  const auto r = Textile("render-photo --material samples/materials/pabst-fig8.json --overhang-mm 50 "
+                         "--size 900x700 --mm-per-px 0.14 --difficulty medium --seed 2 -o " +
+                         Quote(dir / "strip.png") + " --json");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  return nlohmann::json::parse(r.out).at("board_square_mm").get<double>();
+}
+
+TEST(CliCalibrate, BoardGivesARigThatExtractReads) {
+  const fs::path dir = Scratch("cli_calibrate_ok");
+  const double square = Render(dir);
+  const auto r = Textile("calibrate " + Quote(dir / "strip.board.png") + " --board 9x6 --square-mm " +
+                         std::to_string(square) + " -o " + Quote(dir / "rig.json") + " --overlay " +
+                         Quote(dir / "corners.png") + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  // Sub-pixel corners on a medium render (blur 1.2 px, noise 3): well under a quarter pixel.
+  EXPECT_LT(j.at("reprojection_error_px").get<double>(), 0.25);
+  EXPECT_NEAR(j.at("mm_per_px").get<double>(), 0.14, 0.014);
+  EXPECT_TRUE(fs::exists(dir / "corners.png"));
+  const Rig rig = ReadRigJson((dir / "rig.json").string());
+  EXPECT_FALSE(rig.plain_scale);
+  const auto x = Textile("extract " + Quote(dir / "strip.png") + " --rig " + Quote(dir / "rig.json") +
+                         " -o " + Quote(dir / "out") + " --json");
+  ASSERT_EQ(x.exit_code, 0) << x.err;
+  // The medium level frays the tip: the extractor stops within a few pixels (0.14 mm each) of it.
+  EXPECT_NEAR(nlohmann::json::parse(x.out)["photos"][0]["length_mm"].get<double>(), 50.0, 0.7);
+}
+
+TEST(CliCalibrate, RefusesWhatItCannotUse) {
+  const fs::path dir = Scratch("cli_calibrate_bad");
+  Render(dir);
+  { std::ofstream(dir / "text.png") << "not a png"; }
+  const std::string board = Quote(dir / "strip.board.png");
+  const std::string out = " -o " + Quote(dir / "rig.json");
+  struct Case {
+    std::string args;
+    int code;
+    std::string words;
+  };
+  const Case cases[] = {
+      {Quote(dir / "strip.png") + " --board 9x6 --square-mm 10" + out, 3, "chessboard with 9x6 inner corners not found"},
+      {board + " --board 10x7 --square-mm 10" + out, 3, "not found"},
+      {board + " --board 9 --square-mm 10" + out, 2, "--board: expected COLSxROWS"},
+      {board + " --board 6x6 --square-mm 10" + out, 2, "is square"},
+      {board + " --board 9x6 --square-mm 0" + out, 2, "--square-mm"},
+      {board + " --board 9x6 --square-mm 10 --max-error-px 0" + out, 2, "--max-error-px"},
+      {Quote(dir / "missing.png") + " --board 9x6 --square-mm 10" + out, 2, "missing.png: cannot open"},
+      {Quote(dir / "text.png") + " --board 9x6 --square-mm 10" + out, 2, "text.png: not a supported image"},
+      {board + " --board 9x6 --square-mm 10 -o " + Quote(dir / "no" / "rig.json"), 2, "rig.json"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args);
+    const auto r = Textile("calibrate " + c.args);
+    EXPECT_EQ(r.exit_code, c.code) << r.err;
+    EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
+    EXPECT_EQ(CountLines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(c.words), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "rig.json"));
+  }
+}
+
+}  // namespace
+}  // namespace textile

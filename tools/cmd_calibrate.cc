@@ -1,0 +1,134 @@
+// textile calibrate: chessboard photos -> a rig file (image -> bending-plane homography, with
+// several boards also the lens distortion), for `textile extract --rig` and `textile fit --rig`.
+
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "common/atomic_file.h"
+#include "common/cli.h"
+#include "textile/fit/calibrate.h"
+#include "textile/fit/extract.h"
+#include "textile/sim/error.h"
+
+namespace textile::cli {
+namespace {
+
+struct CalibrateArgs {
+  std::vector<std::string> boards;
+  std::string board = "", out, overlay;
+  double square_mm = 0.0, max_error_px = 1.0;
+  bool no_lens = false, json = false;
+};
+
+std::pair<int, int> ParseBoard(const std::string& text) {
+  const auto x = text.find_first_of("xX");
+  try {
+    if (x == std::string::npos) throw std::invalid_argument("");
+    size_t ea = 0, eb = 0;
+    const int a = std::stoi(text.substr(0, x), &ea);
+    const int b = std::stoi(text.substr(x + 1), &eb);
+    if (ea != x || eb != text.size() - x - 1) throw std::invalid_argument("");
+    return {a, b};
+  } catch (const std::exception&) {
+    throw InputError("--board: expected COLSxROWS inner corners (e.g. 9x6), got '" + text + "'");
+  }
+}
+
+// The first board with its corners, the first one circled, scaled to at most 1600 px.
+cv::Mat Overlay(const cv::Mat& gray, const BoardDetection& d, int cols, int rows) {
+  cv::Mat colour;
+  cv::cvtColor(gray, colour, cv::COLOR_GRAY2BGR);
+  std::vector<cv::Point2f> corners;
+  for (const auto& p : d.corners_px) corners.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
+  cv::drawChessboardCorners(colour, cv::Size(cols, rows), corners, d.found);
+  if (!corners.empty()) {
+    cv::circle(colour, corners[0], std::max(6, static_cast<int>(d.square_px / 3)), cv::Scalar(0, 0, 255), 2);
+  }
+  const double scale = std::min(1.0, 1600.0 / std::max(colour.cols, colour.rows));
+  if (scale < 1.0) cv::resize(colour, colour, cv::Size(), scale, scale, cv::INTER_AREA);
+  return colour;
+}
+
+void Run(const CalibrateArgs& a) {
+  CalibrateOptions o;
+  std::tie(o.cols, o.rows) = ParseBoard(a.board);
+  o.square_mm = a.square_mm;
+  o.max_error_px = a.max_error_px;
+  o.lens = !a.no_lens;
+  std::string why;
+  if (!o.Check(&why)) {
+    const std::string flag = why.rfind("square size", 0) == 0 ? "--square-mm"
+                             : why.rfind("maximum", 0) == 0    ? "--max-error-px"
+                                                               : "--board";
+    throw InputError(flag + ": " + why);
+  }
+  // Outputs checked before the work.
+  AtomicFile rig_file(a.out);
+  std::optional<AtomicFile> overlay_file;
+  if (!a.overlay.empty()) overlay_file.emplace(a.overlay);
+  std::vector<cv::Mat> images;
+  for (const auto& path : a.boards) images.push_back(ReadPhotoGray(path));
+  const CalibrationSummary c = CalibrateRig(images, a.boards, o);
+  if (!c.success) throw ComputeError(c.message);
+  std::ofstream(rig_file.temp_path()) << RigToJson(c.rig);
+  if (overlay_file) {
+    if (!cv::imwrite(overlay_file->temp_path(), Overlay(images[0], c.detections[0], o.cols, o.rows))) {
+      throw InputError(a.overlay + ": cannot write the overlay");
+    }
+    overlay_file->Commit();
+  }
+  rig_file.Commit();
+  if (a.json) {
+    nlohmann::json boards = nlohmann::json::array();
+    for (const auto& d : c.detections) {
+      boards.push_back({{"photo", d.source}, {"found", d.found}, {"square_px", d.square_px},
+                        {"image_size_px", {d.image_size.width, d.image_size.height}}});
+    }
+    PrintJson({{"rig_file", a.out},
+               {"boards", boards},
+               {"lens_model", c.lens_model},
+               {"reprojection_error_px", c.rms_error_px},
+               {"max_error_px", c.max_error_px},
+               {"reprojection_error_mm", c.rms_error_mm},
+               {"max_error_mm", c.max_error_mm},
+               {"lens_rms_px", c.lens_model ? nlohmann::json(c.lens_rms_px) : nlohmann::json()},
+               {"mm_per_px", c.mm_per_px},
+               {"seconds", c.seconds}});
+    return;
+  }
+  std::cout << c.BriefReport() << "\nwrote " << a.out << (a.overlay.empty() ? "" : " and " + a.overlay)
+            << "\n";
+}
+
+}  // namespace
+
+void RegisterCalibrate(CLI::App& app) {
+  auto a = std::make_shared<CalibrateArgs>();
+  CLI::App* sub = AddSubcommand(
+      app, "calibrate",
+      "Chessboard photo(s) in the bending plane -> rig file (homography, lens distortion)",
+      "textile calibrate samples/photos/pabst-fig8.board.png --board 9x6 --square-mm 13 -o rig.json");
+  sub->add_option("boards", a->boards,
+                  "Board photos (PNG, JPEG, TIFF, BMP); the first lies in the bending plane, more "
+                  "(other poses) also give the lens distortion")
+      ->required();
+  sub->add_option("--board", a->board, "Inner corners COLSxROWS (e.g. 9x6; not the squares)")->required();
+  sub->add_option("--square-mm", a->square_mm, "Side of one square [mm]")->required();
+  sub->add_option("-o,--out", a->out, "Rig JSON to write")->required();
+  sub->add_option("--overlay", a->overlay, "Write the first board with its corners drawn (PNG)");
+  sub->add_option("--max-error-px", a->max_error_px,
+                  "Refuse a calibration whose RMS reprojection error is larger (default 1 px)");
+  sub->add_flag("--no-lens", a->no_lens, "Homography only, even with several boards");
+  sub->add_flag("--json", a->json, "Print one JSON object instead of text");
+  sub->callback([a] { Run(*a); });
+}
+
+namespace {
+const bool kRegistered = AddCommand(25, RegisterCalibrate);
+}  // namespace
+
+}  // namespace textile::cli

@@ -1,0 +1,326 @@
+#include "textile/fit/seam_fit.h"
+
+#include <gsl/gsl_cdf.h>
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_multifit.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <set>
+#include <sstream>
+
+#include "textile/sim/error.h"
+#include "textile/sim/json_text.h"
+
+namespace textile {
+namespace {
+
+constexpr int kParams = 3;  // a2, a1, a0
+
+std::string Num(double v, int precision = 6) {
+  std::ostringstream s;
+  s.precision(precision);
+  s << v;
+  return s.str();
+}
+
+std::string Trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r");
+  if (b == std::string::npos) return "";
+  const auto e = s.find_last_not_of(" \t\r");
+  return s.substr(b, e - b + 1);
+}
+
+// Parses one CSV field as a double, the whole field.
+bool ParseNumber(const std::string& field, double* v) {
+  const std::string t = Trim(field);
+  if (t.empty()) return false;
+  std::istringstream in(t);
+  in >> *v;
+  return !in.fail() && in.eof();
+}
+
+// The checks every sample must pass, wherever it came from; `where` prefixes the message.
+void CheckSample(const SeamSample& p, const std::string& where) {
+  if (!std::isfinite(p.d_mm) || !std::isfinite(p.factor) || (!std::isnan(p.sd) && !std::isfinite(p.sd)))
+    throw InputError(where + ": values must be finite numbers");
+  if (p.d_mm < 0.0)
+    throw InputError(where + ": d_mm = " + Num(p.d_mm) + " is negative (distance from the seam line)");
+  if (!(p.factor > 0.0))
+    throw InputError(where + ": factor = " + Num(p.factor) +
+                     " must be > 0 (stiffness relative to the plain fabric)");
+  if (!std::isnan(p.sd) && !(p.sd > 0.0))
+    throw InputError(where + ": sd = " + Num(p.sd) + " must be > 0");
+}
+
+struct GslMatrixDeleter {
+  void operator()(gsl_matrix* m) const { gsl_matrix_free(m); }
+};
+struct GslVectorDeleter {
+  void operator()(gsl_vector* v) const { gsl_vector_free(v); }
+};
+struct GslWorkspaceDeleter {
+  void operator()(gsl_multifit_linear_workspace* w) const { gsl_multifit_linear_free(w); }
+};
+
+}  // namespace
+
+std::vector<SeamSample> ParseSeamSamplesCsv(const std::string& text, const std::string& source) {
+  std::vector<SeamSample> samples;
+  std::istringstream in(text);
+  std::string line;
+  int line_no = 0, columns = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const std::string t = Trim(line);
+    if (t.empty() || t[0] == '#') continue;
+    std::vector<std::string> fields;
+    std::string f;
+    std::istringstream row(t);
+    while (std::getline(row, f, ',')) fields.push_back(Trim(f));
+    if (t.back() == ',') fields.push_back("");
+    const std::string where = source + ":" + std::to_string(line_no);
+    if (columns == 0) {
+      if (fields == std::vector<std::string>{"d_mm", "factor"}) {
+        columns = 2;
+      } else if (fields == std::vector<std::string>{"d_mm", "factor", "sd"}) {
+        columns = 3;
+      } else {
+        throw InputError(where + ": expected the header d_mm,factor or d_mm,factor,sd, got '" + t +
+                         "'");
+      }
+      continue;
+    }
+    if (static_cast<int>(fields.size()) != columns)
+      throw InputError(where + ": expected " + std::to_string(columns) + " values, got " +
+                       std::to_string(fields.size()));
+    SeamSample p;
+    double* targets[3] = {&p.d_mm, &p.factor, &p.sd};
+    for (int i = 0; i < columns; ++i) {
+      if (!ParseNumber(fields[i], targets[i]))
+        throw InputError(where + ": '" + fields[i] + "' is not a number");
+    }
+    CheckSample(p, where);
+    samples.push_back(p);
+  }
+  if (columns == 0) throw InputError(source + ": empty (expected the header d_mm,factor[,sd])");
+  return samples;
+}
+
+std::vector<SeamSample> SeamSamplesFromAcpmJson(const nlohmann::json& result,
+                                                const std::string& source) {
+  if (!result.is_object() || !result.contains("rays"))
+    throw InputError(source + ": not an ACPM result (no \"rays\")");
+  const nlohmann::json& rays = result["rays"];
+  if (!rays.is_array()) throw InputError(source + ": rays: must be an array");
+  std::vector<SeamSample> samples;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    const std::string where = source + ": rays[" + std::to_string(i) + "]";
+    const nlohmann::json& r = rays[i];
+    if (!r.is_object()) throw InputError(where + ": must be an object");
+    auto number = [&](const char* key, bool required, double* v) {
+      if (!r.contains(key) || r[key].is_null()) {
+        if (!required) return;
+        if (std::string(key) == "d_mm")
+          throw InputError(where + ".d_mm: no seam distance (a plain sample has no B_f(d) to fit)");
+        throw InputError(where + "." + key + ": missing");
+      }
+      if (!r[key].is_number()) throw InputError(where + "." + key + ": must be a number");
+      *v = r[key].get<double>();
+    };
+    SeamSample p;
+    number("d_mm", true, &p.d_mm);
+    number("factor", true, &p.factor);
+    number("factor_sd", false, &p.sd);
+    CheckSample(p, where);
+    samples.push_back(p);
+  }
+  return samples;
+}
+
+std::vector<SeamSample> ReadSeamSamples(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw InputError(path + ": cannot open");
+  std::stringstream buffer;
+  buffer << f.rdbuf();
+  if (f.bad()) throw InputError(path + ": cannot read");
+  const std::string text = buffer.str();
+  const auto first = text.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos) throw InputError(path + ": empty file");
+  if (text[first] == '{') return SeamSamplesFromAcpmJson(ParseJsonText(text, path), path);
+  return ParseSeamSamplesCsv(text, path);
+}
+
+bool SeamFitOptions::Check(std::string* why) const {
+  std::ostringstream s;
+  if (layers < 1 || layers > 20) {
+    s << "layers must be in [1, 20], got " << layers;
+  } else if (!(influence_mm >= 1.0 && influence_mm <= 1000.0)) {
+    s << "influence_mm must be in [1, 1000] mm, got " << influence_mm;
+  } else if (!(poor_probability > 0.0 && poor_probability < 1.0)) {
+    s << "poor_probability must be in (0, 1), got " << poor_probability;
+  } else if (!(poor_r2 >= 0.0 && poor_r2 <= 1.0)) {
+    s << "poor_r2 must be in [0, 1], got " << poor_r2;
+  }
+  if (why != nullptr) *why = s.str();
+  return s.str().empty();
+}
+
+SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,
+                             const SeamFitOptions& options) {
+  if (std::string why; !options.Check(&why)) throw InputError("seam fit options: " + why);
+  const int n = static_cast<int>(samples.size());
+  if (n < kParams)
+    throw InputError(std::to_string(n) + " point(s): the quadratic B_f(d) has 3 coefficients, " +
+                     "at least 3 points are needed");
+  int with_sd = 0;
+  std::set<double> distinct;
+  for (int i = 0; i < n; ++i) {
+    CheckSample(samples[i], "point " + std::to_string(i + 1));
+    with_sd += std::isnan(samples[i].sd) ? 0 : 1;
+    distinct.insert(samples[i].d_mm);
+  }
+  if (with_sd != 0 && with_sd != n)
+    throw InputError("sd is given for " + std::to_string(with_sd) + " of " + std::to_string(n) +
+                     " points: give it for all or none");
+  if (distinct.size() < kParams)
+    throw InputError(std::to_string(distinct.size()) +
+                     " distinct distance(s) d: a quadratic needs at least 3 (a seam across the "
+                     "push direction gives every ray the same d)");
+
+  SeamFitSummary fit;
+  fit.num_points = n;
+  fit.distinct_distances = static_cast<int>(distinct.size());
+  fit.dof = n - kParams;
+  fit.weighted = with_sd == n;
+  fit.range_mm = {*distinct.begin(), *distinct.rbegin()};
+
+  // Design matrix rows (d², d, 1), weights 1/sd² (or 1); d in mm as in Table 2.
+  std::unique_ptr<gsl_matrix, GslMatrixDeleter> x(gsl_matrix_alloc(n, kParams));
+  std::unique_ptr<gsl_matrix, GslMatrixDeleter> cov(gsl_matrix_alloc(kParams, kParams));
+  std::unique_ptr<gsl_vector, GslVectorDeleter> y(gsl_vector_alloc(n)), w(gsl_vector_alloc(n)),
+      c(gsl_vector_alloc(kParams));
+  std::unique_ptr<gsl_multifit_linear_workspace, GslWorkspaceDeleter> work(
+      gsl_multifit_linear_alloc(n, kParams));
+  for (int i = 0; i < n; ++i) {
+    const double d = samples[i].d_mm;
+    gsl_matrix_set(x.get(), i, 0, d * d);
+    gsl_matrix_set(x.get(), i, 1, d);
+    gsl_matrix_set(x.get(), i, 2, 1.0);
+    gsl_vector_set(y.get(), i, samples[i].factor);
+    gsl_vector_set(w.get(), i, fit.weighted ? 1.0 / (samples[i].sd * samples[i].sd) : 1.0);
+  }
+  double chi2 = 0.0;
+  gsl_error_handler_t* old_handler = gsl_set_error_handler_off();
+  const int status =
+      gsl_multifit_wlinear(x.get(), w.get(), y.get(), c.get(), cov.get(), &chi2, work.get());
+  gsl_set_error_handler(old_handler);
+  if (status != GSL_SUCCESS)
+    throw ComputeError(std::string("seam fit: GSL weighted least squares failed: ") +
+                       gsl_strerror(status));
+  for (int k = 0; k < kParams; ++k) {
+    fit.coefficients_mm[k] = gsl_vector_get(c.get(), k);
+    for (int l = 0; l < kParams; ++l) fit.covariance(k, l) = gsl_matrix_get(cov.get(), k, l);
+  }
+  fit.chi2 = chi2;
+  // (XᵀWX)⁻¹ is the covariance when the sd are true 1-σ; without them every point gets the
+  // residual variance χ²/dof as its variance (undefined for dof = 0).
+  if (fit.weighted) {
+    fit.covariance_known = true;
+    fit.chi2_probability = fit.dof > 0 ? gsl_cdf_chisq_Q(chi2, fit.dof) : 1.0;
+  } else if (fit.dof > 0) {
+    fit.covariance *= chi2 / fit.dof;
+    fit.covariance_known = true;
+  } else {
+    fit.covariance.setZero();
+  }
+  fit.covariance = 0.5 * (fit.covariance + fit.covariance.transpose()).eval();
+
+  double ss_res = 0.0, ss_tot = 0.0, mean = 0.0;
+  for (const auto& p : samples) mean += p.factor / n;
+  for (const auto& p : samples) {
+    const double d = p.d_mm;
+    const double r = p.factor - (fit.coefficients_mm[0] * d * d + fit.coefficients_mm[1] * d +
+                                 fit.coefficients_mm[2]);
+    ss_res += r * r;
+    ss_tot += (p.factor - mean) * (p.factor - mean);
+    fit.max_residual = std::max(fit.max_residual, std::abs(r));
+  }
+  fit.rms = std::sqrt(ss_res / n);
+  fit.r2 = ss_tot > 0.0 ? 1.0 - ss_res / ss_tot : std::numeric_limits<double>::quiet_NaN();
+
+  if (fit.weighted && fit.dof > 0 && fit.chi2_probability < options.poor_probability) {
+    fit.poor = true;
+    fit.poor_reason = "residuals too large for the stated sd: chi2/dof = " +
+                      Num(chi2 / fit.dof, 4) + ", Q(chi2, " + std::to_string(fit.dof) +
+                      ") = " + Num(fit.chi2_probability, 3) + " < " +
+                      Num(options.poor_probability);
+  } else if (!fit.weighted && fit.dof > 0 && !(fit.r2 >= options.poor_r2)) {
+    fit.poor = true;
+    fit.poor_reason = "the quadratic explains only " +
+                      (std::isnan(fit.r2) ? std::string("none") : Num(100.0 * fit.r2, 3) + " %") +
+                      " of the factor's variance (r2 < " + Num(options.poor_r2) + ")";
+  }
+
+  SeamProfile& p = fit.profile;
+  p.type = "fitted";
+  p.name = options.name;
+  p.layers = options.layers;
+  p.coefficients_mm = fit.coefficients_mm;
+  p.range_mm = fit.range_mm;
+  if (!(p.range_mm[1] > p.range_mm[0])) p.range_mm[1] = p.range_mm[0] + 1.0;  // not reached
+  if (fit.covariance_known) p.covariance = fit.covariance;
+  p.influence_mm = options.influence_mm;
+  p.fit = fit.Report();
+  if (std::string why; !p.Check(&why))
+    throw ComputeError("fitted B_f(d) = " + Num(p.coefficients_mm[0]) + " d² + " +
+                       Num(p.coefficients_mm[1]) + " d + " + Num(p.coefficients_mm[2]) +
+                       " cannot serve as a seam profile: " + why);
+  return fit;
+}
+
+nlohmann::json SeamFitSummary::Report() const {
+  auto or_null = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+  nlohmann::json sd = nlohmann::json::array();
+  for (int k = 0; k < kParams; ++k)
+    sd.push_back(covariance_known ? nlohmann::json(std::sqrt(covariance(k, k))) : nlohmann::json());
+  return {{"method", "gsl_multifit_wlinear"},
+          {"weighted", weighted},
+          {"points", num_points},
+          {"distinct_d", distinct_distances},
+          {"dof", dof},
+          {"chi2", chi2},
+          {"chi2_per_dof", dof > 0 ? nlohmann::json(chi2 / dof) : nlohmann::json()},
+          {"chi2_probability", or_null(chi2_probability)},
+          {"rms", rms},
+          {"max_residual", max_residual},
+          {"r2", or_null(r2)},
+          {"range_mm", range_mm},
+          {"coefficients_sd", sd},
+          {"covariance_known", covariance_known},
+          {"poor", poor},
+          {"poor_reason", poor_reason}};
+}
+
+std::string SeamFitSummary::BriefReport() const {
+  std::ostringstream s;
+  s.precision(4);
+  const char* names[3] = {"a2", "a1", "a0"};
+  s << "B_f(d) = " << Num(coefficients_mm[0], 5) << " d² + " << Num(coefficients_mm[1], 5)
+    << " d + " << Num(coefficients_mm[2], 5) << " (d in mm);";
+  for (int k = 0; k < kParams; ++k) {
+    s << " " << names[k] << " ± "
+      << (covariance_known ? Num(std::sqrt(covariance(k, k)), 3) : std::string("?"));
+    if (k < kParams - 1) s << ",";
+  }
+  s << " (1-σ" << (weighted ? ", from the given sd" : ", from the scatter") << "); " << num_points
+    << " points, d in [" << Num(range_mm[0], 4) << ", " << Num(range_mm[1], 4)
+    << "] mm, rms " << Num(rms, 3) << ", r² " << Num(r2, 5);
+  if (weighted && dof > 0) s << ", chi²/dof " << Num(chi2 / dof, 3);
+  if (poor) s << "; POOR FIT: " << poor_reason;
+  return s.str();
+}
+
+}  // namespace textile

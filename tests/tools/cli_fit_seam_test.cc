@@ -1,0 +1,108 @@
+// `textile fit-seam` through the real executable.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "run_cli.h"
+
+namespace textile {
+namespace {
+
+using testing::ExpectRefused;
+using testing::ReadAll;
+using testing::Scratch;
+using testing::Textile;
+namespace fs = std::filesystem;
+
+// C-plain (Table 2) at the 17 centre-seam ray distances, exact.
+std::string CPlainCsv() {
+  std::string csv = "d_mm,factor\n";
+  for (int i = 0; i < 17; ++i) {
+    const double d = std::abs(5.0 + 190.0 * i / 16.0 - 100.0);
+    csv += std::to_string(d) + "," + std::to_string(2e-4 * d * d - 0.0702 * d + 9.07) + "\n";
+  }
+  return csv;
+}
+
+void Write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+TEST(CliFitSeam, CsvToSeamFileThatReadsBack) {
+  const auto dir = Scratch("CliFitSeam.Csv");
+  Write(dir / "f.csv", CPlainCsv());
+  const auto r = Textile("fit-seam " + (dir / "f.csv").string() + " --layers 4 -o " +
+                         (dir / "seam.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("B_f(d) = 0.0002 d² + -0.0702 d + 9.07"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(ReadAll(dir / "seam.json"));
+  EXPECT_EQ(j["type"], "fitted");
+  EXPECT_EQ(j["layers"], 4);
+  // std::to_string keeps 6 decimals: the coefficients come back to ~1e-6 of the factor.
+  EXPECT_NEAR(j["coefficients_mm"][0].get<double>(), 2e-4, 1e-8);
+  EXPECT_NEAR(j["coefficients_mm"][1].get<double>(), -0.0702, 1e-6);
+  EXPECT_NEAR(j["coefficients_mm"][2].get<double>(), 9.07, 1e-5);
+  EXPECT_EQ(j["range_mm"][1].get<double>(), 95.0);
+  EXPECT_EQ(j["fit"]["dof"], 14);
+  EXPECT_TRUE(j.contains("covariance"));
+}
+
+TEST(CliFitSeam, RefusesBadInputWithExit2) {
+  const auto dir = Scratch("CliFitSeam.Bad");
+  Write(dir / "two.csv", "d_mm,factor\n0,3\n10,2\n");
+  Write(dir / "neg.csv", "d_mm,factor\n0,3\n-10,2\n20,1.5\n");
+  Write(dir / "sd0.csv", "d_mm,factor,sd\n0,3,0.1\n10,2,0\n20,1.5,0.1\n");
+  Write(dir / "nan.csv", "d_mm,factor\n0,3\n10,nan\n20,1.5\n");
+  Write(dir / "plain.json", R"({"model": "elastica", "rays": [{"z_mm": 5, "d_mm": null, "factor": 1}]})");
+  const std::string out = " -o " + (dir / "s.json").string();
+  ExpectRefused(Textile("fit-seam " + (dir / "two.csv").string() + " --layers 2" + out),
+                "at least 3 points", "two points");
+  ExpectRefused(Textile("fit-seam " + (dir / "neg.csv").string() + " --layers 2" + out),
+                "neg.csv:3: d_mm = -10 is negative", "negative d");
+  ExpectRefused(Textile("fit-seam " + (dir / "sd0.csv").string() + " --layers 2" + out),
+                "sd0.csv:3: sd = 0", "sd 0");
+  ExpectRefused(Textile("fit-seam " + (dir / "nan.csv").string() + " --layers 2" + out),
+                "nan.csv:3", "nan");
+  ExpectRefused(Textile("fit-seam " + (dir / "plain.json").string() + out), "no seam distance",
+                "plain ACPM result");
+  ExpectRefused(Textile("fit-seam " + (dir / "two.csv").string() + out), "--layers", "no layers");
+  ExpectRefused(Textile("fit-seam " + (dir / "missing.csv").string() + " --layers 2" + out),
+                "cannot open", "missing file");
+  EXPECT_FALSE(fs::exists(dir / "s.json"));
+}
+
+TEST(CliFitSeam, PoorFitWarnsOrFailsWithStrict) {
+  const auto dir = Scratch("CliFitSeam.Poor");
+  std::string csv = "d_mm,factor\n";
+  for (int i = 0; i < 17; ++i) {
+    const double d = 6.0 * i;
+    csv += std::to_string(d) + "," + (d < 20 ? "4" : std::to_string(1.5 + 0.3 * std::sin(d))) + "\n";
+  }
+  Write(dir / "step.csv", csv);
+  const auto warn = Textile("fit-seam " + (dir / "step.csv").string() + " --layers 3 -o " +
+                            (dir / "w.json").string());
+  EXPECT_EQ(warn.exit_code, 0) << warn.err;
+  EXPECT_NE(warn.err.find("warning:"), std::string::npos) << warn.err;
+  EXPECT_TRUE(nlohmann::json::parse(ReadAll(dir / "w.json"))["fit"]["poor"].get<bool>());
+  const auto strict = Textile("fit-seam " + (dir / "step.csv").string() + " --layers 3 --strict -o " +
+                              (dir / "s.json").string());
+  EXPECT_EQ(strict.exit_code, 3) << strict.err;
+  EXPECT_NE(strict.err.find("poor fit"), std::string::npos) << strict.err;
+  EXPECT_FALSE(fs::exists(dir / "s.json"));
+}
+
+TEST(CliFitSeam, JsonOutput) {
+  const auto dir = Scratch("CliFitSeam.Json");
+  Write(dir / "f.csv", CPlainCsv());
+  const auto r = Textile("fit-seam " + (dir / "f.csv").string() + " --layers 4 --json -o " +
+                         (dir / "seam.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["seam"]["layers"], 4);
+  EXPECT_FALSE(j["seam"]["fit"]["poor"].get<bool>());
+}
+
+}  // namespace
+}  // namespace textile

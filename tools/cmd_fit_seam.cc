@@ -1,0 +1,107 @@
+// textile fit-seam: ACPM rays or a (d, factor[, sd]) CSV -> the seam influence factor
+// B_f(d) = a2 d² + a1 d + a0 (Pabst et al. section 4.2, Table 2) with covariance and range,
+// written as a seam file (libsim seam.h) of type "fitted" with a `fit` report.
+
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "common/atomic_file.h"
+#include "common/cli.h"
+#include "textile/fit/seam_fit.h"
+#include "textile/sim/error.h"
+#include "textile/sim/json_text.h"
+
+namespace textile::cli {
+namespace {
+
+struct FitSeamArgs {
+  std::string input, out, name;
+  int layers = 0;  // 0: from the ACPM result's seam, else required
+  double influence_mm = 100.0;
+  bool strict = false, json = false;
+};
+
+// The seam layers an ACPM result records ({"seam": {"layers": N}}), or 0.
+int LayersFromAcpmResult(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  std::stringstream buffer;
+  buffer << f.rdbuf();
+  const std::string text = buffer.str();
+  const auto first = text.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos || text[first] != '{') return 0;
+  const nlohmann::json j = ParseJsonText(text, path);
+  if (j.contains("seam") && j["seam"].is_object() && j["seam"].contains("profile") &&
+      j["seam"]["profile"].is_object() && j["seam"]["profile"].contains("layers") &&
+      j["seam"]["profile"]["layers"].is_number_integer())
+    return j["seam"]["profile"]["layers"].get<int>();
+  return 0;
+}
+
+void Run(const FitSeamArgs& a) {
+  const std::vector<SeamSample> samples = ReadSeamSamples(a.input);
+  SeamFitOptions o;
+  o.name = a.name;
+  o.influence_mm = a.influence_mm;
+  o.layers = a.layers != 0 ? a.layers : LayersFromAcpmResult(a.input);
+  if (o.layers == 0)
+    throw InputError("--layers: required for " + a.input +
+                     " (the seam's fabric layers, Table 1: A 2, B 3, C 4)");
+  if (std::string why; !o.Check(&why)) throw InputError("--layers/--influence-mm: " + why);
+  SeamFitSummary fit;
+  try {
+    fit = FitSeamFactor(samples, o);
+  } catch (const InputError& e) {
+    throw InputError(a.input + ": " + e.what());
+  }
+  if (fit.poor && a.strict) throw ComputeError(a.input + ": poor fit (--strict): " + fit.poor_reason);
+  nlohmann::json seam = SeamProfileToJson(fit.profile);
+  seam["source"] = a.input;
+  WriteFileAtomically(a.out, seam.dump(2) + "\n");
+  if (fit.poor) Info("warning: " + a.input + ": poor fit: " + fit.poor_reason);
+  if (fit.range_mm[1] < o.influence_mm)
+    Info("note: the fit saw d in [" + Num(fit.range_mm[0], 4) + ", " + Num(fit.range_mm[1], 4) +
+         "] mm; S(d) extrapolates it up to the influence range " + Num(o.influence_mm) + " mm");
+
+  if (a.json) {
+    PrintJson({{"input", a.input}, {"output", a.out}, {"seam", seam}});
+    return;
+  }
+  std::cout << "fit-seam: " << fit.num_points << " points from " << a.input << "\n"
+            << fit.BriefReport() << "\n"
+            << "  d [mm]   B_f(d)\n";
+  for (double d : {0.0, 10.0, 25.0, 50.0, 75.0, 100.0}) {
+    std::printf("  %6.1f   %.4f\n", d, fit.profile.StiffnessFactor(d));
+  }
+  std::cout << "wrote " << a.out << "\n";
+}
+
+}  // namespace
+
+void RegisterFitSeam(CLI::App& app) {
+  auto a = std::make_shared<FitSeamArgs>();
+  CLI::App* sub = AddSubcommand(
+      app, "fit-seam",
+      "ACPM rays or a d_mm,factor[,sd] CSV -> seam factor B_f(d) = a2 d² + a1 d + a0 (GSL weighted "
+      "least squares, covariance, range) as a seam file",
+      "textile fit-seam acpm-result.json -o seam.json\n"
+      "  textile fit-seam factors.csv --layers 4 --name 'denim double lap' -o seam.json");
+  sub->add_option("input", a->input, "ACPM result JSON (rays with d_mm, factor) or CSV d_mm,factor[,sd]")
+      ->required();
+  sub->add_option("-o,--out", a->out, "Seam JSON to write (type \"fitted\", with a fit report)")->required();
+  sub->add_option("--layers", a->layers,
+                  "Fabric layers in the seam (A 2, B 3, C 4); default: the ACPM result's seam");
+  sub->add_option("--name", a->name, "Name to store in the seam file");
+  sub->add_option("--influence-mm", a->influence_mm,
+                  "Influence range d_max of the written profile [mm] (default 100)");
+  sub->add_flag("--strict", a->strict, "A poor fit is an error (exit 3, nothing written)");
+  sub->add_flag("--json", a->json, "Print one JSON object instead of text");
+  sub->callback([a] { Run(*a); });
+}
+
+namespace {
+const bool kRegistered = AddCommand(45, RegisterFitSeam);
+}  // namespace
+
+}  // namespace textile::cli

@@ -79,7 +79,19 @@ struct Strip {
   double stiffness0 = 0.0;    // B(0) [N·m]
   int num_directions = 1;     // variational directions: z, then optionally b1, b2, c1
   std::array<double, 3> param_scale{};  // the p-directions are s_p ∂/∂p, O(1) in size
+  const StripVariation* variation = nullptr;  // null: a uniform strip
 };
+
+// Stiffness multiplier S and scaled weight from the tip w = W(u)/L at t = u/L (1 and t for a
+// uniform strip). With them dm̃/dt = w cos θ and κ = M⁻¹(m/S).
+inline void Variation(const Strip& p, double t, double* multiplier, double* weight) {
+  *multiplier = 1.0;
+  *weight = t;
+  if (p.variation == nullptr) return;
+  const double u = t * p.length;
+  if (p.variation->stiffness_multiplier) *multiplier = p.variation->stiffness_multiplier(u);
+  if (p.variation->weight_from_tip) *weight = p.variation->weight_from_tip(u) / p.length;
+}
 
 // ∂M/∂p divided by κ, per branch, finite as κ -> 0 (used by the log form).
 std::array<double, 3> MomentGradientOverKappa(const BendingLaw& law, double kappa) {
@@ -93,17 +105,19 @@ std::array<double, 3> MomentGradientOverKappa(const BendingLaw& law, double kapp
 // Direct form, state (θ, m̃, X̃, Ỹ) followed by their derivatives along each direction.
 int DirectRhs(double t, const double y[], double f[], void* params) {
   const Strip& p = *static_cast<const Strip*>(params);
+  double sm, w;
+  Variation(p, t, &sm, &w);
   const double theta = y[0];
-  const double kappa = p.law->Curvature(p.moment_scale * y[1]);
+  const double kappa = p.law->Curvature(p.moment_scale * y[1] / sm);
   const double c = std::cos(theta), s = std::sin(theta);
   f[0] = -p.length * kappa;
-  f[1] = t * c;
+  f[1] = w * c;
   f[2] = c;
   f[3] = s;
   // Variational equations: δθ' = -(A δm̃ + L s_p ∂κ/∂p), δm̃' = -t sin θ δθ, with
-  // A = ρgL³/B(κ) = L ∂κ/∂m̃ and ∂κ/∂p|m = -∂M/∂p / B.
+  // A = ρgL³/(S B(κ)) = L ∂κ/∂m̃ and ∂κ/∂p|m = -∂M/∂p / B (S M(κ) = m: S cancels).
   const double b = p.law->Stiffness(kappa);
-  const double a = p.load / b;
+  const double a = p.load / (sm * b);
   std::array<double, 3> grad{};
   if (p.num_directions > 1) grad = p.law->MomentGradient(kappa);
   for (int k = 0; k < p.num_directions; ++k) {
@@ -111,7 +125,7 @@ int DirectRhs(double t, const double y[], double f[], void* params) {
     double* fd = f + kPrimary * (k + 1);
     const double forcing = k == 0 ? 0.0 : -p.param_scale[k - 1] * p.length / b * grad[k - 1];
     fd[0] = -(a * d[1] + forcing);
-    fd[1] = -t * s * d[0];
+    fd[1] = -w * s * d[0];
     fd[2] = -s * d[0];
     fd[3] = c * d[0];
   }
@@ -135,15 +149,17 @@ inline void Sinc(double phi, double sin_phi, double cos_phi, double* sinc,
 // Log form, state (ψ = log(π/2 - θ), μ̃ = m̃/φ, X̃, Ỹ) and derivatives along each direction.
 int LogRhs(double t, const double y[], double f[], void* params) {
   const Strip& p = *static_cast<const Strip*>(params);
+  double sm, w;
+  Variation(p, t, &sm, &w);
   const double psi = y[0], mu = y[1];
   const double phi = std::exp(psi);  // may underflow to 0: nothing below divides by it
   const double m = p.moment_scale * mu * phi;
   double kappa, ratio;  // κ [1/m] and κ/m [1/(N·m)]
   if (m > kTinyMoment) {
-    kappa = p.law->Curvature(m);
+    kappa = p.law->Curvature(m / sm);
     ratio = kappa / m;
   } else {
-    ratio = 1.0 / p.stiffness0;
+    ratio = 1.0 / (sm * p.stiffness0);
     kappa = m * ratio;
   }
   const double r = p.load * ratio;
@@ -152,14 +168,14 @@ int LogRhs(double t, const double y[], double f[], void* params) {
   Sinc(phi, sphi, cphi, &sinc, &cos_minus_sinc);
   const double dpsi = r * mu;  // = L κ / φ
   f[0] = dpsi;
-  f[1] = t * sinc - dpsi * mu;
+  f[1] = w * sinc - dpsi * mu;
   f[2] = sphi;  // cos θ
   f[3] = cphi;  // sin θ
   // Variational equations of (ψ, μ̃): with δm̃ = φ (δμ̃ + μ̃ δψ),
   //   δψ' = A (δμ̃ + μ̃ δψ) + P ψ' - ψ' δψ,   P = -(s_p/B) (∂M/∂p)/κ,
   //   δμ̃' = t (cos φ - sinc φ) δψ - ψ' δμ̃ - μ̃ δψ'.
   const double b = p.law->Stiffness(kappa);
-  const double a = p.load / b;
+  const double a = p.load / (sm * b);
   std::array<double, 3> grad_over_kappa{};
   if (p.num_directions > 1) grad_over_kappa = MomentGradientOverKappa(*p.law, kappa);
   for (int k = 0; k < p.num_directions; ++k) {
@@ -168,7 +184,7 @@ int LogRhs(double t, const double y[], double f[], void* params) {
     const double forcing = k == 0 ? 0.0 : -p.param_scale[k - 1] / b * grad_over_kappa[k - 1];
     const double dd0 = a * (d[1] + mu * d[0]) + forcing * dpsi - dpsi * d[0];
     fd[0] = dd0;
-    fd[1] = t * cos_minus_sinc * d[0] - dpsi * d[1] - mu * dd0;
+    fd[1] = w * cos_minus_sinc * d[0] - dpsi * d[1] - mu * dd0;
     fd[2] = cphi * phi * d[0];
     fd[3] = -sphi * phi * d[0];
   }
@@ -224,8 +240,17 @@ struct ShotResult {
 class Shooter {
  public:
   // angle_scale: expected size of θ (small loads: the tip angle), for the error control.
-  Shooter(const BendingLaw& law, double areal_density, double length, double angle_scale) {
+  // variation: null or non-empty; it must outlive the shooter.
+  Shooter(const BendingLaw& law, double areal_density, double length, double angle_scale,
+          const StripVariation* variation) {
     strip_.law = &law;
+    strip_.variation = variation;
+    if (variation != nullptr) {
+      for (double u : variation->breakpoints) {
+        if (u > 0.0 && u < length) breaks_t_.push_back(u / length);
+      }
+      std::sort(breaks_t_.begin(), breaks_t_.end());
+    }
     strip_.length = length;
     strip_.moment_scale = areal_density * units::kGravity * length * length;
     strip_.load = strip_.moment_scale * length;
@@ -286,7 +311,8 @@ class Shooter {
     // shots), else small: the controller grows it by up to 4.9× per step.
     h_ = std::isnan(first_step_) ? 1e-3 : first_step_;
     first_step_ = kNaN;
-    kink_done_ = std::isnan(kink_moment_);
+    // With a varying stiffness m/S may cross M(κ0) more than once: no event then.
+    kink_done_ = std::isnan(kink_moment_) || strip_.variation != nullptr;
     kink_t_ = kNaN;
     steps_ = 0;
 
@@ -327,8 +353,12 @@ class Shooter {
       }
       std::copy_n(y_.begin(), dim_, y_prev.begin());
       const double t_prev = t_, h_prev = h_;
+      // Stop at the next breakpoint of a strip variation, if it comes first.
+      double t_stop = t_target;
+      const auto next_break = std::upper_bound(breaks_t_.begin(), breaks_t_.end(), t_);
+      if (next_break != breaks_t_.end() && *next_break < t_target) t_stop = *next_break;
       const int status =
-          gsl_odeiv2_evolve_apply(evolve, control, step, &sys_, &t_, t_target, &h_, y_.data());
+          gsl_odeiv2_evolve_apply(evolve, control, step, &sys_, &t_, t_stop, &h_, y_.data());
       if (status != GSL_SUCCESS || !std::all_of(y_.begin(), y_.begin() + dim_,
                                                 [](double v) { return std::isfinite(v); })) {
         result->kind = ShotResult::Kind::kFailed;
@@ -400,6 +430,7 @@ class Shooter {
   }
 
   Strip strip_;
+  std::vector<double> breaks_t_;  // breakpoints of the variation in t, ascending, in (0, 1)
   double kink_moment_ = kNaN;  // M(κ0)/(ρgL²), NaN when there is no kink to cross
   std::unique_ptr<Integrator> cheap_, full_;
 
@@ -457,6 +488,9 @@ bool ElasticaOptions::Check(std::string* why) const {
   } else if (!std::isnan(tip_angle_guess) &&
              !(tip_angle_guess >= 0.0 && tip_angle_guess < kHalfPi)) {
     s << "tip_angle_guess must be NaN or in [0, pi/2) rad, got " << tip_angle_guess;
+  } else if (!std::all_of(variation.breakpoints.begin(), variation.breakpoints.end(),
+                          [](double u) { return std::isfinite(u); })) {
+    s << "variation.breakpoints must be finite";
   } else {
     for (size_t i = 0; i < arc_lengths.size(); ++i) {
       if (!std::isfinite(arc_lengths[i]) || arc_lengths[i] < 0.0) {
@@ -527,7 +561,8 @@ ElasticaProfile SolveHeavyElastica(const BendingLaw& law, double areal_density, 
   // Deflection scale for the error control: the small-load tip angle, capped at 1.
   const double alpha = areal_density * units::kGravity * length * length * length /
                        law.Stiffness(0.0);
-  Shooter shooter(law, areal_density, length, alpha / 6.0);
+  Shooter shooter(law, areal_density, length, alpha / 6.0,
+                  options.variation.empty() ? nullptr : &options.variation);
   const int final_directions = options.sensitivities ? kMaxDirections : 1;
 
   // Safeguarded Newton on z with a bracket [lo, hi]: the residual at z = 0 (a flat tip) is
@@ -617,6 +652,10 @@ ElasticaProfile SolveHeavyElastica(const BendingLaw& law, double areal_density, 
     record.row(i) += record.row(kPrimary + i) * correction;
   }
   const Strip& strip = shooter.strip();
+  // S at distance u from the tip (1 for a uniform strip): κ = M⁻¹(m / S).
+  auto multiplier = [&options](double u) {
+    return options.variation.stiffness_multiplier ? options.variation.stiffness_multiplier(u) : 1.0;
+  };
   const double tip_x_scaled = edge[2], tip_y_scaled = edge[3];
 
   profile.s = arc;
@@ -629,7 +668,7 @@ ElasticaProfile SolveHeavyElastica(const BendingLaw& law, double areal_density, 
     const double* y = record.col(n - 1 - j).data();
     profile.theta[j] = Angle(log_form, y);
     profile.moment[j] = strip.moment_scale * ScaledMoment(log_form, y);
-    profile.kappa[j] = law.Curvature(profile.moment[j]);
+    profile.kappa[j] = law.Curvature(profile.moment[j] / multiplier(length - arc[j]));
     profile.x[j] = length * (tip_x_scaled - y[2]);
     profile.y[j] = -length * (tip_y_scaled - y[3]);
   }
@@ -645,7 +684,7 @@ ElasticaProfile SolveHeavyElastica(const BendingLaw& law, double areal_density, 
   profile.tip_x = length * tip_x_scaled;
   profile.tip_y = -length * tip_y_scaled;
   profile.clamp_moment = strip.moment_scale * ScaledMoment(log_form, edge.data());
-  profile.clamp_curvature = law.Curvature(profile.clamp_moment);
+  profile.clamp_curvature = law.Curvature(profile.clamp_moment / multiplier(length));
   if (!std::isnan(shot.kink_t)) profile.kink_arc_length = length * (1.0 - shot.kink_t);
 
   if (options.sensitivities) {

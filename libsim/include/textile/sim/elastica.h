@@ -24,6 +24,7 @@
 // the edge (GSL rk8pd with error control). See docs/cantilever-facts.md for the method and its
 // accuracy. Everything here is SI.
 
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -33,6 +34,30 @@
 #include "textile/sim/bending_law.h"
 
 namespace textile {
+
+// A strip whose bending stiffness or weight varies along its length, such as a seam across it
+// (Pabst et al. section 4.2). Both are functions of the distance u = L - s from the free tip
+// [m], so that a seam at a fixed distance from the sample's front stays at that point of the
+// strip whatever the overhang. With S(u) the law becomes M_S(κ) = S(u) M(κ) (the multiplier of
+// eq. 6 on the moment), so κ = M⁻¹(m / S), and the moment balance of cantilever.md becomes
+// dm/ds = -ρ g W(u) cos θ with W(u) = ∫_0^u ρ(u')/ρ du' the weight beyond s in strip lengths.
+//
+//   // A C-plain seam across the strip, 20 mm from the front (docs/acpm.md):
+//   textile::StripVariation v;
+//   v.stiffness_multiplier = [&](double u) { return seam.Multiplier(std::abs(u - 0.02) * 1e3); };
+//   v.breakpoints = {0.02};  // S has a corner at the seam line
+//   options.variation = v;
+struct StripVariation {
+  // S(u) > 0 [-]; empty: 1 everywhere.
+  std::function<double(double u)> stiffness_multiplier;
+  // W(u) [m], continuous, increasing, W(0) = 0; empty: W(u) = u (a uniform strip).
+  std::function<double(double u)> weight_from_tip;
+  // Distances from the tip [m] where S or W is not smooth (a seam line, band edges, the ends of
+  // a fade): the integration stops there, so each step sees a smooth right-hand side.
+  std::vector<double> breakpoints;
+
+  bool empty() const { return !stiffness_multiplier && !weight_from_tip; }
+};
 
 struct ElasticaOptions {
   // Error tolerance per integration step, relative and absolute on the scaled variables (θ,
@@ -51,6 +76,10 @@ struct ElasticaOptions {
   // θ(L) [rad] to start the shooting from, in [0, π/2), e.g. from the previous solve of a
   // continuation in L; NaN lets the solver estimate it (small-load or hanging-chain limit).
   double tip_angle_guess = std::numeric_limits<double>::quiet_NaN();
+  // Stiffness and weight varying along the strip (default: a uniform strip). The law's kink
+  // is then not located as an event (m/S may cross M(κ0) several times); the error control
+  // takes the corner of κ(m) in its stride.
+  StripVariation variation;
 
   // False, with the reason in *why, when a field is out of range.
   bool Check(std::string* why) const;

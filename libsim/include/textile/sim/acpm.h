@@ -1,0 +1,159 @@
+#ifndef TEXTILE_SIM_ACPM_H_
+#define TEXTILE_SIM_ACPM_H_
+
+// The virtual ACPM200 bending tester (Pabst et al. 2008, sections 4.1 and 5.1;
+// ../shared/spec/cantilever.md, "Virtual ACPM200"). A sample up to 200 mm wide lies on a
+// platform and is pushed over its edge at 12 cm/min; the light barrier is the plane through
+// the edge inclined 41.5° below the horizontal, sampled by 17 rays across the width. Ray i is
+// cut when the sample's front at its width position z_i crosses that plane; the device records
+// the overhang L_i then, and reports c_i = L_i / 2, G_i = ρ g c_i³ and G_i relative to the
+// same fabric without seams (the "factor", Fig. 5).
+//
+//   textile::Material fabric = textile::ReadMaterial("samples/materials/pabst-fig8.json");
+//   textile::AcpmOptions options;                        // 200 × 300 mm, 17 rays, auto model
+//   options.seam.direction = textile::AcpmSeamDirection::kAcross;
+//   options.seam.profile = textile::SeamPreset("C-plain");
+//   options.seam.position = 0.02;                        // 20 mm behind the front [m]
+//   textile::AcpmResult r = textile::RunAcpm(fabric, options);   // elastica, exact
+//   // r.rays[i].overhang, .factor; r.model_reason says why the elastica answers it
+//
+// Models:
+//  - elastica: the exact 1D heavy elastica (elastica.h). Exact whenever nothing varies across
+//    the width: a plain sample (all rays cut together) and a seam across the push direction
+//    (the stiffness multiplier S(d) and the seam band's mass vary along the strip only).
+//  - shell: the 3D cloth engine, needed when something varies across the width (a seam along
+//    the push direction). It is plugged in as an AcpmModel (below); this build has none.
+//  - auto: the elastica when it is exact, else the shell model; the result says which and why.
+//
+// Everything here is SI (m, kg, s); the result JSON (cli.md) is in lab units.
+
+#include <functional>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "textile/sim/cantilever_outputs.h"
+#include "textile/sim/material.h"
+#include "textile/sim/seam.h"
+
+namespace textile {
+
+enum class AcpmModelKind { kAuto, kElastica, kShell };
+enum class AcpmSeamDirection {
+  kNone,    // a plain sample
+  kAlong,   // a seam line along the push direction, at width position z_s
+  kAcross,  // a seam line across the push direction, at a distance behind the sample's front
+};
+
+// "auto", "elastica", "shell"; "none", "along", "across". Parse* throw InputError otherwise.
+std::string AcpmModelName(AcpmModelKind kind);
+AcpmModelKind ParseAcpmModel(const std::string& name);
+std::string AcpmSeamDirectionName(AcpmSeamDirection direction);
+AcpmSeamDirection ParseAcpmSeamDirection(const std::string& name);
+
+struct AcpmSeam {
+  AcpmSeamDirection direction = AcpmSeamDirection::kNone;
+  SeamProfile profile;  // Table 2 preset (SeamPreset) or a fitted seam file (ReadSeamProfile)
+  // kAlong: z_s [m] from the sample's left edge (ray 0 side), in [0, width]; NaN: the centre.
+  // kAcross: distance [m] of the seam line behind the sample's front edge, in [0, length].
+  double position = std::numeric_limits<double>::quiet_NaN();
+};
+
+struct AcpmResult;
+struct AcpmOptions;
+
+// What a model answers for a scene: per ray, the overhang at which the front crosses the
+// barrier, plus the side profile (mid-line in the bending plane, cantilever.md's frame) at the
+// crossing of one ray.
+struct AcpmCrossings {
+  bool converged = false;
+  std::string message;            // why not, when not converged
+  std::vector<double> overhang;   // #rays, L_i [m]
+  int profile_ray = 0;            // the ray whose side profile is given
+  std::vector<double> profile_x;  // side profile at that crossing [m], from the edge to the
+  std::vector<double> profile_y;  // front, x towards the overhang, y up (y < 0 hanging)
+  // The model's own crossing for the same fabric without seams [m], if it ran one (at the same
+  // resolution, so that its error cancels in the factor); NaN: the exact elastica's is used.
+  double plain_overhang = std::numeric_limits<double>::quiet_NaN();
+  int solves = 0;                 // static solves (elastica solves, or shell push steps)
+  std::string notes;              // anything the model wants in the result
+};
+
+// The plug-in point of the shell model (issue 6): given the material, the scene (options:
+// sample size, barrier, push speed, crossing refinement, seam) and the ray positions z_i [m]
+// (#rays, from the left edge), return every ray's crossing. A shell implementation pushes the
+// sample in quasi-static steps (each warm-started from the last) and refines each ray's
+// crossing to options.crossing_tolerance. Report non-convergence in the result; throw
+// InputError only for input the model cannot take.
+using AcpmModel = std::function<AcpmCrossings(const Material& material, const AcpmOptions& options,
+                                              const std::vector<double>& ray_z)>;
+
+// The shell model of this build: empty until the 3D engine provides one (then RunAcpm uses it
+// whenever the options carry none). Defined in libsim/src/acpm.cc.
+AcpmModel ShellAcpmModel();
+
+struct AcpmOptions {
+  double width = 0.2;              // sample width W [m], in (0, 0.2] (the ACPM200's maximum)
+  double length = 0.3;             // sample length [m], the longest overhang, in (0, 1]
+  int num_rays = 17;               // sampling rays, evenly spaced across the width, ≥ 1
+  double ray_margin = 0.005;       // first and last ray this far inside the edges [m]
+  double barrier_angle = kStandardBarrierAngle;  // below the horizontal [rad], in (0, π/2)
+  double push_speed = 0.12 / 60.0;               // [m/s] (12 cm/min)
+  double crossing_tolerance = 5e-5;  // crossing refinement [m] for stepping models (the
+                                     // elastica solves the crossing to 1e-10 relative)
+  AcpmModelKind model = AcpmModelKind::kAuto;
+  AcpmSeam seam;
+  AcpmModel shell_model;  // empty: ShellAcpmModel()
+
+  // False with "<field>: <problem>" in *why (names as the CLI flags say them, in mm).
+  bool Check(std::string* why) const;
+  // Ray positions z_i [m] from the left edge: evenly from margin to width - margin (one ray:
+  // the centre).
+  std::vector<double> RayPositions() const;
+};
+
+struct AcpmRay {
+  double z = 0.0;         // width position [m] from the left edge
+  double d = std::numeric_limits<double>::quiet_NaN();  // distance from the seam line [m]
+                          // (along: |z - z_s|; across: the seam's distance behind the front;
+                          // NaN for a plain sample)
+  double overhang = 0.0;  // L_i [m]
+  double bending_length = 0.0;  // c_i = L_i / 2 [m]
+  double rigidity = 0.0;        // G_i = ρ g c_i³ [N·m], ρ the plain fabric's density
+  double factor = 1.0;          // G_i / G of the same fabric without seams [-]
+  double device_time = 0.0;     // L_i / push speed [s]
+};
+
+struct AcpmResult {
+  AcpmModelKind model = AcpmModelKind::kElastica;  // the model that answered
+  std::string model_reason;                        // why that model (auto), or "requested"
+  std::vector<AcpmRay> rays;
+  double plain_overhang = 0.0;   // L* of the same fabric without seams [m]
+  double plain_rigidity = 0.0;   // its G [N·m]
+  double device_time = 0.0;      // until the last ray is cut [s]
+  int profile_ray = 0;           // the ray of the side profile
+  std::vector<double> profile_x, profile_y;  // side profile at that crossing [m]
+  int solves = 0;
+  std::string notes;
+
+  // One line: model, crossing range, factor range, device time.
+  std::string BriefReport() const;
+};
+
+// Runs the scene. Throws InputError for options that fail Check() and for a material the tester
+// cannot bend to the barrier within the sample length ("does not reach the barrier within
+// 300 mm"); ComputeError when the shell model is needed but not available in this build, or a
+// model fails to converge.
+AcpmResult RunAcpm(const Material& material, const AcpmOptions& options = {});
+
+// cli.md's ACPM result JSON: {"model", "model_reason", "rays": [{"z_mm", "d_mm", "overhang_mm",
+// "bending_length_mm", "rigidity_uNm", "factor", "device_time_s"}], "plain": {...},
+// "device_time_s", "seam": {"direction", "at_mm", "profile"}, "side_profile": {...}, ...}.
+// d_mm is null for a plain sample.
+nlohmann::json AcpmResultToJson(const AcpmResult& result, const Material& material,
+                                const AcpmOptions& options);
+
+}  // namespace textile
+
+#endif  // TEXTILE_SIM_ACPM_H_

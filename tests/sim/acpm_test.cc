@@ -1,0 +1,342 @@
+// The virtual ACPM200 (acpm.h) and the elastica's strip variation (elastica.h) that answers a
+// seam across the push direction.
+
+#include "textile/sim/acpm.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "textile/sim/elastica.h"
+#include "textile/sim/error.h"
+#include "textile/sim/units.h"
+
+namespace textile {
+namespace {
+
+Material Fabric(double b1, double b2, double c1, double gsm) {
+  Material m;
+  m.name = "test";
+  m.areal_density = units::GsmToSi(gsm);
+  m.bending = BendingLaw::FromKes(b1, b2, c1);
+  return m;
+}
+Material Fig8() { return Fabric(0.1, 0.0892, -0.0092, 200); }
+
+template <typename Fn>
+std::string ErrorOf(Fn fn) {
+  try {
+    fn();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+// ---- The strip variation of the elastica ----
+
+// The reference solutions have rel_tol 1e-10 (docs/cantilever-facts.md: positions to ~1e-12 L);
+// two different integrations of the same strip agree to 1e-9 L.
+constexpr double kSameStrip = 1e-9;
+
+TEST(ElasticaVariation, ConstantMultiplierIsTheScaledLaw) {
+  // S(u) = k everywhere is M_S = k M: the law scaled by k (β of section 3.4 does the same).
+  const BendingLaw law = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+  for (double length : {0.03, 0.1, 0.5}) {  // 0.5 m hangs near vertically: the log form
+    for (double k : {0.5, 3.0}) {
+      ElasticaOptions o;
+      o.variation.stiffness_multiplier = [k](double) { return k; };
+      const ElasticaProfile a = SolveHeavyElastica(law, 0.2, length, o);
+      const ElasticaProfile b = SolveHeavyElastica(law.Scaled(k), 0.2, length);
+      ASSERT_TRUE(a.converged && b.converged) << a.message << b.message;
+      for (size_t j = 0; j < a.x.size(); ++j) {
+        EXPECT_NEAR(a.x[j], b.x[j], kSameStrip * length) << length << " " << k << " " << j;
+        EXPECT_NEAR(a.y[j], b.y[j], kSameStrip * length) << length << " " << k << " " << j;
+      }
+      EXPECT_NEAR(a.log_tip_gap, b.log_tip_gap, 1e-8 * std::abs(b.log_tip_gap));
+    }
+  }
+}
+
+TEST(ElasticaVariation, UniformWeightFactorIsADenserStrip) {
+  // W(u) = q u is the strip of density q ρ.
+  const BendingLaw law = BendingLaw::FromKes(0.5168, 1.8856, 2.2683);
+  ElasticaOptions o;
+  o.variation.weight_from_tip = [](double u) { return 2.5 * u; };
+  const ElasticaProfile a = SolveHeavyElastica(law, 0.25, 0.1, o);
+  const ElasticaProfile b = SolveHeavyElastica(law, 0.625, 0.1);
+  ASSERT_TRUE(a.converged && b.converged);
+  for (size_t j = 0; j < a.x.size(); ++j) {
+    EXPECT_NEAR(a.x[j], b.x[j], kSameStrip * 0.1);
+    EXPECT_NEAR(a.y[j], b.y[j], kSameStrip * 0.1);
+  }
+}
+
+TEST(ElasticaVariation, StiffRegionMatchesTwoPieceComposition) {
+  // A strip whose first 40 mm from the tip is 4× stiffer. Changing tolerance and dropping the
+  // breakpoint must not move the answer beyond the tolerance: the step that crosses the jump
+  // is cut by the error control alone then (an independent check of the breakpoint logic).
+  const BendingLaw law = BendingLaw::FromKes(0.0973, 0.0973, 0.0453);
+  auto solve = [&](bool breakpoint, double tol) {
+    ElasticaOptions o;
+    o.rel_tol = tol;
+    o.variation.stiffness_multiplier = [](double u) { return u < 0.04 ? 4.0 : 1.0; };
+    if (breakpoint) o.variation.breakpoints = {0.04};
+    return SolveHeavyElastica(law, 0.13, 0.06, o);
+  };
+  const ElasticaProfile ref = solve(true, 1e-12), with = solve(true, 1e-10),
+                        without = solve(false, 1e-10);
+  ASSERT_TRUE(ref.converged && with.converged && without.converged);
+  EXPECT_NEAR(with.tip_y, ref.tip_y, 1e-9 * 0.06);
+  EXPECT_NEAR(without.tip_y, ref.tip_y, 1e-7 * 0.06);
+  // Stiffer near the tip: 60 mm is 3 bending lengths, short enough that stiffness anywhere
+  // lifts the tip: it deflects less than the plain strip and more than the 4× stiffer one.
+  const ElasticaProfile plain = SolveHeavyElastica(law, 0.13, 0.06);
+  const ElasticaProfile stiff = SolveHeavyElastica(law.Scaled(4.0), 0.13, 0.06);
+  EXPECT_GT(ref.tip_y, plain.tip_y);
+  EXPECT_LT(ref.tip_y, stiff.tip_y);
+  // The curvature jumps by 4× across the seam point (same moment on both sides).
+  ElasticaOptions o;
+  o.variation.stiffness_multiplier = [](double u) { return u < 0.04 ? 4.0 : 1.0; };
+  o.variation.breakpoints = {0.04};
+  o.arc_lengths = {0.02 - 1e-9, 0.02 + 1e-9};  // s = L - u
+  const ElasticaProfile k = SolveHeavyElastica(law, 0.13, 0.06, o);
+  ASSERT_TRUE(k.converged);
+  EXPECT_NEAR(k.kappa[0] / k.kappa[1], 4.0, 1e-6);
+}
+
+TEST(ElasticaVariation, SensitivitiesMatchFiniteDifferences) {
+  // The variational equations carry S through (S M(κ) = m: ∂κ/∂p|m has no S): check against
+  // central differences, relative step 1e-5 (O(h²) ≈ 1e-9 of the largest, as in elastica_test).
+  const BendingLaw law = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+  ElasticaOptions o;
+  o.num_samples = 11;
+  o.variation.stiffness_multiplier = [](double u) { return 1.0 + 2.0 * std::exp(-u / 0.01); };
+  o.variation.weight_from_tip = [](double u) { return u + 2.0 * std::min(u, 0.005); };
+  o.variation.breakpoints = {0.005};
+  ElasticaOptions os = o;
+  os.sensitivities = true;
+  const ElasticaProfile p = SolveHeavyElastica(law, 0.2, 0.06, os);
+  ASSERT_TRUE(p.converged) << p.message;
+  const double params[3] = {law.b1(), law.b2(), law.c1()};
+  double largest = 0.0;
+  for (int k = 0; k < 3; ++k) largest = std::max(largest, p.dy_dp.col(k).cwiseAbs().maxCoeff() * std::abs(params[k]));
+  for (int k = 0; k < 3; ++k) {
+    double plus[3] = {params[0], params[1], params[2]}, minus[3] = {params[0], params[1], params[2]};
+    const double h = 1e-5 * std::abs(params[k]);
+    plus[k] += h;
+    minus[k] -= h;
+    const ElasticaProfile a =
+        SolveHeavyElastica(BendingLaw::FromSi(plus[0], plus[1], plus[2]), 0.2, 0.06, o);
+    const ElasticaProfile b =
+        SolveHeavyElastica(BendingLaw::FromSi(minus[0], minus[1], minus[2]), 0.2, 0.06, o);
+    for (int j = 0; j < 11; ++j) {
+      const double fd = (a.y[j] - b.y[j]) / (2 * h);
+      EXPECT_NEAR(p.dy_dp(j, k) * std::abs(params[k]), fd * std::abs(params[k]), 1e-6 * largest)
+          << "param " << k << " sample " << j;
+    }
+  }
+}
+
+// ---- The scene ----
+
+TEST(Acpm, PlainSampleIsTheElasticaCrossingOnEveryRay) {
+  // cantilever.md's reference crossings (independent exact elastica), 1e-6 relative.
+  struct Case {
+    Material m;
+    double crossing_mm;
+  };
+  for (const Case& c : {Case{Fig8(), 33.5864}, Case{Fabric(0.0973, 0.0973, 0.0453, 130), 39.1287},
+                        Case{Fabric(0.5168, 1.8856, 2.2683, 250), 70.4996}}) {
+    const AcpmResult r = RunAcpm(c.m);
+    EXPECT_EQ(r.model, AcpmModelKind::kElastica);
+    EXPECT_NE(r.model_reason.find("plain sample"), std::string::npos) << r.model_reason;
+    ASSERT_EQ(r.rays.size(), 17u);
+    EXPECT_DOUBLE_EQ(r.rays.front().z, 0.005);
+    EXPECT_NEAR(r.rays.back().z, 0.195, 1e-15);
+    EXPECT_NEAR(r.rays[8].z, 0.1, 1e-15);
+    for (const AcpmRay& ray : r.rays) {
+      EXPECT_NEAR(units::MToMm(ray.overhang), c.crossing_mm, 1e-4);  // printed to 1e-4 mm
+      EXPECT_DOUBLE_EQ(ray.bending_length, ray.overhang / 2.0);
+      EXPECT_DOUBLE_EQ(ray.factor, 1.0);
+      EXPECT_TRUE(std::isnan(ray.d));
+      // 12 cm/min = 2 mm/s.
+      EXPECT_NEAR(ray.device_time, units::MToMm(ray.overhang) / 2.0, 1e-12);
+    }
+    // The side profile ends at the crossing: its tip lies on the 41.5° line.
+    ASSERT_FALSE(r.profile_x.empty());
+    EXPECT_NEAR(std::atan2(-r.profile_y.back(), r.profile_x.back()), kStandardBarrierAngle, 1e-8);
+  }
+}
+
+TEST(Acpm, FarAcrossSeamChangesNothing) {
+  // A seam 300 mm behind the front: d ≥ 266 mm on the overhang, beyond d_max + fade = 120 mm,
+  // and its band is on the platform. Same strip as plain: factor 1 to the solver's accuracy.
+  AcpmOptions o;
+  o.seam.direction = AcpmSeamDirection::kAcross;
+  o.seam.profile = SeamPreset("C-plain");
+  o.seam.position = 0.3;
+  const AcpmResult r = RunAcpm(Fig8(), o);
+  EXPECT_EQ(r.model, AcpmModelKind::kElastica);
+  EXPECT_NE(r.model_reason.find("across"), std::string::npos);
+  EXPECT_NEAR(r.rays[0].factor, 1.0, 1e-8);
+  EXPECT_NEAR(units::MToMm(r.rays[0].d), 300.0, 1e-12);
+}
+
+TEST(Acpm, AcrossSeamStiffensAndItsBandWeighs) {
+  const Material m = Fig8();
+  AcpmOptions o;
+  o.seam.direction = AcpmSeamDirection::kAcross;
+  o.seam.profile = SeamPreset("C-plain");
+  o.seam.position = 0.01;
+  const AcpmResult seamed = RunAcpm(m, o);
+  // Stiffer near the front: it reaches the barrier later, but the whole strip is never more
+  // than S(0) = 9.07 times as stiff.
+  EXPECT_GT(seamed.rays[0].factor, 1.5);
+  EXPECT_LT(seamed.rays[0].factor, 9.07);
+  for (const AcpmRay& ray : seamed.rays) EXPECT_DOUBLE_EQ(ray.overhang, seamed.rays[0].overhang);
+  // Mass alone: a seam with no stiffening (B_f = 1) but 4 layers in its band bends the strip
+  // more, so it crosses earlier: factor < 1.
+  AcpmOptions heavy = o;
+  heavy.seam.profile.type = "fitted";
+  heavy.seam.profile.coefficients_mm = {0.0, 0.0, 1.0};
+  const AcpmResult h = RunAcpm(m, heavy);
+  EXPECT_LT(h.rays[0].factor, 1.0);
+  heavy.seam.profile.layers = 1;  // no extra mass either: the plain strip
+  EXPECT_NEAR(RunAcpm(m, heavy).rays[0].factor, 1.0, 1e-8);
+  // The side profile: its curvature jumps by S(0⁺)/S at the seam... here simply: the tip is on
+  // the barrier line.
+  EXPECT_NEAR(std::atan2(-seamed.profile_y.back(), seamed.profile_x.back()),
+              kStandardBarrierAngle, 1e-8);
+}
+
+TEST(Acpm, LinearLawAcrossSeamMatchesScaledLawWhenSIsConstantOverTheOverhang) {
+  // A "seam" whose factor is 3 on all of [0, 300] mm, no extra mass: the whole overhang is 3×
+  // stiffer, so for a linear law G scales by 3 exactly (c³ ∝ B) up to the L/2 rule, which is
+  // the same relative bias for both: factor = 3 to solver accuracy.
+  AcpmOptions o;
+  o.seam.direction = AcpmSeamDirection::kAcross;
+  o.seam.profile.type = "fitted";
+  o.seam.profile.layers = 1;
+  o.seam.profile.coefficients_mm = {0.0, 0.0, 3.0};
+  o.seam.profile.influence_mm = 400;
+  o.seam.position = 0.0;
+  const AcpmResult r = RunAcpm(Fabric(0.0973, 0.0973, 0.0453, 130), o);
+  EXPECT_NEAR(r.rays[0].factor, 3.0, 1e-8);
+}
+
+TEST(Acpm, SeamAlongNeedsTheShellModelWhichThisBuildLacks) {
+  AcpmOptions o;
+  o.seam.direction = AcpmSeamDirection::kAlong;
+  o.seam.profile = SeamPreset("B-plain");
+  const std::string auto_error = ErrorOf([&] { RunAcpm(Fig8(), o); });
+  EXPECT_NE(auto_error.find("shell model is not available in this build"), std::string::npos)
+      << auto_error;
+  EXPECT_THROW(RunAcpm(Fig8(), o), ComputeError);
+  AcpmOptions shell;
+  shell.model = AcpmModelKind::kShell;
+  EXPECT_THROW(RunAcpm(Fig8(), shell), ComputeError);
+  o.model = AcpmModelKind::kElastica;
+  EXPECT_THROW(RunAcpm(Fig8(), o), InputError);
+}
+
+TEST(Acpm, ShellModelPlugsIn) {
+  // A stand-in shell model: each ray's crossing = the plain one times S(d)^(1/3) (uncoupled
+  // strips, linear law). RunAcpm must hand it the rays and the seam, and report its answer.
+  const Material m = Fabric(0.0973, 0.0973, 0.0453, 130);
+  const double plain = RunAcpm(m).rays[0].overhang;
+  AcpmOptions o;
+  o.seam.direction = AcpmSeamDirection::kAlong;
+  o.seam.profile = SeamPreset("A-plain");
+  o.seam.position = 0.05;
+  int calls = 0;
+  o.shell_model = [&](const Material&, const AcpmOptions& scene, const std::vector<double>& z) {
+    ++calls;
+    AcpmCrossings c;
+    c.converged = true;
+    for (double zi : z)
+      c.overhang.push_back(plain * std::cbrt(scene.seam.profile.Multiplier(units::MToMm(std::abs(zi - 0.05)))));
+    c.solves = 42;
+    return c;
+  };
+  const AcpmResult r = RunAcpm(m, o);
+  EXPECT_EQ(calls, 1);
+  EXPECT_EQ(r.model, AcpmModelKind::kShell);
+  EXPECT_NE(r.model_reason.find("along"), std::string::npos);
+  ASSERT_EQ(r.rays.size(), 17u);
+  for (const AcpmRay& ray : r.rays) {
+    EXPECT_NEAR(ray.d, std::abs(ray.z - 0.05), 1e-15);
+    EXPECT_NEAR(ray.factor, o.seam.profile.Multiplier(units::MToMm(ray.d)), 1e-9);
+  }
+  EXPECT_EQ(r.solves, 43);  // + the elastica's plain reference
+  const nlohmann::json j = AcpmResultToJson(r, m, o);
+  EXPECT_EQ(j["model"], "shell");
+  EXPECT_EQ(j["rays"].size(), 17u);
+  EXPECT_NEAR(j["rays"][0]["d_mm"].get<double>(), 45.0, 1e-9);
+  EXPECT_EQ(j["seam"]["profile"]["type"], "A-plain");
+}
+
+TEST(Acpm, RefusesBadScenes) {
+  struct Case {
+    std::function<void(AcpmOptions&)> set;
+    const char* fragment;
+  };
+  const std::vector<Case> cases = {
+      {[](AcpmOptions& o) { o.width = 0.25; }, "250 mm is wider than the ACPM200 takes"},
+      {[](AcpmOptions& o) { o.width = -0.1; }, "width"},
+      {[](AcpmOptions& o) { o.length = 0.0; }, "length"},
+      {[](AcpmOptions& o) { o.ray_margin = -0.001; }, "ray margin"},
+      {[](AcpmOptions& o) {
+         o.seam = {AcpmSeamDirection::kAlong, SeamPreset("A-plain"), 0.25};
+       },
+       "seam at z = 250 mm lies outside the 200 mm wide sample"},
+      {[](AcpmOptions& o) {
+         o.seam = {AcpmSeamDirection::kAlong, SeamPreset("A-plain"), -0.01};
+       },
+       "negative"},
+      {[](AcpmOptions& o) {
+         o.seam = {AcpmSeamDirection::kAcross, SeamPreset("A-plain"), -0.01};
+       },
+       "negative"},
+      {[](AcpmOptions& o) {
+         o.seam = {AcpmSeamDirection::kAcross, SeamPreset("A-plain"), 0.31};
+       },
+       "outside the 300 mm long sample"},
+      {[](AcpmOptions& o) {
+         o.seam.direction = AcpmSeamDirection::kAcross;
+         o.seam.profile = SeamPreset("A-plain");
+       },
+       "required"},
+  };
+  for (const Case& c : cases) {
+    AcpmOptions o;
+    c.set(o);
+    std::string why;
+    EXPECT_FALSE(o.Check(&why)) << c.fragment;
+    EXPECT_NE(why.find(c.fragment), std::string::npos) << why;
+    EXPECT_THROW(RunAcpm(Fig8(), o), InputError) << c.fragment;
+  }
+}
+
+TEST(Acpm, TooStiffToReachTheBarrierIsBadInput) {
+  // b = 50 gf·cm at 100 g/m²: bending length (B/ρg)^(1/3) = 171 mm, crossing ≈ 342 mm.
+  const std::string e = ErrorOf([] { RunAcpm(Fabric(50, 50, 0, 100)); });
+  EXPECT_NE(e.find("does not reach the barrier within 300 mm"), std::string::npos) << e;
+  EXPECT_THROW(RunAcpm(Fabric(50, 50, 0, 100)), InputError);
+  // A longer sample holds it.
+  AcpmOptions longer;
+  longer.length = 0.5;
+  EXPECT_NEAR(units::MToMm(RunAcpm(Fabric(50, 50, 0, 100), longer).rays[0].overhang), 342.1, 1.0);
+}
+
+TEST(Acpm, NarrowSampleAndOneRay) {
+  AcpmOptions o;
+  o.width = 0.05;
+  o.num_rays = 1;
+  const AcpmResult r = RunAcpm(Fig8(), o);
+  ASSERT_EQ(r.rays.size(), 1u);
+  EXPECT_DOUBLE_EQ(r.rays[0].z, 0.025);
+}
+
+}  // namespace
+}  // namespace textile

@@ -1,0 +1,116 @@
+// `textile acpm` through the real executable.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "run_cli.h"
+
+namespace textile {
+namespace {
+
+using testing::ExpectRefused;
+using testing::ReadAll;
+using testing::Scratch;
+using testing::Textile;
+namespace fs = std::filesystem;
+
+const std::string kFig8 = "--material samples/materials/pabst-fig8.json";
+
+TEST(CliAcpm, PlainSamplePrintsTheRayTableAndWritesJsonAndPng) {
+  const auto dir = Scratch("CliAcpm.Plain");
+  const auto r = Textile("acpm " + kFig8 + " -o " + (dir / "r.json").string() + " --png " +
+                         (dir / "front.png").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("model: elastica (auto: nothing varies across the width"), std::string::npos)
+      << r.out;
+  // cantilever.md: Fig. 8 at 200 g/m² crosses at 33.5864 mm; ray 17 at z = 195 mm.
+  EXPECT_NE(r.out.find(" 17   195.00        -    33.5864"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(ReadAll(dir / "r.json"));
+  EXPECT_EQ(j["model"], "elastica");
+  ASSERT_EQ(j["rays"].size(), 17u);
+  for (const auto& ray : j["rays"]) {
+    EXPECT_NEAR(ray["overhang_mm"].get<double>(), 33.5864, 1e-4);
+    EXPECT_NEAR(ray["bending_length_mm"].get<double>(), 16.7932, 1e-4);
+    EXPECT_NEAR(ray["rigidity_uNm"].get<double>(), 9.28863, 1e-5);
+    EXPECT_TRUE(ray["d_mm"].is_null());
+    EXPECT_EQ(ray["factor"].get<double>(), 1.0);
+  }
+  EXPECT_NEAR(j["device_time_s"].get<double>(), 33.5864 / 2.0, 1e-4);
+  EXPECT_EQ(j["side_profile"]["x_mm"].size(), 201u);
+  EXPECT_GT(fs::file_size(dir / "front.png"), 10000u);
+}
+
+TEST(CliAcpm, SeamAcrossIsAnsweredByTheElastica) {
+  const auto dir = Scratch("CliAcpm.Across");
+  const auto r = Textile("acpm " + kFig8 + " --seam C-plain --seam-dir across --seam-at 10 --json -o " +
+                         (dir / "r.json").string() + " --png " + (dir / "p.png").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["model"], "elastica");
+  EXPECT_EQ(j["seam"]["direction"], "across");
+  EXPECT_EQ(j["seam"]["profile"]["type"], "C-plain");
+  EXPECT_DOUBLE_EQ(j["rays"][0]["d_mm"].get<double>(), 10.0);
+  EXPECT_GT(j["rays"][0]["factor"].get<double>(), 1.5);
+  EXPECT_TRUE(fs::exists(dir / "p.png"));
+}
+
+TEST(CliAcpm, FittedSeamFileIsAccepted) {
+  const auto dir = Scratch("CliAcpm.SeamFile");
+  const auto r = Textile("acpm " + kFig8 + " --seam samples/seams/B-twill.json --seam-dir across --seam-at 50 -o " +
+                         (dir / "r.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("seam: B-twill (3 layers) across"), std::string::npos) << r.out;
+}
+
+TEST(CliAcpm, SeamAlongOrShellModelIsAComputeErrorInThisBuild) {
+  const auto dir = Scratch("CliAcpm.Shell");
+  for (const std::string args : {"--seam C-plain", "--model shell", "--seam A-twill --seam-at 30"}) {
+    const auto r = Textile("acpm " + kFig8 + " " + args + " -o " + (dir / "r.json").string());
+    EXPECT_EQ(r.exit_code, 3) << args << ": " << r.err;
+    EXPECT_EQ(testing::CountLines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find("shell model is not available in this build"), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir / "r.json"));
+}
+
+TEST(CliAcpm, RefusesBadInput) {
+  const auto dir = Scratch("CliAcpm.Bad");
+  const std::string out = " -o " + (dir / "r.json").string();
+  std::ofstream(dir / "stiff.json")
+      << R"({"name": "board", "areal_density_gsm": 100, "bending": {"units": "kes", "b1": 50, "b2": 50, "c1": 0}})";
+  ExpectRefused(Textile("acpm " + kFig8 + " --width-mm 250" + out), "wider than the ACPM200", "wide");
+  ExpectRefused(Textile("acpm " + kFig8 + " --seam A-plain --seam-at 250" + out),
+                "lies outside the 200 mm wide sample", "seam outside");
+  ExpectRefused(Textile("acpm " + kFig8 + " --seam A-plain --seam-at -5" + out), "negative",
+                "negative offset");
+  ExpectRefused(Textile("acpm " + kFig8 + " --seam A-plain --seam-dir across --seam-at 400" + out),
+                "outside the 300 mm long sample", "across outside");
+  ExpectRefused(Textile("acpm " + kFig8 + " --seam A-plain --seam-dir across" + out), "required",
+                "across without distance");
+  ExpectRefused(Textile("acpm " + kFig8 + " --seam Z-plain" + out), "Z-plain", "unknown seam");
+  ExpectRefused(Textile("acpm " + kFig8 + " --seam-at 10" + out), "--seam-at", "no seam");
+  ExpectRefused(Textile("acpm " + kFig8 + " --model elastica --seam A-plain" + out),
+                "cannot represent", "elastica along");
+  ExpectRefused(Textile("acpm --material " + (dir / "stiff.json").string() + out),
+                "does not reach the barrier within 300 mm", "too stiff");
+  ExpectRefused(Textile("acpm --material nope.json" + out), "nope.json", "missing material");
+  EXPECT_FALSE(fs::exists(dir / "r.json"));
+}
+
+TEST(CliAcpm, ResultFeedsFitSeam) {
+  // Across seam: every ray has the same d, so fit-seam refuses it (no quadratic in d).
+  const auto dir = Scratch("CliAcpm.FitSeam");
+  ASSERT_EQ(Textile("acpm " + kFig8 + " --seam C-plain --seam-dir across --seam-at 10 -o " +
+                    (dir / "r.json").string())
+                .exit_code,
+            0);
+  ExpectRefused(Textile("fit-seam " + (dir / "r.json").string() + " -o " + (dir / "s.json").string()),
+                "distinct distance", "across seam rays");
+}
+
+}  // namespace
+}  // namespace textile

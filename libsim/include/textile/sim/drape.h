@@ -1,0 +1,194 @@
+#ifndef TEXTILE_SIM_DRAPE_H_
+#define TEXTILE_SIM_DRAPE_H_
+
+// The virtual drapemeter (Cusick test; Pabst et al. section 5.2, Fig. 8;
+// ../shared/spec/drapemeter.md): a disk of fabric held on a smaller disk drapes under its own
+// weight; the drape coefficient and the folds ("nodes") of its shadow are measured.
+//
+//   textile::DrapeOptions options;                       // 150 mm specimen, 90 mm support, clamped
+//   options.seams = textile::DrapeSeams::kWeft;           // one seam through the centre
+//   options.seam_profile = textile::SeamPreset("C-plain");
+//   options.seeds = 3;                                    // three handlings of the specimen
+//   textile::DrapeResult r = textile::SimulateDrape(material, options);
+//   if (!r.converged) throw textile::ComputeError(r.message);   // no DC from such a run
+//   std::cout << r.drape_coefficient << " ± " << r.drape_coefficient_sd << ", "
+//             << r.nodes << " nodes\n";
+//
+// Scene. The pattern is meshed by Gmsh (MeshDisk) with the seam lines and the support's circle
+// embedded as edge paths, so that the clamp edge is a true circle of the support's radius.
+// - clamped (the standard): every vertex within the support circle is held flat at z = 0 (the
+//   specimen is held between two disks); the rest hangs.
+// - resting (the paper's wording): the specimen lies on Support::Disk (top face z = 0, rounded rim)
+//   with penalty contact and Coulomb friction (μ from the material), nothing fixed.
+// Start: flat (resting: drop_height above the support) plus a seeded smooth out-of-plane
+// perturbation w(r, θ) = A ((r - R_s) / (R - R_s))² Σ_k c_k cos(k (θ - frame) + φ_k) on the
+// overhang, so that folds can form; the static equilibrium is found by Newton (optionally
+// coarse → fine, SolveCascadic).
+//
+// Measurement (MeasureShadow): the draped mesh's triangles are projected on the plane z = 0 and
+// rasterised on a square grid (cell centres sampled); holes are filled (cells not reachable
+// from the grid's border through empty cells count as shadow); A_shadow = shadow cells × cell
+// area. DC = (A_shadow - A_support) / (A_specimen - A_support), with A_specimen the area of the
+// meshed pattern (so a flat specimen gives DC = 1 on any mesh) and A_support = π R_s².
+// The outline r(θ) is the largest radius of a shadow cell centre in each of `outline_bins`
+// equal angle bins (the shadow is star-shaped about the centre in every drape we have seen; a
+// bin that no cell reaches is interpolated). Nodes (FindNodes) are the local maxima of r(θ),
+// smoothed by a circular moving average, whose topographic prominence reaches the threshold.
+//
+// Units: SI inside (m, kg, rad); the CLI converts to mm.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "textile/sim/material.h"
+#include "textile/sim/mesh.h"
+#include "textile/sim/seam.h"
+#include "textile/sim/static_solver.h"
+
+namespace textile {
+
+enum class DrapeMount { kClamped, kResting };
+enum class DrapeSeams { kNone, kWeft, kWeftWarp, kShifted };
+
+std::string DrapeMountName(DrapeMount mount);      // "clamped" | "resting"
+DrapeMount ParseDrapeMount(const std::string& name);  // InputError naming the value
+std::string DrapeSeamsName(DrapeSeams seams);      // "none" | "weft" | "weft+warp" | "shifted"
+DrapeSeams ParseDrapeSeams(const std::string& name);  // InputError naming the value
+
+// The solver settings a drape starts from: Newton + CHOLMOD, relative residual 1e-4 (DC is
+// stable to ~1e-4 there; docs/drapemeter.md), 3000 iterations, 600 s.
+SolveOptions DefaultDrapeSolveOptions();
+
+struct DrapeOptions {
+  double specimen_radius = 0.15;  // R [m] (Cusick, BS 5058, ISO 9073-9)
+  double support_radius = 0.09;   // R_s [m], < R
+  DrapeMount mount = DrapeMount::kClamped;
+  // Resting mount: the support disk's thickness and rim rounding [m], the start height of the
+  // flat specimen above it [m].
+  double support_thickness = 0.005;
+  double rim_rounding = 0.001;
+  double drop_height = 0.001;
+
+  // Repeated tests: seeds first_seed, first_seed + 1, ...; each seed is one perturbation.
+  int seeds = 1;
+  unsigned first_seed = 1;
+  // Largest out-of-plane perturbation at the rim, A [m]; > 0 (0 would leave a perfectly
+  // symmetric start, from which the folds form only by round-off).
+  double perturbation = 0.002;
+  // Angular harmonics k = min_harmonic .. max_harmonic, each with a random weight and phase.
+  int min_harmonic = 3;
+  int max_harmonic = 8;
+  // Rotates the seams and the perturbation (not the mesh, not the material axes) about the
+  // centre [rad]: DC must not depend on how the mesh sits under them (isotropic fabrics).
+  double frame_angle = 0.0;
+
+  // Target edge length of the fine mesh away from seams [m]. The default keeps a single-seed
+  // plain drape well under 5 s on a 2-core machine (docs/drapemeter.md has the curve).
+  double element_size = 0.008;
+  // Coarse → fine: solve on a mesh coarse_factor × element_size first and prolong (cascadic).
+  bool coarse_to_fine = true;
+  double coarse_factor = 2.0;
+  // Points on the embedded support circle (also on the coarse mesh).
+  int circle_segments = 0;  // 0: about one per element_size along the circle
+
+  DrapeSeams seams = DrapeSeams::kNone;
+  // The seam type (Table 2 preset or a fitted file) of every seam.
+  SeamProfile seam_profile = SeamPreset("C-plain");
+  // The shifted seam runs parallel to the weft seam, this far from the centre [m].
+  double seam_shift = 0.05;
+  // Section 4.3 refinement near seams (element area / ⌈S(d)⌉), applied within this distance of
+  // any embedded line (seams and the support circle alike: the mesher sees distances only) [m];
+  // 0 turns the refinement off.
+  double seam_refinement_range = 0.02;
+
+  // Newton by default; tolerance on the residual relative to the weight.
+  SolveOptions solver = DefaultDrapeSolveOptions();
+
+  // Measurement.
+  double raster_cell = 0.0005;  // shadow grid cell [m]
+  int outline_bins = 360;       // angle bins of r(θ)
+  int smoothing_bins = 5;       // circular moving average before node detection (odd, ≥ 1)
+  // A node's prominence must reach max(node_prominence, node_prominence_relative × (max r - min r)).
+  double node_prominence = 0.003;          // [m]
+  double node_prominence_relative = 0.15;  // [-]
+
+  // Called with one line of progress (meshing, each seed's outcome); may be empty.
+  std::function<void(const std::string&)> progress;
+
+  // False with "<field>: <problem>" when a field is out of range.
+  bool Check(std::string* why) const;
+};
+
+// The shadow of a draped specimen: a raster mask and the polar outline.
+struct DrapeShadow {
+  double area = 0.0;               // A_shadow, holes filled [m²]
+  double cell = 0.0;               // raster cell [m]
+  double origin_x = 0.0, origin_y = 0.0;  // centre of cell (0, 0) [m]
+  int width = 0, height = 0;       // cells
+  std::vector<std::uint8_t> mask;  // height × width, row-major (row = y), 1 = shadow
+  Eigen::VectorXd angles;          // #B bin centres θ_b ∈ [0, 2π) [rad]
+  Eigen::VectorXd radii;           // #B outline radius r(θ_b) [m]
+};
+
+// Projects the triangles of x (#V×3 [m]; triangles #F×3) on z = 0 and measures the shadow
+// about the origin. cell [m] > 0, bins ≥ 8. Throws InputError for bad sizes or non-finite x.
+DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double cell, int bins);
+
+struct DrapeNodes {
+  std::vector<double> angles;       // [rad], ascending
+  std::vector<double> radii;        // outline radius at each node [m]
+  std::vector<double> prominences;  // [m]
+};
+// Local maxima of the circular signal radii (#B, uniform bins from angle 0) after a circular
+// moving average over `smoothing_bins`, with prominence ≥ max(min_prominence,
+// relative × (max - min)). A constant signal has no nodes.
+DrapeNodes FindNodes(const Eigen::VectorXd& radii, int smoothing_bins, double min_prominence,
+                     double relative_prominence);
+
+// (A_shadow - A_support) / (A_specimen - A_support); InputError unless A_specimen > A_support > 0.
+double DrapeCoefficient(double shadow_area, double specimen_area, double support_area);
+
+// One seed's drape.
+struct DrapeSeedResult {
+  unsigned seed = 0;
+  bool converged = false;
+  SolveSummary summary;              // fine level (with coarse figures when cascadic)
+  double drape_coefficient = 0.0;    // NaN unless converged
+  DrapeShadow shadow;                // empty unless converged
+  DrapeNodes nodes;                  // empty unless converged
+  double min_radius = 0.0, max_radius = 0.0, mean_radius = 0.0;  // of the outline [m]
+  Vertices positions;                // #V×3 final state [m] (also when not converged)
+};
+
+struct DrapeResult {
+  bool converged = false;  // every seed converged; otherwise no figure below is meaningful
+  std::string message;     // why not (the first failing seed), or "converged"
+  // Over the seeds (sd: sample standard deviation, 0 for a single seed); NaN unless converged.
+  double drape_coefficient = 0.0, drape_coefficient_sd = 0.0;
+  double nodes = 0.0, nodes_sd = 0.0;
+  double mean_radius = 0.0, min_radius = 0.0, max_radius = 0.0;  // means over seeds [m]
+  std::vector<DrapeSeedResult> per_seed;
+  TriangleMesh mesh;                         // the fine pattern (rest, z = 0)
+  std::vector<std::vector<int>> seam_paths;  // vertex ids along each seam of the scene
+  std::vector<SeamLine> seam_lines;          // the seams of the scene [m]
+  int coarse_vertices = 0;                   // 0 without coarse → fine
+  double specimen_area = 0.0;                // meshed pattern area [m²]
+  double support_area = 0.0;                 // π R_s² [m²]
+  double mass = 0.0;                         // total mass incl. seam bands [kg]
+  double seconds = 0.0;                      // wall time, meshing included [s]
+};
+
+// The seam lines of a configuration [m] (frame_angle applied).
+std::vector<SeamLine> DrapeSeamLines(const DrapeOptions& options);
+
+// Runs the drapemeter. Throws InputError for bad options or material (a specimen not larger
+// than the support, ...) and ComputeError when meshing fails; a solve that does not converge is
+// reported in the result (converged = false), never as a DC.
+DrapeResult SimulateDrape(const Material& material, const DrapeOptions& options);
+
+}  // namespace textile
+
+#endif  // TEXTILE_SIM_DRAPE_H_

@@ -1,0 +1,502 @@
+#include "textile/sim/drape.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <random>
+#include <sstream>
+
+#include "textile/sim/cloth_problem.h"
+#include "textile/sim/contact.h"
+#include "textile/sim/error.h"
+#include "textile/sim/pattern_mesh.h"
+
+namespace textile {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+bool Fail(std::string* why, const std::string& text) {
+  if (why) *why = text;
+  return false;
+}
+
+bool Finite(double v) { return std::isfinite(v); }
+
+// A chord of the specimen through the point at distance `offset` from the centre along
+// `normal_angle`, running along the direction `angle` [rad]; its ends lie on the rim.
+SeamLine Chord(double radius, double angle, double offset) {
+  const double half = std::sqrt(radius * radius - offset * offset);
+  const Eigen::Vector2d dir(std::cos(angle), std::sin(angle));
+  const Eigen::Vector2d normal(-dir.y(), dir.x());
+  SeamLine line(2, 2);
+  line.row(0) = (offset * normal - half * dir).transpose();
+  line.row(1) = (offset * normal + half * dir).transpose();
+  return line;
+}
+
+// The support circle as an open polyline covering all but one segment (so that no two embedded
+// lines share an end point); starting half a segment off the axes, where seams run.
+Polyline2 SupportCircle(double radius, int segments, double frame) {
+  Polyline2 circle(segments, 2);
+  const double step = 2.0 * kPi / segments;
+  const double start = frame + 0.5 * step + 0.0123;
+  for (int i = 0; i < segments; ++i) {
+    circle(i, 0) = radius * std::cos(start + i * step);
+    circle(i, 1) = radius * std::sin(start + i * step);
+  }
+  return circle;
+}
+
+int CircleSegments(const DrapeOptions& o, double element_size) {
+  if (o.circle_segments > 0) return o.circle_segments;
+  return std::max(24, static_cast<int>(std::ceil(2.0 * kPi * o.support_radius / element_size)));
+}
+
+struct Pattern {
+  PatternMesh pm;
+  std::vector<int> clamp;  // vertices held by the clamp (r ≤ R_s)
+};
+
+Pattern MeshPattern(const DrapeOptions& o, const std::vector<Seam>& seams, double element_size) {
+  std::vector<Polyline2> lines;
+  for (const Seam& s : seams) lines.push_back(Polyline2(s.line));
+  lines.push_back(SupportCircle(o.support_radius, CircleSegments(o, element_size), o.frame_angle));
+  PatternMeshOptions mo;
+  mo.element_size = element_size;
+  if (!seams.empty() && o.seam_refinement_range > 0.0) {
+    std::vector<SeamProfile> profiles;
+    for (const Seam& s : seams) profiles.push_back(s.profile);
+    mo.area_factor = SeamAreaFactor(profiles);
+    mo.refinement_range = o.seam_refinement_range;
+  }
+  Pattern p;
+  p.pm = MeshDisk(o.specimen_radius, lines, mo);
+  // The circle's polyline vertices lie at R_s up to round-off; everything inside is clamped.
+  const double limit = o.support_radius * (1.0 + 1e-9);
+  for (int v = 0; v < p.pm.mesh.num_vertices(); ++v)
+    if (p.pm.mesh.vertices.row(v).head<2>().norm() <= limit) p.clamp.push_back(v);
+  return p;
+}
+
+// The seeded start: flat (resting: drop_height up) plus the smooth wave on the overhang.
+Vertices StartState(const TriangleMesh& mesh, const DrapeOptions& o, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> weight(-1.0, 1.0), phase(0.0, 2.0 * kPi);
+  std::vector<double> c, phi;
+  double total = 0.0;
+  for (int k = o.min_harmonic; k <= o.max_harmonic; ++k) {
+    c.push_back(weight(rng));
+    phi.push_back(phase(rng));
+    total += std::abs(c.back());
+  }
+  Vertices x = mesh.vertices;
+  const double lift = o.mount == DrapeMount::kResting ? o.drop_height : 0.0;
+  const double overhang = o.specimen_radius - o.support_radius;
+  for (int v = 0; v < x.rows(); ++v) {
+    const double r = std::hypot(x(v, 0), x(v, 1));
+    x(v, 2) = lift;
+    if (r <= o.support_radius || total == 0.0) continue;
+    const double theta = std::atan2(x(v, 1), x(v, 0)) - o.frame_angle;
+    double w = 0.0;
+    for (size_t i = 0; i < c.size(); ++i)
+      w += c[i] * std::cos((o.min_harmonic + static_cast<int>(i)) * theta + phi[i]);
+    const double t = (r - o.support_radius) / overhang;
+    x(v, 2) += o.perturbation * t * t * w / total;
+  }
+  return x;
+}
+
+std::unique_ptr<ClothProblem> MakeProblem(const Pattern& p, const Material& material,
+                                          const std::vector<Seam>& seams, const DrapeOptions& o) {
+  ClothOptions co;
+  co.contact.friction = material.friction;
+  auto problem = std::make_unique<ClothProblem>(p.pm.mesh, material, seams, co);
+  if (o.mount == DrapeMount::kClamped) {
+    Vertices held(static_cast<long>(p.clamp.size()), 3);
+    for (size_t k = 0; k < p.clamp.size(); ++k) {
+      held.row(static_cast<long>(k)) = p.pm.mesh.vertices.row(p.clamp[k]);
+      held(static_cast<long>(k), 2) = 0.0;
+    }
+    problem->FixVertices(p.clamp, held);
+  } else {
+    problem->AddSupport(Support::Disk(Eigen::Vector3d::Zero(), o.support_radius,
+                                      o.support_thickness, o.rim_rounding));
+  }
+  return problem;
+}
+
+double Mean(const std::vector<double>& v) {
+  double s = 0.0;
+  for (double x : v) s += x;
+  return v.empty() ? kNaN : s / static_cast<double>(v.size());
+}
+
+double SampleSd(const std::vector<double>& v) {
+  if (v.size() < 2) return 0.0;
+  const double m = Mean(v);
+  double s = 0.0;
+  for (double x : v) s += (x - m) * (x - m);
+  return std::sqrt(s / static_cast<double>(v.size() - 1));
+}
+
+}  // namespace
+
+std::string DrapeMountName(DrapeMount mount) {
+  return mount == DrapeMount::kClamped ? "clamped" : "resting";
+}
+
+DrapeMount ParseDrapeMount(const std::string& name) {
+  if (name == "clamped") return DrapeMount::kClamped;
+  if (name == "resting") return DrapeMount::kResting;
+  throw InputError("mount: '" + name + "' is not clamped or resting");
+}
+
+std::string DrapeSeamsName(DrapeSeams seams) {
+  switch (seams) {
+    case DrapeSeams::kNone: return "none";
+    case DrapeSeams::kWeft: return "weft";
+    case DrapeSeams::kWeftWarp: return "weft+warp";
+    case DrapeSeams::kShifted: return "shifted";
+  }
+  return "none";
+}
+
+DrapeSeams ParseDrapeSeams(const std::string& name) {
+  if (name == "none") return DrapeSeams::kNone;
+  if (name == "weft") return DrapeSeams::kWeft;
+  if (name == "weft+warp") return DrapeSeams::kWeftWarp;
+  if (name == "shifted") return DrapeSeams::kShifted;
+  throw InputError("seams: '" + name + "' is not none, weft, weft+warp or shifted");
+}
+
+SolveOptions DefaultDrapeSolveOptions() {
+  SolveOptions s;
+  s.tolerance = 1e-4;
+  s.max_iterations = 3000;
+  s.max_seconds = 600.0;  // wall time: generous, the machine may be shared
+  return s;
+}
+
+bool DrapeOptions::Check(std::string* why) const {
+  if (!Finite(specimen_radius) || specimen_radius <= 0.0 || specimen_radius > 2.0)
+    return Fail(why, "specimen_radius: must be in (0, 2] m");
+  if (!Finite(support_radius) || support_radius <= 0.0)
+    return Fail(why, "support_radius: must be > 0");
+  if (specimen_radius <= support_radius)
+    return Fail(why, "specimen_radius: the specimen (" + std::to_string(specimen_radius * 1e3) +
+                         " mm) must be larger than the support (" +
+                         std::to_string(support_radius * 1e3) + " mm)");
+  if (!Finite(support_thickness) || support_thickness <= 0.0)
+    return Fail(why, "support_thickness: must be > 0");
+  if (!Finite(rim_rounding) || rim_rounding <= 0.0 || rim_rounding > 0.5 * support_thickness)
+    return Fail(why, "rim_rounding: must be in (0, support_thickness / 2]");
+  if (!Finite(drop_height) || drop_height < 0.0) return Fail(why, "drop_height: must be ≥ 0");
+  if (seeds < 1 || seeds > 1000) return Fail(why, "seeds: must be in 1..1000");
+  if (!Finite(perturbation) || perturbation <= 0.0 || perturbation > specimen_radius)
+    return Fail(why, "perturbation: must be in (0, specimen_radius]");
+  if (min_harmonic < 1 || max_harmonic < min_harmonic || max_harmonic > 64)
+    return Fail(why, "harmonics: need 1 ≤ min_harmonic ≤ max_harmonic ≤ 64");
+  if (!Finite(frame_angle)) return Fail(why, "frame_angle: must be finite");
+  if (!Finite(element_size) || element_size <= 0.0 ||
+      element_size > 0.5 * (specimen_radius - support_radius))
+    return Fail(why, "element_size: must be in (0, half the overhang]");
+  if (element_size < 1e-4) return Fail(why, "element_size: below 0.1 mm is not a drape mesh");
+  if (!Finite(coarse_factor) || coarse_factor < 1.0 || coarse_factor > 8.0)
+    return Fail(why, "coarse_factor: must be in [1, 8]");
+  if (coarse_to_fine && coarse_factor * element_size > 0.5 * (specimen_radius - support_radius))
+    return Fail(why, "coarse_factor: the coarse mesh would be coarser than half the overhang");
+  if (circle_segments != 0 && (circle_segments < 8 || circle_segments > 100000))
+    return Fail(why, "circle_segments: must be 0 (automatic) or in 8..100000");
+  if (seams != DrapeSeams::kNone) {
+    std::string w;
+    if (!seam_profile.Check(&w)) return Fail(why, "seam_profile: " + w);
+  }
+  if (!Finite(seam_shift) || std::abs(seam_shift) >= specimen_radius)
+    return Fail(why, "seam_shift: must be inside the specimen");
+  if (!Finite(seam_refinement_range) || seam_refinement_range < 0.0)
+    return Fail(why, "seam_refinement_range: must be ≥ 0");
+  std::string w;
+  if (!solver.Check(&w)) return Fail(why, "solver: " + w);
+  if (!Finite(raster_cell) || raster_cell <= 0.0 || raster_cell > 0.05 * specimen_radius)
+    return Fail(why, "raster_cell: must be in (0, specimen_radius / 20]");
+  if (specimen_radius / raster_cell > 4000.0)
+    return Fail(why, "raster_cell: too fine for this specimen (over 8000 cells across)");
+  if (outline_bins < 8 || outline_bins > 100000) return Fail(why, "outline_bins: must be in 8..100000");
+  if (smoothing_bins < 1 || smoothing_bins % 2 == 0 || smoothing_bins > outline_bins / 4)
+    return Fail(why, "smoothing_bins: must be odd, ≥ 1 and at most a quarter of outline_bins");
+  if (!Finite(node_prominence) || node_prominence < 0.0)
+    return Fail(why, "node_prominence: must be ≥ 0");
+  if (!Finite(node_prominence_relative) || node_prominence_relative < 0.0 ||
+      node_prominence_relative >= 1.0)
+    return Fail(why, "node_prominence_relative: must be in [0, 1)");
+  return true;
+}
+
+DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double cell, int bins) {
+  if (!(cell > 0.0) || !Finite(cell)) throw InputError("shadow: raster cell must be > 0");
+  if (bins < 8) throw InputError("shadow: need at least 8 angle bins");
+  if (x.rows() == 0 || triangles.rows() == 0) throw InputError("shadow: empty mesh");
+  if (!x.allFinite()) throw InputError("shadow: non-finite vertex positions");
+  if (triangles.minCoeff() < 0 || triangles.maxCoeff() >= x.rows())
+    throw InputError("shadow: triangle index out of range");
+  DrapeShadow s;
+  s.cell = cell;
+  const double lo_x = x.col(0).minCoeff(), hi_x = x.col(0).maxCoeff();
+  const double lo_y = x.col(1).minCoeff(), hi_y = x.col(1).maxCoeff();
+  const double cells_x = (hi_x - lo_x) / cell, cells_y = (hi_y - lo_y) / cell;
+  if (cells_x * cells_y > 1e8) throw InputError("shadow: the projection spans over 1e8 raster cells");
+  // Two empty cells of margin on every side, so the border is outside the shadow.
+  s.width = static_cast<int>(std::ceil(cells_x)) + 5;
+  s.height = static_cast<int>(std::ceil(cells_y)) + 5;
+  s.origin_x = lo_x - 2.0 * cell;
+  s.origin_y = lo_y - 2.0 * cell;
+  s.mask.assign(static_cast<size_t>(s.width) * s.height, 0);
+  auto at = [&](int i, int j) -> std::uint8_t& { return s.mask[static_cast<size_t>(j) * s.width + i]; };
+
+  for (int f = 0; f < triangles.rows(); ++f) {
+    const Eigen::Vector2d a = x.row(triangles(f, 0)).head<2>().transpose();
+    const Eigen::Vector2d b = x.row(triangles(f, 1)).head<2>().transpose();
+    const Eigen::Vector2d c = x.row(triangles(f, 2)).head<2>().transpose();
+    const double area2 = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    if (area2 == 0.0) continue;  // seen edge-on: its neighbours cover its line
+    const double sign = area2 > 0.0 ? 1.0 : -1.0;
+    const int i0 = std::max(0, static_cast<int>(std::floor((std::min({a.x(), b.x(), c.x()}) - s.origin_x) / cell)));
+    const int i1 = std::min(s.width - 1, static_cast<int>(std::ceil((std::max({a.x(), b.x(), c.x()}) - s.origin_x) / cell)));
+    const int j0 = std::max(0, static_cast<int>(std::floor((std::min({a.y(), b.y(), c.y()}) - s.origin_y) / cell)));
+    const int j1 = std::min(s.height - 1, static_cast<int>(std::ceil((std::max({a.y(), b.y(), c.y()}) - s.origin_y) / cell)));
+    // Edge functions, inclusive (a cell centre on a shared edge belongs to both triangles).
+    auto edge = [sign](const Eigen::Vector2d& p, const Eigen::Vector2d& q, double px, double py) {
+      return sign * ((q.x() - p.x()) * (py - p.y()) - (q.y() - p.y()) * (px - p.x()));
+    };
+    for (int j = j0; j <= j1; ++j) {
+      const double py = s.origin_y + j * cell;
+      for (int i = i0; i <= i1; ++i) {
+        const double px = s.origin_x + i * cell;
+        if (edge(a, b, px, py) >= 0.0 && edge(b, c, px, py) >= 0.0 && edge(c, a, px, py) >= 0.0)
+          at(i, j) = 1;
+      }
+    }
+  }
+  // Holes filled: flood the empty cells from the border; what the flood does not reach is shadow.
+  std::deque<std::pair<int, int>> queue;
+  auto seed = [&](int i, int j) {
+    if (at(i, j) == 0) {
+      at(i, j) = 2;
+      queue.emplace_back(i, j);
+    }
+  };
+  for (int i = 0; i < s.width; ++i) seed(i, 0), seed(i, s.height - 1);
+  for (int j = 0; j < s.height; ++j) seed(0, j), seed(s.width - 1, j);
+  while (!queue.empty()) {
+    const auto [i, j] = queue.front();
+    queue.pop_front();
+    if (i > 0) seed(i - 1, j);
+    if (i + 1 < s.width) seed(i + 1, j);
+    if (j > 0) seed(i, j - 1);
+    if (j + 1 < s.height) seed(i, j + 1);
+  }
+  long count = 0;
+  s.angles.resize(bins);
+  s.radii = Eigen::VectorXd::Constant(bins, -1.0);
+  for (int b = 0; b < bins; ++b) s.angles(b) = (b + 0.5) * 2.0 * kPi / bins;
+  for (int j = 0; j < s.height; ++j) {
+    for (int i = 0; i < s.width; ++i) {
+      std::uint8_t& m = at(i, j);
+      m = m == 2 ? 0 : 1;
+      if (!m) continue;
+      ++count;
+      const double px = s.origin_x + i * cell, py = s.origin_y + j * cell;
+      double theta = std::atan2(py, px);
+      if (theta < 0.0) theta += 2.0 * kPi;
+      const int b = std::min(bins - 1, static_cast<int>(theta / (2.0 * kPi) * bins));
+      s.radii(b) = std::max(s.radii(b), std::hypot(px, py));
+    }
+  }
+  s.area = static_cast<double>(count) * cell * cell;
+  // Bins no cell centre reached (a tiny shadow, or fine bins near the centre): interpolate
+  // between the nearest filled bins on either side, circularly.
+  std::vector<int> filled;
+  for (int b = 0; b < bins; ++b)
+    if (s.radii(b) >= 0.0) filled.push_back(b);
+  if (filled.empty()) {
+    s.radii.setZero();
+  } else if (static_cast<int>(filled.size()) < bins) {
+    const Eigen::VectorXd raw = s.radii;
+    for (size_t k = 0; k < filled.size(); ++k) {
+      const int from = filled[k], to = filled[(k + 1) % filled.size()];
+      const int gap = (to - from + bins) % bins == 0 ? bins : (to - from + bins) % bins;
+      for (int g = 1; g < gap; ++g) {
+        const double t = static_cast<double>(g) / gap;
+        s.radii((from + g) % bins) = (1.0 - t) * raw(from) + t * raw(to);
+      }
+    }
+  }
+  return s;
+}
+
+DrapeNodes FindNodes(const Eigen::VectorXd& radii, int smoothing_bins, double min_prominence,
+                     double relative_prominence) {
+  const int n = static_cast<int>(radii.size());
+  if (n < 3) throw InputError("nodes: need at least 3 outline bins");
+  if (smoothing_bins < 1 || smoothing_bins % 2 == 0 || smoothing_bins > n)
+    throw InputError("nodes: smoothing_bins must be odd and between 1 and the number of bins");
+  if (!radii.allFinite()) throw InputError("nodes: non-finite outline radius");
+  Eigen::VectorXd s(n);
+  const int half = smoothing_bins / 2;
+  for (int i = 0; i < n; ++i) {
+    double sum = 0.0;
+    for (int k = -half; k <= half; ++k) sum += radii(((i + k) % n + n) % n);
+    s(i) = sum / smoothing_bins;
+  }
+  const double lo = s.minCoeff(), hi = s.maxCoeff();
+  const double threshold = std::max(min_prominence, relative_prominence * (hi - lo));
+  DrapeNodes nodes;
+  if (hi - lo <= 0.0) return nodes;
+  for (int i = 0; i < n; ++i) {
+    const double v = s(i);
+    // Strict on the left, non-strict on the right: a plateau counts once, at its first bin.
+    if (!(v > s((i - 1 + n) % n) && v >= s((i + 1) % n))) continue;
+    double left_min = v, right_min = v;
+    bool higher = false;
+    for (int k = 1; k < n; ++k) {
+      const double u = s(((i - k) % n + n) % n);
+      if (u > v) {
+        higher = true;
+        break;
+      }
+      left_min = std::min(left_min, u);
+    }
+    for (int k = 1; k < n; ++k) {
+      const double u = s((i + k) % n);
+      if (u > v) break;
+      right_min = std::min(right_min, u);
+    }
+    const double prominence = higher ? v - std::max(left_min, right_min) : v - lo;
+    if (prominence < threshold || prominence <= 0.0) continue;
+    nodes.angles.push_back((i + 0.5) * 2.0 * kPi / n);
+    nodes.radii.push_back(radii(i));
+    nodes.prominences.push_back(prominence);
+  }
+  return nodes;
+}
+
+double DrapeCoefficient(double shadow_area, double specimen_area, double support_area) {
+  if (!(support_area > 0.0) || !(specimen_area > support_area) || !Finite(specimen_area))
+    throw InputError("drape coefficient: need specimen area > support area > 0");
+  if (!Finite(shadow_area) || shadow_area < 0.0)
+    throw InputError("drape coefficient: shadow area must be finite and ≥ 0");
+  return (shadow_area - support_area) / (specimen_area - support_area);
+}
+
+std::vector<SeamLine> DrapeSeamLines(const DrapeOptions& o) {
+  // The pattern's x axis is the warp (bending_element.h), y the weft.
+  const double weft = o.frame_angle + 0.5 * kPi, warp = o.frame_angle;
+  const double r = o.specimen_radius;
+  switch (o.seams) {
+    case DrapeSeams::kNone: return {};
+    case DrapeSeams::kWeft: return {Chord(r, weft, 0.0)};
+    case DrapeSeams::kWeftWarp: return {Chord(r, weft, 0.0), Chord(r, warp, 0.0)};
+    case DrapeSeams::kShifted: return {Chord(r, weft, -o.seam_shift)};
+  }
+  return {};
+}
+
+DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
+  std::string why;
+  if (!o.Check(&why)) throw InputError("drape options: " + why);
+  DrapeResult result;
+  std::vector<Seam> seams;
+  result.seam_lines = DrapeSeamLines(o);
+  for (const SeamLine& line : result.seam_lines) seams.push_back(Seam{o.seam_profile, line});
+
+  auto say = [&o](const std::string& line) {
+    if (o.progress) o.progress(line);
+  };
+  const Pattern fine = MeshPattern(o, seams, o.element_size);
+  std::unique_ptr<Pattern> coarse;
+  if (o.coarse_to_fine) {
+    coarse = std::make_unique<Pattern>(MeshPattern(o, seams, o.coarse_factor * o.element_size));
+    result.coarse_vertices = coarse->pm.mesh.num_vertices();
+  }
+  result.mesh = fine.pm.mesh;
+  result.seam_paths = fine.pm.seam_paths;
+  result.seam_paths.pop_back();  // the support circle is not a seam
+  result.specimen_area = TriangleAreas(fine.pm.mesh).sum();
+  result.support_area = kPi * o.support_radius * o.support_radius;
+  {
+    std::ostringstream line;
+    line << "mesh: " << fine.pm.mesh.num_vertices() << " vertices, " << fine.pm.mesh.num_triangles()
+         << " triangles" << (coarse ? " (coarse " + std::to_string(result.coarse_vertices) + " vertices)" : "")
+         << ", " << fine.clamp.size() << " on the support";
+    say(line.str());
+  }
+
+  std::vector<double> dcs, node_counts, mins, maxs, means;
+  for (int k = 0; k < o.seeds; ++k) {
+    DrapeSeedResult seed;
+    seed.seed = o.first_seed + static_cast<unsigned>(k);
+    auto fine_problem = MakeProblem(fine, material, seams, o);
+    result.mass = fine_problem->total_mass();
+    if (coarse) {
+      auto coarse_problem = MakeProblem(*coarse, material, seams, o);
+      Vertices xc = StartState(coarse->pm.mesh, o, seed.seed);
+      seed.summary = SolveCascadic(coarse_problem.get(), fine_problem.get(), &xc, &seed.positions, o.solver);
+    } else {
+      seed.positions = StartState(fine.pm.mesh, o, seed.seed);
+      seed.summary = SolveStatic(fine_problem.get(), &seed.positions, o.solver);
+    }
+    seed.converged = seed.summary.converged;
+    seed.drape_coefficient = kNaN;
+    if (seed.converged) {
+      seed.shadow = MeasureShadow(seed.positions, fine.pm.mesh.triangles, o.raster_cell, o.outline_bins);
+      seed.drape_coefficient = DrapeCoefficient(seed.shadow.area, result.specimen_area, result.support_area);
+      seed.nodes = FindNodes(seed.shadow.radii, o.smoothing_bins, o.node_prominence,
+                             o.node_prominence_relative);
+      seed.min_radius = seed.shadow.radii.minCoeff();
+      seed.max_radius = seed.shadow.radii.maxCoeff();
+      seed.mean_radius = seed.shadow.radii.mean();
+      dcs.push_back(seed.drape_coefficient);
+      node_counts.push_back(static_cast<double>(seed.nodes.angles.size()));
+      mins.push_back(seed.min_radius);
+      maxs.push_back(seed.max_radius);
+      means.push_back(seed.mean_radius);
+    }
+    {
+      std::ostringstream line;
+      line << "seed " << seed.seed << ": " << seed.summary.BriefReport();
+      if (seed.converged)
+        line << "; DC " << seed.drape_coefficient << ", " << seed.nodes.angles.size() << " nodes";
+      say(line.str());
+    }
+    if (!seed.converged && result.message.empty()) {
+      result.message = "seed " + std::to_string(seed.seed) + ": " + seed.summary.message;
+    }
+    result.per_seed.push_back(std::move(seed));
+  }
+  result.converged = result.message.empty();
+  if (result.converged) {
+    result.message = "converged";
+    result.drape_coefficient = Mean(dcs);
+    result.drape_coefficient_sd = SampleSd(dcs);
+    result.nodes = Mean(node_counts);
+    result.nodes_sd = SampleSd(node_counts);
+    result.min_radius = Mean(mins);
+    result.max_radius = Mean(maxs);
+    result.mean_radius = Mean(means);
+  } else {
+    result.drape_coefficient = result.drape_coefficient_sd = kNaN;
+    result.nodes = result.nodes_sd = kNaN;
+    result.min_radius = result.max_radius = result.mean_radius = kNaN;
+  }
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace textile

@@ -107,7 +107,11 @@ Vertices StartState(const TriangleMesh& mesh, const DrapeOptions& o, unsigned se
     for (size_t i = 0; i < c.size(); ++i)
       w += c[i] * std::cos((o.min_harmonic + static_cast<int>(i)) * theta + phi[i]);
     const double t = (r - o.support_radius) / overhang;
-    x(v, 2) += o.perturbation * t * t * w / total;
+    const double s = r - o.support_radius;
+    const double scale = (o.support_radius + s * std::cos(o.start_droop)) / r;
+    x(v, 0) *= scale;
+    x(v, 1) *= scale;
+    x(v, 2) += -s * std::sin(o.start_droop) + o.perturbation * t * t * w / total;
   }
   return x;
 }
@@ -202,6 +206,8 @@ bool DrapeOptions::Check(std::string* why) const {
     return Fail(why, "perturbation: must be in (0, specimen_radius]");
   if (min_harmonic < 1 || max_harmonic < min_harmonic || max_harmonic > 64)
     return Fail(why, "harmonics: need 1 ≤ min_harmonic ≤ max_harmonic ≤ 64");
+  if (!Finite(start_droop) || start_droop < 0.0 || start_droop > 0.5 * kPi)
+    return Fail(why, "start_droop: must be in [0, π/2]");
   if (!Finite(frame_angle)) return Fail(why, "frame_angle: must be finite");
   if (!Finite(element_size) || element_size <= 0.0 ||
       element_size > 0.5 * (specimen_radius - support_radius))

@@ -31,4 +31,19 @@ for f in samples/materials/pabst-fig8.json "$out/pabst-fig8.fitted.json" "$out/p
     awk '$1 ~ /^[0-9.]+$/ && NF >= 6 { printf "  M(%s/cm) = %.5f", $1, $3 } END { print "  gf·cm/cm" }'
 done
 echo
+echo "== 4. Photos -> the law: calibrate the camera on its chessboard, fit the photos (textile calibrate, fit)"
+echo "   samples/photos/: rendered photos of the Fig. 8 fabric at 40, 60 and 80 mm, their board and truth"
+"$textile" calibrate samples/photos/pabst-fig8.board.jpg --board 9x6 --square-mm 8.5 \
+  -o "$out/pabst-fig8.rig.json"
+"$textile" fit samples/photos/pabst-fig8_L0{40,60,80}mm.jpg --rig "$out/pabst-fig8.rig.json" --gsm 200 \
+  -o "$out/pabst-fig8.photos.fitted.json" --plot "$out/pabst-fig8.photos.fit.png"
+"$textile" extract samples/photos/pabst-fig8_L060mm.jpg --rig "$out/pabst-fig8.rig.json" \
+  -o "$out/photos" --overlay-px 1000 > /dev/null
+for f in samples/materials/pabst-fig8.json "$out/pabst-fig8.photos.fitted.json"; do
+  printf '%-36s' "$f:"
+  "$textile" law --material "$f" --kappa 0.5 1 1.5 |
+    awk '$1 ~ /^[0-9.]+$/ && NF >= 6 { printf "  M(%s/cm) = %.5f", $1, $3 } END { print "  gf·cm/cm" }'
+done
+echo "   (overlay of the 60 mm photo: $out/photos/pabst-fig8_L060mm.overlay.png)"
+echo
 echo "Pictures and outputs: $out"

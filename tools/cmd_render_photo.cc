@@ -58,6 +58,25 @@ std::string WithSuffix(const std::string& path, const std::string& suffix, const
   return (p.parent_path() / (p.stem().string() + suffix + ext)).string();
 }
 
+// The truth at about `spacing` [m] of arc (the renderer samples every quarter pixel), ends kept.
+Profile Thinned(const Profile& p, double spacing) {
+  if (p.size() < 3) return p;
+  const double ds = p.s.back() / static_cast<double>(p.size() - 1);
+  const size_t k = std::max<size_t>(1, static_cast<size_t>(spacing / ds));
+  Profile out;
+  out.source = p.source;
+  for (size_t i = 0; i < p.size(); i += k) {
+    if (i + 1 == p.size()) break;
+    out.s.push_back(p.s[i]);
+    out.x.push_back(p.x[i]);
+    out.y.push_back(p.y[i]);
+  }
+  out.s.push_back(p.s.back());
+  out.x.push_back(p.x.back());
+  out.y.push_back(p.y.back());
+  return out;
+}
+
 void WriteImage(const AtomicFile& f, const cv::Mat& image, const std::vector<unsigned char>& jpeg,
                 bool as_jpeg) {
   if (as_jpeg && !jpeg.empty()) {
@@ -116,7 +135,8 @@ void Run(const RenderArgs& a) {
   std::stable_sort(order.begin(), order.end(), [&](size_t i, size_t j) { return lengths[i] > lengths[j]; });
 
   const std::string ext = std::filesystem::path(a.out).extension().string();
-  const std::string board_path = WithSuffix(a.out, ".board", ".png");
+  // The board in the photo's format (JPEG boards keep samples small; corners stay sub-pixel).
+  const std::string board_path = WithSuffix(a.out, ".board", as_jpeg ? ".jpg" : ".png");
   const std::string rig_path = WithSuffix(a.out, ".rig-truth", ".json");
   std::vector<std::unique_ptr<AtomicFile>> files;
   files.push_back(std::make_unique<AtomicFile>(board_path));
@@ -135,13 +155,15 @@ void Run(const RenderArgs& a) {
     const RenderedPhoto r = RenderPhoto(m.EffectiveLaw(), m.areal_density, o);
     if (k == 0) {
       o.aim_mm = r.aim_mm;
-      if (!cv::imwrite(files[0]->temp_path(), r.board)) throw InputError(board_path + ": cannot write");
+      std::vector<int> params;
+      if (as_jpeg) params = {cv::IMWRITE_JPEG_QUALITY, 95};
+      if (!cv::imwrite(files[0]->temp_path(), r.board, params)) throw InputError(board_path + ": cannot write");
       std::ofstream(files[1]->temp_path()) << RigToJson(r.rig);
     }
     files.push_back(std::make_unique<AtomicFile>(photo_path));
     WriteImage(*files.back(), r.photo, r.encoded, as_jpeg);
     files.push_back(std::make_unique<AtomicFile>(truth_path));
-    std::ofstream(files.back()->temp_path(), std::ios::binary) << ProfileToCsv(r.truth);
+    std::ofstream(files.back()->temp_path(), std::ios::binary) << ProfileToCsv(Thinned(r.truth, 1e-4));
     by_input[i] = {{"photo", photo_path},
                    {"truth_csv", truth_path},
                    {"overhang_mm", lengths[i]},
@@ -194,7 +216,7 @@ void RegisterRenderPhoto(CLI::App& app) {
                   "Overhang length(s) [mm]; several give <stem>_L060mm.png etc., one camera")
       ->required();
   sub->add_option("-o,--out", a->out,
-                  "Photo to write (.png or .jpg); also <stem>.truth.csv, <stem>.board.png and "
+                  "Photo to write (.png or .jpg); also <stem>.truth.csv, <stem>.board.png|jpg and "
                   "<stem>.rig-truth.json")
       ->required();
   sub->add_option("--difficulty", a->difficulty, "easy, medium (default) or hard");

@@ -305,7 +305,7 @@ RenderPhotoOptions RenderPhotoOptions::ForDifficulty(PhotoDifficulty difficulty,
       o.gradient = 0.25 + 0.1 * u(rng);
       o.shadow = 0.25 + 0.1 * u(rng);
       o.texture = 0.06;
-      o.tip_fibres = 12;
+      o.tip_fibres = 8;
       o.edge_fibres = 40;
       o.blur_px = 1.2;
       o.noise = 3.0;
@@ -442,10 +442,13 @@ RenderedPhoto RenderPhoto(const BendingLaw& law, double areal_density,
   const double margin = 0.08 * std::min(W, H);
   // The platform takes a sixth to a quarter of the width, the strip the rest.
   const double plat = std::clamp(W - xmax - 2 * margin, W / 6.0, W / 4.0);
-  const double top = t_mm + margin, bottom = ymin - margin;
+  // Background above the platform: most of the spare height (the extractor models the
+  // background from it), at least 6 % of the height.
+  const double spare = H - (t_mm - ymin);
+  const double top_margin = std::clamp(0.6 * spare, 0.06 * H, 0.3 * H);
   const Eigen::Vector2d aim =
       o.aim_mm ? *o.aim_mm
-               : Eigen::Vector2d(-plat + W / 2.0 + o.aim_dx * W, 0.5 * (top + bottom) - o.aim_dy * H);
+               : Eigen::Vector2d(-plat + W / 2.0 + o.aim_dx * W, t_mm + top_margin - H / 2.0 - o.aim_dy * H);
   const Camera cam = MakeCamera(o, aim);
 
   // Far points of the platform and of the strip lying on it: beyond the photo on every side.
@@ -507,7 +510,7 @@ RenderedPhoto RenderPhoto(const BendingLaw& law, double areal_density,
     const double ang = Deg(45.0) * gauss(rng);
     const Eigen::Vector2d dir = std::cos(ang) * tip_t + std::sin(ang) * normal[n - 1];
     const double len = 0.3 + 2.2 * u01(rng);
-    sc.strip.push_back(Project(cam, FibreQuad(start, start + len * dir, 0.015 + 0.03 * u01(rng)), true));
+    sc.strip.push_back(Project(cam, FibreQuad(start, start + len * dir, 0.01 + 0.02 * u01(rng)), true));
   }
   for (int k = 0; k < o.edge_fibres; ++k) {
     const int i = std::clamp(static_cast<int>(n * (0.05 + 0.93 * u01(rng))), 0, n - 2);

@@ -12,11 +12,14 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "../fit/synthetic_photo.h"
 #include "run_cli.h"
+#include "textile/fit/law_error.h"
+#include "textile/sim/material.h"
 
 namespace textile {
 namespace {
@@ -437,6 +440,39 @@ TEST(CliFit, PhotoInputsNeedARigAndAreNamedWhenBad) {
     EXPECT_EQ(CountLines(r.err), 1) << r.err;
     EXPECT_NE(r.err.find(c.words), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+TEST(CliFit, ShippedPhotosGiveTheExpectedLawAndTheTruthWithinOnePercent) {
+  // samples/photos: rendered photos (medium level) of two of the paper's fabrics, their boards.
+  // Calibrate on the board, fit the photos: the shipped expected law is reproduced, and the
+  // moment curve is within 1 % of the truth (issue 4's target for fits from photos).
+  struct Case {
+    std::string fabric, overhangs, gsm, square;
+  };
+  const auto dir = Scratch("cli_fit_sample_photos");
+  for (const Case& c : {Case{"pabst-fig8", "040 060 080", "200", "8.5"},
+                        Case{"pabst-interlining", "070 100 140", "250", "10.5"}}) {
+    SCOPED_TRACE(c.fabric);
+    const std::string photos_dir = "samples/photos/";
+    const fs::path rig = dir / (c.fabric + ".rig.json"), out = dir / (c.fabric + ".json");
+    const auto cal = Textile("calibrate " + photos_dir + c.fabric + ".board.jpg --board 9x6 --square-mm " +
+                             c.square + " -o " + Quote(rig));
+    ASSERT_EQ(cal.exit_code, 0) << cal.err;
+    std::string photos;
+    std::stringstream in(c.overhangs);
+    for (std::string L; in >> L;) photos += photos_dir + c.fabric + "_L" + L + "mm.jpg ";
+    const auto r = Textile("fit " + photos + "--rig " + Quote(rig) + " --gsm " + c.gsm + " -o " + Quote(out));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string src = TEXTILE_SOURCE_DIR;
+    const Material got = ReadMaterial(out.string());
+    const Material expected = ReadMaterial(src + "/samples/photos/" + c.fabric + ".fitted.json");
+    const Material truth = ReadMaterial(src + "/samples/materials/" + c.fabric + ".json");
+    const double kappa_max = got.fit["kappa_max_per_cm"].get<double>() * 100.0;
+    // Optimiser precision, as for the shipped profiles (cli_samples_test.cc).
+    EXPECT_LT(MomentCurveError(got.bending, expected.bending, kappa_max), 1e-4);
+    EXPECT_LT(MomentCurveError(got.bending, truth.bending, kappa_max), 0.01);
+    EXPECT_EQ(got.fit["photos"].size(), 3u);
   }
 }
 

@@ -38,7 +38,7 @@ TEST(CliRenderPhoto, WritesPhotoTruthRigAndBoard) {
   const auto r = Textile("render-photo --material " + kFig8 + " --overhang-mm 50 -o " +
                          Quote(dir / "strip.jpg") + kSmall + " --difficulty medium --seed 3 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_EQ(Listing(dir), (std::set<std::string>{"strip.jpg", "strip.truth.csv", "strip.board.png",
+  EXPECT_EQ(Listing(dir), (std::set<std::string>{"strip.jpg", "strip.truth.csv", "strip.board.jpg",
                                                  "strip.rig-truth.json"}));
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("photos").size(), 1u);
@@ -49,7 +49,7 @@ TEST(CliRenderPhoto, WritesPhotoTruthRigAndBoard) {
   EXPECT_NEAR(rig.MmPerPxAt({400, 300}), 0.15, 0.02);
   const cv::Mat photo = cv::imread((dir / "strip.jpg").string(), cv::IMREAD_GRAYSCALE);
   EXPECT_EQ(photo.cols, 800);
-  EXPECT_EQ(cv::imread((dir / "strip.board.png").string(), cv::IMREAD_GRAYSCALE).rows, 600);
+  EXPECT_EQ(cv::imread((dir / "strip.board.jpg").string(), cv::IMREAD_GRAYSCALE).rows, 600);
 }
 
 TEST(CliRenderPhoto, SeveralOverhangsShareOneCamera) {

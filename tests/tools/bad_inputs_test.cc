@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -313,10 +314,27 @@ TEST(BadInputs, EverySubcommandHasCases) {
   }
 }
 
-TEST(BadInputs, EveryCaseIsRefusedCleanly) {
+// One test per manifest (BadInputs/Manifest.EveryCaseIsRefusedCleanly/fit, ...), so that ctest
+// runs them in parallel and each has its own timeout. The list of manifests is read when the
+// test binary starts (a new manifest needs a rebuild to get its test; new lines do not).
+std::vector<std::string> ManifestStems() {
+  std::vector<std::string> stems;
+  std::error_code ec;
+  if (!fs::is_directory(kCorpus, ec)) return stems;
+  for (const fs::path& m : Manifests()) stems.push_back(m.stem().string());
+  return stems;
+}
+
+class Manifest : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(Manifest, EveryCaseIsRefusedCleanly) {
   std::vector<std::string> errors;
-  const std::vector<Case> cases = LoadCases(&errors);
+  std::vector<Case> cases;
+  for (const Case& c : LoadCases(&errors)) {
+    if (c.manifest == GetParam() + ".cases") cases.push_back(c);
+  }
   ASSERT_TRUE(errors.empty()) << errors.front();
+  ASSERT_FALSE(cases.empty()) << GetParam() << ".cases has no case";
   int xfailed = 0;
   for (const Case& c : cases) {
     SCOPED_TRACE(c.manifest + ":" + std::to_string(c.line) + " " + c.name);
@@ -340,8 +358,19 @@ TEST(BadInputs, EveryCaseIsRefusedCleanly) {
     }
     if (problems.empty()) fs::remove_all(out);
   }
-  std::printf("[ corpus   ] %zu cases, %d known failures (xfail)\n", cases.size(), xfailed);
+  std::printf("[ corpus   ] %s: %zu cases, %d known failures (xfail)\n", GetParam().c_str(),
+              cases.size(), xfailed);
 }
+
+INSTANTIATE_TEST_SUITE_P(BadInputs, Manifest, ::testing::ValuesIn(ManifestStems()),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           std::string name = info.param;
+                           for (char& ch : name) {
+                             if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+                           }
+                           return name;
+                         });
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(Manifest);
 
 }  // namespace
 }  // namespace textile::testing

@@ -451,8 +451,9 @@ TEST(CliFit, ShippedPhotosGiveTheExpectedLawAndTheTruthWithinOnePercent) {
     std::string fabric, overhangs, gsm, square;
   };
   const auto dir = Scratch("cli_fit_sample_photos");
-  for (const Case& c : {Case{"pabst-fig8", "040 060 080", "200", "8.5"},
-                        Case{"pabst-interlining", "070 100 140", "250", "10.5"}}) {
+  // The Fig. 8 fabric only (the interlining's photos are made and fitted the same way; one
+  // fabric keeps the test short).
+  for (const Case& c : {Case{"pabst-fig8", "040 060 080", "200", "8.5"}}) {
     SCOPED_TRACE(c.fabric);
     const std::string photos_dir = "samples/photos/";
     const fs::path rig = dir / (c.fabric + ".rig.json"), out = dir / (c.fabric + ".json");

@@ -1,0 +1,55 @@
+#ifndef TEXTILE_SIM_ACPM_SHELL_H_
+#define TEXTILE_SIM_ACPM_SHELL_H_
+
+// The shell model of the virtual ACPM200 (acpm.h): the 3D cloth engine (cloth_problem.h,
+// static_solver.h) pushes the sample over the platform edge in quasi-static steps.
+//
+//   textile::AcpmOptions options;                    // plain 200 mm sample
+//   options.model = textile::AcpmModelKind::kShell;  // RunAcpm plugs this model in
+//   textile::AcpmResult r = textile::RunAcpm(fabric, options);
+//
+// The scene at overhang L: the sample's overhanging part [0, L] × [0, W] (x along the push, y
+// across the width, z up) plus one cell on the platform, whose vertices are held flat: the
+// platform holds the sample as the elastica's clamp does (the part on the platform stays flat
+// under its own weight, cantilever.md). A tensor-product grid with a constant number of cells
+// stretches with L, so each step is warm-started from the last state; a seam along the push
+// direction lies on a grid line, a seam across it at its distance behind the front. The front
+// edge's height over the 41.5° barrier plane is interpolated at every ray; the push steps
+// until every ray is cut, then each ray's crossing is refined (Illinois regula falsi on the
+// solved states) to AcpmOptions::crossing_tolerance. Solved states are shared by all rays.
+
+#include <vector>
+
+#include "textile/sim/acpm.h"
+#include "textile/sim/static_solver.h"
+
+namespace textile {
+
+struct ShellAcpmSettings {
+  // Element length along the push direction [m]; the grid has ⌈L_ref / this⌉ cells over the
+  // overhang, L_ref the plain elastica's crossing.
+  double element_length = 0.002;
+  // Cells across the width: plain samples and seams across (nothing varies across the width
+  // but the mesh must still be a shell) and seams along (the seam's stiffness profile S(d)
+  // must be resolved; the seam line is snapped to a grid line).
+  int width_cells_plain = 2;
+  int width_cells_seam = 20;
+  // Static solver settings for every push step.
+  SolveOptions solve = [] {
+    SolveOptions s;
+    s.tolerance = 1e-7;
+    s.max_iterations = 400;
+    return s;
+  }();
+
+  bool Check(std::string* why) const;
+};
+
+// The AcpmModel of acpm.h (so RunAcpm can call it): crossings of every ray at z_i [m].
+AcpmCrossings ShellAcpmCrossings(const Material& material, const AcpmOptions& options,
+                                 const std::vector<double>& ray_z,
+                                 const ShellAcpmSettings& settings = {});
+
+}  // namespace textile
+
+#endif  // TEXTILE_SIM_ACPM_SHELL_H_

@@ -1,0 +1,303 @@
+#include "textile/sim/acpm_shell.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "textile/sim/cantilever_outputs.h"
+#include "textile/sim/error.h"
+#include "textile/sim/units.h"
+
+namespace textile {
+namespace {
+
+// Triangles of a tensor-product grid xs × ys (vertex (i, j) = i * ny1 + j), split along one
+// diagonal like RegularGridMesh.
+TriangleMesh TensorGrid(const std::vector<double>& xs, const std::vector<double>& ys) {
+  const int nx1 = static_cast<int>(xs.size()), ny1 = static_cast<int>(ys.size());
+  TriangleMesh mesh;
+  mesh.vertices.resize(static_cast<long>(nx1) * ny1, 3);
+  for (int i = 0; i < nx1; ++i)
+    for (int j = 0; j < ny1; ++j) mesh.vertices.row(i * ny1 + j) << xs[i], ys[j], 0.0;
+  mesh.triangles.resize(2L * (nx1 - 1) * (ny1 - 1), 3);
+  int f = 0;
+  for (int i = 0; i + 1 < nx1; ++i) {
+    for (int j = 0; j + 1 < ny1; ++j) {
+      const int a = i * ny1 + j, b = (i + 1) * ny1 + j, c = (i + 1) * ny1 + j + 1, d = i * ny1 + j + 1;
+      if ((i + j) % 2 == 0) {
+        mesh.triangles.row(f++) << a, b, c;
+        mesh.triangles.row(f++) << a, c, d;
+      } else {
+        mesh.triangles.row(f++) << a, b, d;
+        mesh.triangles.row(f++) << b, c, d;
+      }
+    }
+  }
+  return mesh;
+}
+
+// One push: the sample at a given overhang, its grid and its solver state.
+class PushedSample {
+ public:
+  PushedSample(const Material& material, const AcpmOptions& options, const AcpmSeam& seam,
+               const ShellAcpmSettings& settings, double reference_overhang)
+      : material_(material), options_(options), seam_(seam), settings_(settings) {
+    nx_ = std::max(8, static_cast<int>(std::ceil(reference_overhang / settings.element_length)));
+    platform_ = reference_overhang / nx_;
+    // Across the width: uniform, with the seam along the push direction on a grid line.
+    const bool along = seam.direction == AcpmSeamDirection::kAlong;
+    const int ny = along ? settings.width_cells_seam : settings.width_cells_plain;
+    for (int j = 0; j <= ny; ++j) ys_.push_back(options.width * j / ny);
+    if (along) {
+      const double zs = std::isfinite(seam.position) ? seam.position : 0.5 * options.width;
+      auto nearest = std::min_element(ys_.begin() + 1, ys_.end() - 1, [&](double a, double b) {
+        return std::abs(a - zs) < std::abs(b - zs);
+      });
+      if (ny >= 2) *nearest = zs;
+      seam_z_ = zs;
+    }
+  }
+
+  // Solves the sample at overhang L, warm-started from the last solved state. False (with
+  // *message) when the solver did not converge.
+  bool Solve(double overhang, std::string* message) {
+    std::vector<double> xs = {-platform_};
+    for (int i = 0; i <= nx_; ++i) xs.push_back(overhang * i / nx_);
+    TriangleMesh mesh = TensorGrid(xs, ys_);
+    std::vector<Seam> seams;
+    if (seam_.direction == AcpmSeamDirection::kAlong) {
+      SeamLine line(2, 2);
+      line << -platform_, seam_z_, overhang, seam_z_;
+      seams.push_back({seam_.profile, line});
+    } else if (seam_.direction == AcpmSeamDirection::kAcross && seam_.position <= overhang) {
+      // A seam still on the platform is held flat there: it changes nothing.
+      SeamLine line(2, 2);
+      line << overhang - seam_.position, 0.0, overhang - seam_.position, options_.width;
+      seams.push_back({seam_.profile, line});
+    }
+    ClothOptions cloth;
+    cloth.contact.friction = 0.0;
+    problem_ = std::make_unique<ClothProblem>(mesh, material_, seams, cloth);
+    std::vector<int> held;
+    for (int v = 0; v < mesh.num_vertices(); ++v)
+      if (mesh.vertices(v, 0) <= 0.0) held.push_back(v);
+    Vertices at(static_cast<long>(held.size()), 3);
+    for (size_t k = 0; k < held.size(); ++k) at.row(static_cast<long>(k)) = mesh.vertices.row(held[k]);
+    problem_->FixVertices(held, at);
+    if (state_.rows() != mesh.num_vertices()) {
+      state_ = mesh.vertices;
+    } else {
+      // Warm start: the last state, stretched along its own shape to the new length.
+      const double scale = overhang / overhang_;
+      for (int v = 0; v < state_.rows(); ++v)
+        if (mesh.vertices(v, 0) > 0.0) state_.row(v) *= scale;
+    }
+    const SolveSummary s = SolveStatic(problem_.get(), &state_, settings_.solve);
+    ++solves_;
+    overhang_ = overhang;
+    mesh_ = std::move(mesh);
+    if (!s.converged) {
+      *message = "shell model: the static solve at overhang " +
+                 std::to_string(units::MToMm(overhang)) + " mm did not converge: " + s.message;
+      state_.resize(0, 3);  // a state that did not converge is not a warm start
+      return false;
+    }
+    return true;
+  }
+
+  // Height of the front above the barrier plane at width position z [m] (negative: the ray is
+  // cut). The plane holds the platform edge and descends at the barrier angle.
+  double FrontOverBarrier(double z) const {
+    const int ny1 = static_cast<int>(ys_.size());
+    const int row = (static_cast<int>(mesh_.num_vertices()) / ny1) - 1;
+    int j = 0;
+    while (j + 2 < ny1 && ys_[j + 1] < z) ++j;
+    const double t = std::clamp((z - ys_[j]) / (ys_[j + 1] - ys_[j]), 0.0, 1.0);
+    const Eigen::Vector3d p = (1.0 - t) * state_.row(row * ny1 + j).transpose() +
+                              t * state_.row(row * ny1 + j + 1).transpose();
+    const double a = options_.barrier_angle;
+    return std::sin(a) * p.x() + std::cos(a) * p.z();
+  }
+
+  // The side profile along the grid line nearest to z: (x, height) from the edge to the front.
+  void SideProfile(double z, std::vector<double>* px, std::vector<double>* py) const {
+    const int ny1 = static_cast<int>(ys_.size());
+    int j = 0;
+    for (int k = 1; k < ny1; ++k)
+      if (std::abs(ys_[k] - z) < std::abs(ys_[j] - z)) j = k;
+    px->clear();
+    py->clear();
+    for (int i = 1; i < mesh_.num_vertices() / ny1; ++i) {  // from the edge (i = 1) on
+      px->push_back(state_(i * ny1 + j, 0));
+      py->push_back(state_(i * ny1 + j, 2));
+    }
+  }
+
+  int solves() const { return solves_; }
+  int num_vertices() const { return mesh_.num_vertices(); }
+  const Vertices& state() const { return state_; }
+  void Restore(const Vertices& state, double overhang) {
+    state_ = state;
+    overhang_ = overhang;
+  }
+
+ private:
+  const Material& material_;
+  const AcpmOptions& options_;
+  AcpmSeam seam_;
+  ShellAcpmSettings settings_;
+  int nx_ = 0;
+  double platform_ = 0.0;
+  std::vector<double> ys_;
+  double seam_z_ = 0.0;
+  std::unique_ptr<ClothProblem> problem_;
+  TriangleMesh mesh_;
+  Vertices state_;
+  double overhang_ = 1.0;
+  int solves_ = 0;
+};
+
+struct Solved {
+  std::vector<double> front;  // per ray, height over the barrier [m]
+  Vertices state;
+};
+
+// Pushes until every ray is cut, then refines each ray's crossing.
+AcpmCrossings Push(const Material& material, const AcpmOptions& options, const AcpmSeam& seam,
+                   const std::vector<double>& ray_z, const ShellAcpmSettings& settings,
+                   double reference) {
+  AcpmCrossings out;
+  PushedSample sample(material, options, seam, settings, reference);
+  std::map<double, Solved> solved;  // by overhang
+  auto solve = [&](double overhang) -> const Solved* {
+    // Warm start from the nearest solved overhang.
+    if (!solved.empty()) {
+      auto it = solved.lower_bound(overhang);
+      if (it == solved.end() || (it != solved.begin() &&
+                                 overhang - std::prev(it)->first < it->first - overhang))
+        it = it == solved.begin() ? it : std::prev(it);
+      sample.Restore(it->second.state, it->first);
+    }
+    if (!sample.Solve(overhang, &out.message)) return nullptr;
+    Solved s{{}, sample.state()};
+    for (double z : ray_z) s.front.push_back(sample.FrontOverBarrier(z));
+    return &(solved[overhang] = std::move(s));
+  };
+  // Push in steps of 10 % of the reference until every ray is cut (or the sample ends).
+  double overhang = 0.6 * reference;
+  const double step = 0.1 * reference;
+  for (;;) {
+    const Solved* s = solve(overhang);
+    if (!s) return out;
+    if (*std::max_element(s->front.begin(), s->front.end()) <= 0.0) break;
+    if (overhang >= options.length) {
+      out.message = "does not reach the barrier within " +
+                    std::to_string(static_cast<int>(std::lround(units::MToMm(options.length)))) +
+                    " mm (shell model)";
+      return out;
+    }
+    overhang = std::min(overhang + step, options.length);
+  }
+  // Each ray: Illinois regula falsi between the last uncut and the first cut state.
+  out.overhang.assign(ray_z.size(), 0.0);
+  for (size_t r = 0; r < ray_z.size(); ++r) {
+    double lo = 0.0, hi = 0.0, f_lo = 0.0, f_hi = 0.0;
+    bool have_lo = false;
+    for (const auto& [l, s] : solved) {
+      if (s.front[r] > 0.0) {
+        lo = l;
+        f_lo = s.front[r];
+        have_lo = true;
+      } else {
+        hi = l;
+        f_hi = s.front[r];
+        if (have_lo) break;
+      }
+    }
+    if (!have_lo) {
+      out.message = "shell model: ray " + std::to_string(r) + " is cut at the first push step";
+      return out;
+    }
+    int side = 0;
+    while (hi - lo > options.crossing_tolerance) {
+      double mid = hi - f_hi * (hi - lo) / (f_hi - f_lo);
+      if (!(mid > lo && mid < hi)) mid = 0.5 * (lo + hi);
+      const Solved* s = solve(mid);
+      if (!s) return out;
+      const double f = s->front[r];
+      if (f > 0.0) {
+        lo = mid;
+        f_lo = f;
+        if (side == -1) f_hi *= 0.5;
+        side = -1;
+      } else {
+        hi = mid;
+        f_hi = f;
+        if (side == 1) f_lo *= 0.5;
+        side = 1;
+      }
+    }
+    out.overhang[r] = hi - f_hi * (hi - lo) / (f_hi - f_lo);
+  }
+  // Side profile at the middle ray's crossing.
+  out.profile_ray = static_cast<int>(ray_z.size() / 2);
+  if (solve(out.overhang[out.profile_ray]))
+    sample.SideProfile(ray_z[out.profile_ray], &out.profile_x, &out.profile_y);
+  out.solves = sample.solves();
+  out.converged = true;
+  std::ostringstream notes;
+  notes << "shell: " << sample.num_vertices() << " vertices, element "
+        << units::MToMm(settings.element_length) << " mm along the push, " << out.solves
+        << " static solves";
+  out.notes = notes.str();
+  return out;
+}
+
+}  // namespace
+
+bool ShellAcpmSettings::Check(std::string* why) const {
+  if (!(element_length > 1e-5) || !std::isfinite(element_length)) {
+    *why = "shell element length must be > 0.01 mm";
+    return false;
+  }
+  if (width_cells_plain < 1 || width_cells_seam < 2) {
+    *why = "shell width cells must be >= 1 (plain) and >= 2 (seam along)";
+    return false;
+  }
+  return solve.Check(why);
+}
+
+AcpmCrossings ShellAcpmCrossings(const Material& material, const AcpmOptions& options,
+                                 const std::vector<double>& ray_z,
+                                 const ShellAcpmSettings& settings) {
+  std::string why;
+  if (!settings.Check(&why)) throw InputError(why);
+  if (!options.Check(&why)) throw InputError(why);
+  // The plain fabric's exact crossing sets the scale of the grid and the push.
+  const BarrierCrossing plain_exact = FindBarrierCrossing(material.EffectiveLaw(),
+                                                          material.areal_density);
+  if (!plain_exact.converged) {
+    AcpmCrossings out;
+    out.message = "shell model: " + plain_exact.message;
+    return out;
+  }
+  const double reference = plain_exact.overhang;
+  AcpmCrossings result = Push(material, options, options.seam, ray_z, settings, reference);
+  if (!result.converged || options.seam.direction == AcpmSeamDirection::kNone) return result;
+  // The same fabric without the seam at the same resolution: its error cancels in the factor.
+  AcpmSeam none;
+  const std::vector<double> centre = {0.5 * options.width};
+  const AcpmCrossings plain = Push(material, options, none, centre, settings, reference);
+  if (!plain.converged) {
+    result.converged = false;
+    result.message = "plain reference: " + plain.message;
+    return result;
+  }
+  result.plain_overhang = plain.overhang.front();
+  result.solves += plain.solves;
+  return result;
+}
+
+}  // namespace textile

@@ -200,8 +200,8 @@ void Run(const AcpmArgs& a) {
               << (o.seam.direction == AcpmSeamDirection::kAcross ? " behind the front" : "") << "\n";
   }
   std::cout << "model: " << AcpmModelName(r.model) << " (" << r.model_reason << ")\n";
-  std::printf("  %3s %8s %8s %10s %9s %10s %8s %7s\n", "ray", "z [mm]", "d [mm]", "L [mm]",
-              "c [mm]", "G [µN·m]", "factor", "t [s]");
+  // (µ and · are two bytes each in UTF-8: the header is spelled out, not padded by printf.)
+  std::cout << "  ray   z [mm]   d [mm]     L [mm]    c [mm]   G [µN·m]   factor   t [s]\n";
   for (size_t i = 0; i < r.rays.size(); ++i) {
     const AcpmRay& ray = r.rays[i];
     std::printf("  %3zu %8.2f %8s %10.4f %9.4f %10.5g %8.4f %7.2f\n", i + 1, units::MToMm(ray.z),

@@ -1,0 +1,77 @@
+// `textile validate` through the real executable.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "run_cli.h"
+
+namespace textile {
+namespace {
+
+using testing::ExpectRefused;
+using testing::ReadAll;
+using testing::Scratch;
+using testing::Textile;
+namespace fs = std::filesystem;
+
+const std::string kFig8Profiles =
+    "samples/profiles/pabst-fig8_L040mm.profile.csv samples/profiles/pabst-fig8_L060mm.profile.csv "
+    "samples/profiles/pabst-fig8_L080mm.profile.csv";
+
+TEST(CliValidate, ShippedProfilesPassWithTheirNoiseLevel) {
+  const auto dir = Scratch("CliValidate.Pass");
+  const auto r = Textile("validate " + kFig8Profiles + " --gsm 200 -o " + dir.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("verdict: PASS"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(ReadAll(dir / "validate.json"));
+  EXPECT_EQ(j["verdict"], "pass");
+  ASSERT_EQ(j["profiles"].size(), 3u);
+  for (const auto& p : j["profiles"]) {
+    // The samples carry 0.1 mm of noise (README): the deviation is that noise, not more.
+    EXPECT_GT(p["rms_mm"].get<double>(), 0.05);
+    EXPECT_LT(p["rms_mm"].get<double>(), 0.15);
+    EXPECT_LT(p["tip_mm"].get<double>(), 0.5);
+    EXPECT_TRUE(p["pass"].get<bool>());
+  }
+  // The simulated overhangs are the fitted ones, close to the nominal 40, 60, 80 mm.
+  EXPECT_NEAR(j["profiles"][0]["overhang_mm"].get<double>(), 40.0, 0.5);
+  EXPECT_NEAR(j["profiles"][2]["overhang_mm"].get<double>(), 80.0, 0.5);
+  EXPECT_EQ(j["models"]["shell"], "not available in this build (issue 6)");
+  EXPECT_GT(fs::file_size(dir / "validate.png"), 10000u);
+  EXPECT_TRUE(fs::exists(dir / "fitted.json"));
+}
+
+TEST(CliValidate, TightToleranceFailsAndStrictExits3) {
+  const auto dir = Scratch("CliValidate.Fail");
+  const auto r = Textile("validate " + kFig8Profiles + " --gsm 200 --tolerance-mm 0.02 --json -o " +
+                         dir.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["verdict"], "fail");
+  EXPECT_NE(j["profiles"][0]["why"].get<std::string>().find("rms"), std::string::npos);
+  const auto strict_dir = Scratch("CliValidate.Strict");
+  const auto s = Textile("validate " + kFig8Profiles + " --gsm 200 --tolerance-mm 0.02 --strict -o " +
+                         strict_dir.string());
+  EXPECT_EQ(s.exit_code, 3) << s.err;
+  EXPECT_NE(s.err.find("validation failed"), std::string::npos) << s.err;
+  EXPECT_FALSE(fs::exists(strict_dir / "validate.json"));
+}
+
+TEST(CliValidate, RefusesBadInput) {
+  const auto dir = Scratch("CliValidate.Bad");
+  std::ofstream(dir / "fake.png", std::ios::binary) << "\x89PNG\r\n\x1a\n";
+  const std::string out = " -o " + (dir / "out").string();
+  ExpectRefused(Textile("validate " + kFig8Profiles + " --gsm -3" + out), "--gsm", "negative gsm");
+  ExpectRefused(Textile("validate " + kFig8Profiles + " --gsm 200 --tolerance-mm 0" + out),
+                "--tolerance-mm", "zero tolerance");
+  ExpectRefused(Textile("validate nope.profile.csv --gsm 200" + out), "nope.profile.csv", "missing");
+  ExpectRefused(Textile("validate " + (dir / "fake.png").string() + " --gsm 200" + out), "fake.png",
+                "photo without rig");
+  EXPECT_FALSE(fs::exists(dir / "out" / "validate.json"));
+}
+
+}  // namespace
+}  // namespace textile

@@ -1,0 +1,106 @@
+// `textile drape` through the real executable (coarse meshes: the figures are checked for
+// consistency and bounds, docs/drapemeter.md has the converged numbers).
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "run_cli.h"
+
+namespace textile {
+namespace {
+
+using testing::ExpectRefused;
+using testing::ReadAll;
+using testing::Scratch;
+using testing::Textile;
+namespace fs = std::filesystem;
+
+const std::string kFig8 = "--material samples/materials/pabst-fig8.json";
+const std::string kCoarse = " --resolution-mm 12 --no-coarse-to-fine";
+
+TEST(CliDrape, PlainDrapeWritesResultOutlinePngAndObj) {
+  const auto dir = Scratch("CliDrape.Plain");
+  const auto r = Textile("drape " + kFig8 + kCoarse + " --seeds 2 -o " + (dir / "drape.json").string() +
+                         " --png " + (dir / "shadow.png").string() + " --obj " + (dir / "mesh.obj").string() +
+                         " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("drape: seed 2"), std::string::npos) << r.err;  // progress on stderr
+  const auto out = nlohmann::json::parse(r.out);
+  const auto j = nlohmann::json::parse(ReadAll(dir / "drape.json"));
+  EXPECT_EQ(out["drape_coefficient"], j["drape_coefficient"]);
+  EXPECT_TRUE(j["converged"].get<bool>());
+  const double dc = j["drape_coefficient"].get<double>();
+  EXPECT_GT(dc, 0.0);
+  EXPECT_LT(dc, 1.0);
+  ASSERT_EQ(j["seeds"].size(), 2u);
+  // Mean and sample sd of the two seeds' figures.
+  const double a = j["seeds"][0]["drape_coefficient"], b = j["seeds"][1]["drape_coefficient"];
+  EXPECT_NEAR(dc, 0.5 * (a + b), 1e-12);
+  EXPECT_NEAR(j["drape_coefficient_sd"].get<double>(), std::abs(a - b) / std::sqrt(2.0), 1e-12);
+  EXPECT_TRUE(j["nodes"].is_number());
+  EXPECT_TRUE(j["nodes_sd"].is_number());
+  EXPECT_EQ(j["scene"]["mount"], "clamped");
+  // Outline CSV next to the result: a header and one row per 1° bin, radii between the
+  // support and the specimen.
+  const std::string csv = ReadAll(dir / "drape.outline.csv");
+  EXPECT_EQ(csv.rfind("theta_deg,r_mm,x_mm,y_mm\n", 0), 0u);
+  EXPECT_EQ(testing::CountLines(csv), 361);
+  EXPECT_GT(j["min_radius_mm"].get<double>(), 90.0);
+  EXPECT_LT(j["max_radius_mm"].get<double>(), 151.0);
+  EXPECT_GT(fs::file_size(dir / "shadow.png"), 5000u);
+  const std::string obj = ReadAll(dir / "mesh.obj");
+  EXPECT_NE(obj.find("\nf "), std::string::npos);
+}
+
+TEST(CliDrape, SeamFromPresetOrFileRaisesDc) {
+  const auto dir = Scratch("CliDrape.Seam");
+  const auto plain = Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "plain.json").string() + " --json");
+  const auto preset = Textile("drape " + kFig8 + kCoarse + " --seams weft --seam-type C-plain -o " +
+                              (dir / "preset.json").string() + " --json");
+  const auto file = Textile("drape " + kFig8 + kCoarse + " --seams weft --seam-file samples/seams/C-plain.json -o " +
+                            (dir / "file.json").string() + " --json");
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  ASSERT_EQ(preset.exit_code, 0) << preset.err;
+  ASSERT_EQ(file.exit_code, 0) << file.err;
+  const auto p = nlohmann::json::parse(plain.out), s = nlohmann::json::parse(preset.out),
+             f = nlohmann::json::parse(file.out);
+  EXPECT_GT(s["drape_coefficient"].get<double>(), p["drape_coefficient"].get<double>());
+  // The sample file holds the same Table 2 seam: the same drape.
+  EXPECT_NEAR(f["drape_coefficient"].get<double>(), s["drape_coefficient"].get<double>(), 1e-9);
+  EXPECT_EQ(s["scene"]["seams"], "weft");
+  EXPECT_EQ(s["scene"]["seam_profile"]["type"], "C-plain");
+}
+
+TEST(CliDrape, NonConvergenceIsExit3WithOneLineAndNoFiles) {
+  const auto dir = Scratch("CliDrape.NoConv");
+  const auto r = Textile("drape " + kFig8 + kCoarse + " --max-seconds 0.001 -o " + (dir / "r.json").string());
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  const std::string last = r.err.substr(r.err.rfind("error: "));
+  EXPECT_EQ(testing::CountLines(last), 1) << r.err;
+  EXPECT_NE(last.find("not converged"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "r.json"));
+  EXPECT_FALSE(fs::exists(dir / "r.outline.csv"));
+}
+
+TEST(CliDrape, RefusesBadInput) {
+  const auto dir = Scratch("CliDrape.Bad");
+  const std::string o = " -o " + (dir / "r.json").string();
+  ExpectRefused(Textile("drape " + kFig8 + " --specimen-mm 90" + o), "--specimen-mm", "specimen = support");
+  ExpectRefused(Textile("drape " + kFig8 + " --specimen-mm 80" + o), "larger than the support", "small specimen");
+  ExpectRefused(Textile("drape " + kFig8 + " --seams diagonal" + o), "--seams", "bad seams");
+  ExpectRefused(Textile("drape " + kFig8 + " --mount glued" + o), "--mount", "bad mount");
+  ExpectRefused(Textile("drape " + kFig8 + " --seams weft --seam-type Z-plain" + o), "--seam-type", "bad type");
+  ExpectRefused(Textile("drape " + kFig8 + " --seam-type C-plain" + o), "--seams", "type without seams");
+  ExpectRefused(Textile("drape " + kFig8 + " --seams weft --seam-file nope.json" + o), "nope.json", "missing file");
+  ExpectRefused(Textile("drape " + kFig8 + " --seeds 0" + o), "--seeds", "no seeds");
+  ExpectRefused(Textile("drape " + kFig8 + " --resolution-mm 0" + o), "--resolution-mm", "zero size");
+  ExpectRefused(Textile("drape --material nope.json" + o), "nope.json", "missing material");
+  ExpectRefused(Textile("drape " + kFig8 + " -o /nonexistent/dir/r.json"), "/nonexistent/dir", "bad output");
+  EXPECT_FALSE(fs::exists(dir / "r.json"));
+}
+
+}  // namespace
+}  // namespace textile

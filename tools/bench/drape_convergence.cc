@@ -1,0 +1,160 @@
+// drape-convergence: the virtual drapemeter's drape coefficient and node count against mesh
+// resolution and solver tolerance, against run time (benchmarks.md), for the paper's Fig. 8
+// fabric {0.1, 0.0892, -0.0092} KES at 200 g/m², plain and with a double lap (C-plain) weft seam.
+// The finest resolution is the reference: DC should settle to < 0.005.
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "bench/bench.h"
+#include "common/chart.h"
+#include "textile/sim/drape.h"
+
+namespace textile::bench {
+
+Benchmark DrapeConvergenceBenchmark();
+
+namespace {
+const bool kRegistered = AddBenchmark(60, DrapeConvergenceBenchmark);
+
+struct Run {
+  double seconds = 0.0, dc = std::nan(""), nodes = std::nan("");
+  bool converged = false;
+  int vertices = 0, iterations = 0;
+};
+
+Run Drape(const Material& m, DrapeSeams seams, double h, double tolerance, bool cascadic) {
+  DrapeOptions o;
+  o.seams = seams;
+  o.seam_profile = SeamPreset("C-plain");
+  o.element_size = h;
+  o.coarse_to_fine = cascadic && 2.0 * h <= 0.5 * (o.specimen_radius - o.support_radius);
+  o.solver.tolerance = tolerance;
+  o.solver.max_seconds = 600.0;
+  const auto start = std::chrono::steady_clock::now();
+  const DrapeResult r = SimulateDrape(m, o);
+  Run run;
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  run.converged = r.converged;
+  run.vertices = r.mesh.num_vertices();
+  run.iterations = r.per_seed.front().summary.iterations;
+  if (r.converged) {
+    run.dc = r.drape_coefficient;
+    run.nodes = r.nodes;
+  }
+  return run;
+}
+
+}  // namespace
+
+Benchmark DrapeConvergenceBenchmark() {
+  return {
+      "drape-convergence",
+      "Drapemeter: DC and nodes against resolution and tolerance, against run time (Fig. 8 fabric, "
+      "plain and C-plain weft seam)",
+      [](const Context& ctx) {
+        Result res;
+        res.columns = {"seams",    "resolution_mm", "tolerance", "coarse_to_fine", "seconds",
+                       "vertices", "iterations",    "converged", "drape_coefficient", "nodes"};
+        Material m;
+        m.name = "Pabst Fig. 8";
+        m.areal_density = 0.2;
+        m.bending = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+        const std::vector<double> resolutions_mm =
+            ctx.quick ? std::vector<double>{15, 10} : std::vector<double>{15, 12, 10, 8, 6, 5, 4};
+        const std::vector<double> tolerances =
+            ctx.quick ? std::vector<double>{1e-3, 1e-4} : std::vector<double>{1e-3, 1e-4, 1e-5, 1e-6};
+        const double default_h = DrapeOptions{}.element_size;
+        const double default_tol = DefaultDrapeSolveOptions().tolerance;
+        auto add = [&](DrapeSeams seams, double h, double tol, bool cascadic) {
+          const Run r = Drape(m, seams, h, tol, cascadic);
+          res.rows.push_back({{"seams", DrapeSeamsName(seams)},
+                              {"resolution_mm", h * 1e3},
+                              {"tolerance", tol},
+                              {"coarse_to_fine", cascadic},
+                              {"seconds", r.seconds},
+                              {"vertices", r.vertices},
+                              {"iterations", r.iterations},
+                              {"converged", r.converged},
+                              {"drape_coefficient", std::isfinite(r.dc) ? nlohmann::json(r.dc) : nlohmann::json()},
+                              {"nodes", std::isfinite(r.nodes) ? nlohmann::json(r.nodes) : nlohmann::json()}});
+          if (ctx.print)
+            std::fprintf(stderr, "drape-convergence: %s h=%.1f mm tol=%.0e %s: %.2f s, DC %.4f, %g nodes\n",
+                         DrapeSeamsName(seams).c_str(), h * 1e3, tol, cascadic ? "cascadic" : "direct",
+                         r.seconds, r.dc, r.nodes);
+        };
+        for (DrapeSeams seams : {DrapeSeams::kNone, DrapeSeams::kWeft}) {
+          for (double h_mm : resolutions_mm) add(seams, h_mm * 1e-3, default_tol, true);
+          for (double tol : tolerances)
+            if (tol != default_tol) add(seams, default_h, tol, true);
+          add(seams, default_h, default_tol, false);  // the coarse → fine shortcut's own row
+        }
+
+        // Summary: error against the finest converged resolution at the default tolerance.
+        std::ostringstream sum;
+        char line[240];
+        std::snprintf(line, sizeof line, "%-6s %8s %8s %9s %9s %8s %6s %10s\n", "seams", "h [mm]", "tol",
+                      "c->f", "seconds", "DC", "nodes", "|dDC|");
+        sum << line;
+        for (const char* seams : {"none", "weft"}) {
+          double reference = std::nan(""), finest = 1e9;
+          for (const auto& r : res.rows) {
+            if (r["seams"] != seams || r["tolerance"].get<double>() != default_tol || !r["converged"].get<bool>() ||
+                !r["coarse_to_fine"].get<bool>())
+              continue;
+            if (r["resolution_mm"].get<double>() < finest) {
+              finest = r["resolution_mm"].get<double>();
+              reference = r["drape_coefficient"].get<double>();
+            }
+          }
+          for (auto& r : res.rows) {
+            if (r["seams"] != seams) continue;
+            const bool ok = r["converged"].get<bool>();
+            const double dc = ok ? r["drape_coefficient"].get<double>() : std::nan("");
+            r["dc_error_vs_finest"] = ok ? nlohmann::json(std::abs(dc - reference)) : nlohmann::json();
+            std::snprintf(line, sizeof line, "%-6s %8.1f %8.0e %9s %9.2f %8.4f %6.0f %10.4f\n", seams,
+                          r["resolution_mm"].get<double>(), r["tolerance"].get<double>(),
+                          r["coarse_to_fine"].get<bool>() ? "yes" : "no", r["seconds"].get<double>(), dc,
+                          ok ? r["nodes"].get<double>() : std::nan(""), std::abs(dc - reference));
+            sum << line;
+          }
+        }
+        sum << "(|dDC|: against the finest resolution at the default tolerance; one seed)\n";
+        res.columns.push_back("dc_error_vs_finest");
+        res.summary = sum.str();
+
+        namespace chart = textile::chart;
+        chart::Panel dc{.title = "DC against resolution", .x_label = "element size h [mm]", .y_label = "DC"};
+        chart::Panel time{.title = "Run time against resolution",
+                          .x_label = "element size h [mm]",
+                          .y_label = "seconds",
+                          .log_y = true};
+        int k = 0;
+        for (const char* seams : {"none", "weft"}) {
+          chart::Series sd{.label = std::string("seams ") + seams, .style = chart::Series::Style::kLineAndMarkers,
+                           .color = chart::PaletteColor(k)};
+          chart::Series st = sd;
+          for (const auto& r : res.rows) {
+            if (r["seams"] != seams || r["tolerance"].get<double>() != default_tol || !r["coarse_to_fine"].get<bool>())
+              continue;
+            sd.x.push_back(r["resolution_mm"].get<double>());
+            sd.y.push_back(r["converged"].get<bool>() ? r["drape_coefficient"].get<double>() : std::nan(""));
+            st.x.push_back(r["resolution_mm"].get<double>());
+            st.y.push_back(r["seconds"].get<double>());
+          }
+          dc.series.push_back(sd);
+          time.series.push_back(st);
+          ++k;
+        }
+        chart::WritePng({.title = "drape-convergence (Fig. 8 fabric, clamped, one seed)",
+                         .width_px = 1400,
+                         .columns = 2,
+                         .panels = {dc, time}},
+                        ctx.out_dir + "/drape-convergence.png");
+        return res;
+      }};
+}
+
+}  // namespace textile::bench

@@ -1,0 +1,348 @@
+// textile drape: the virtual drapemeter (Cusick test; Pabst section 5.2). Drape coefficient and
+// nodes of a disk of fabric on a smaller disk, over N seeded perturbations; result JSON, outline
+// CSV, top-view shadow PNG, draped mesh OBJ.
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <numbers>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <optional>
+#include <sstream>
+
+#include "common/atomic_file.h"
+#include "common/cli.h"
+#include "textile/sim/drape.h"
+#include "textile/sim/error.h"
+#include "textile/sim/material.h"
+#include "textile/sim/mesh_io.h"
+#include "textile/sim/units.h"
+
+namespace textile::cli {
+namespace {
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+
+struct DrapeArgs {
+  std::string material, seams = "none", seam_type, seam_file, mount = "clamped", out, png, obj;
+  int seeds = 1;
+  unsigned first_seed = 1;
+  std::optional<double> resolution_mm;
+  double specimen_mm = 150.0, support_mm = 90.0, shift_mm = 50.0, perturbation_mm = 2.0;
+  double frame_deg = 0.0;
+  std::optional<double> tolerance;
+  double max_seconds = 120.0;
+  bool no_coarse = false;
+  bool json = false;
+};
+
+SeamProfile LoadSeamProfile(const DrapeArgs& a) {
+  if (!a.seam_type.empty() && !a.seam_file.empty())
+    throw InputError("--seam-type and --seam-file: give one of them, not both");
+  if (!a.seam_type.empty()) {
+    for (const std::string& name : SeamPresetNames())
+      if (name == a.seam_type) return SeamPreset(name);
+    std::string names;
+    for (const std::string& name : SeamPresetNames()) names += (names.empty() ? "" : ", ") + name;
+    throw InputError("--seam-type: '" + a.seam_type + "' is not a Table 2 seam (" + names + ")");
+  }
+  if (!a.seam_file.empty()) return ReadSeamProfile(a.seam_file);
+  return SeamPreset("C-plain");  // Fig. 8: a double lap seam
+}
+
+DrapeOptions Options(const DrapeArgs& a) {
+  DrapeOptions o;
+  try {
+    o.seams = ParseDrapeSeams(a.seams);
+  } catch (const InputError&) {
+    throw InputError("--seams: '" + a.seams + "' is not none, weft, weft+warp or shifted");
+  }
+  try {
+    o.mount = ParseDrapeMount(a.mount);
+  } catch (const InputError&) {
+    throw InputError("--mount: '" + a.mount + "' is not clamped or resting");
+  }
+  if (o.seams == DrapeSeams::kNone && (!a.seam_type.empty() || !a.seam_file.empty()))
+    throw InputError("--seam-type/--seam-file: need --seams weft, weft+warp or shifted");
+  o.seam_profile = LoadSeamProfile(a);
+  auto finite = [](double v, const char* flag) {
+    if (!std::isfinite(v)) throw InputError(std::string(flag) + ": must be a finite number");
+    return v;
+  };
+  o.specimen_radius = units::MmToM(finite(a.specimen_mm, "--specimen-mm"));
+  o.support_radius = units::MmToM(finite(a.support_mm, "--support-mm"));
+  if (!(a.specimen_mm > 0.0)) throw InputError("--specimen-mm: must be > 0");
+  if (!(a.support_mm > 0.0)) throw InputError("--support-mm: must be > 0");
+  if (a.specimen_mm <= a.support_mm)
+    throw InputError("--specimen-mm: the specimen (" + Num(a.specimen_mm) +
+                     " mm) must be larger than the support (" + Num(a.support_mm) + " mm)");
+  o.seam_shift = units::MmToM(finite(a.shift_mm, "--shift-mm"));
+  if (std::abs(a.shift_mm) >= a.specimen_mm) throw InputError("--shift-mm: the seam must cross the specimen");
+  o.perturbation = units::MmToM(finite(a.perturbation_mm, "--perturbation-mm"));
+  if (!(a.perturbation_mm > 0.0)) throw InputError("--perturbation-mm: must be > 0");
+  o.frame_angle = finite(a.frame_deg, "--frame-deg") * kDegree;
+  if (a.seeds < 1 || a.seeds > 1000) throw InputError("--seeds: must be in 1..1000");
+  o.seeds = a.seeds;
+  o.first_seed = a.first_seed;
+  if (a.resolution_mm) {
+    const double h = finite(*a.resolution_mm, "--resolution-mm");
+    const double overhang = a.specimen_mm - a.support_mm;
+    if (h < 0.5 || h > 0.25 * overhang)
+      throw InputError("--resolution-mm: must be between 0.5 mm and a quarter of the overhang (" +
+                       Num(0.25 * overhang) + " mm)");
+    o.element_size = units::MmToM(h);
+  }
+  o.element_size = std::min(o.element_size, 0.25 * (o.specimen_radius - o.support_radius));
+  o.coarse_to_fine = !a.no_coarse;
+  if (a.tolerance) {
+    if (!(*a.tolerance > 0.0) || *a.tolerance > 0.1) throw InputError("--tolerance: must be in (0, 0.1]");
+    o.solver.tolerance = *a.tolerance;
+  }
+  if (!(a.max_seconds > 0.0)) throw InputError("--max-seconds: must be > 0");
+  o.solver.max_seconds = a.max_seconds;
+  if (std::string why; !o.Check(&why)) throw InputError("drape: " + why);
+  return o;
+}
+
+void WriteText(AtomicFile& file, const std::string& text) {
+  std::ofstream out(file.temp_path(), std::ios::binary);
+  out << text;
+  out.close();
+  if (!out) throw InputError("cannot write " + file.path());
+  file.Commit();
+}
+
+std::string OutlinePath(const std::string& result) {
+  std::filesystem::path p(result);
+  if (p.extension() == ".json") p.replace_extension();
+  return p.string() + ".outline.csv";
+}
+
+std::string OutlineCsv(const DrapeSeedResult& s) {
+  std::ostringstream out;
+  out.precision(10);
+  out << "theta_deg,r_mm,x_mm,y_mm\n";
+  for (int b = 0; b < s.shadow.angles.size(); ++b) {
+    const double t = s.shadow.angles(b), r = s.shadow.radii(b);
+    out << t / kDegree << "," << units::MToMm(r) << "," << units::MToMm(r * std::cos(t)) << ","
+        << units::MToMm(r * std::sin(t)) << "\n";
+  }
+  return out.str();
+}
+
+// The test's photo: the shadow seen from above, the support and the flat specimen's circles,
+// the seams as they lie on the draped cloth, and the nodes.
+cv::Mat ShadowImage(const DrapeResult& r, const DrapeSeedResult& s, const DrapeOptions& o) {
+  constexpr int kSize = 800;
+  const double half = 1.08 * o.specimen_radius;  // [m] from the centre to the image edge
+  const double px_per_m = kSize / (2.0 * half);
+  auto to_px = [&](double x, double y) {
+    return cv::Point(static_cast<int>(std::lround((x + half) * px_per_m)),
+                     static_cast<int>(std::lround((half - y) * px_per_m)));
+  };
+  cv::Mat img(kSize, kSize, CV_8UC3, cv::Scalar(250, 250, 250));
+  const DrapeShadow& sh = s.shadow;
+  for (int v = 0; v < kSize; ++v) {
+    for (int u = 0; u < kSize; ++u) {
+      const double x = u / px_per_m - half, y = half - v / px_per_m;
+      const int i = static_cast<int>(std::lround((x - sh.origin_x) / sh.cell));
+      const int j = static_cast<int>(std::lround((y - sh.origin_y) / sh.cell));
+      if (i < 0 || j < 0 || i >= sh.width || j >= sh.height) continue;
+      if (sh.mask[static_cast<size_t>(j) * sh.width + i]) img.at<cv::Vec3b>(v, u) = cv::Vec3b(70, 60, 50);
+    }
+  }
+  const cv::Point centre = to_px(0.0, 0.0);
+  cv::circle(img, centre, static_cast<int>(o.specimen_radius * px_per_m), cv::Scalar(160, 160, 160), 1,
+             cv::LINE_AA);
+  cv::circle(img, centre, static_cast<int>(o.support_radius * px_per_m), cv::Scalar(60, 160, 240), 2,
+             cv::LINE_AA);
+  for (const auto& path : r.seam_paths) {
+    for (size_t k = 1; k < path.size(); ++k) {
+      cv::line(img, to_px(s.positions(path[k - 1], 0), s.positions(path[k - 1], 1)),
+               to_px(s.positions(path[k], 0), s.positions(path[k], 1)), cv::Scalar(80, 80, 230), 2,
+               cv::LINE_AA);
+    }
+  }
+  for (size_t k = 0; k < s.nodes.angles.size(); ++k) {
+    const double t = s.nodes.angles[k], rad = s.nodes.radii[k];
+    cv::circle(img, to_px(rad * std::cos(t), rad * std::sin(t)), 6, cv::Scalar(40, 200, 40), 2, cv::LINE_AA);
+  }
+  std::ostringstream caption;
+  caption.precision(3);
+  caption << "DC " << s.drape_coefficient << ", " << s.nodes.angles.size() << " nodes, seams "
+          << DrapeSeamsName(o.seams) << ", seed " << s.seed;
+  cv::putText(img, caption.str(), cv::Point(12, 28), cv::FONT_HERSHEY_SIMPLEX, 0.7, cv::Scalar(30, 30, 30), 2,
+              cv::LINE_AA);
+  return img;
+}
+
+nlohmann::json SummaryJson(const SolveSummary& s) {
+  return {{"converged", s.converged},   {"method", s.method},
+          {"message", s.message},       {"iterations", s.iterations},
+          {"coarse_iterations", s.coarse_iterations},
+          {"residual", s.residual},     {"energy_J", s.energy},
+          {"seconds", s.seconds},       {"coarse_seconds", s.coarse_seconds},
+          {"contacts", s.contacts},     {"anchors", s.anchors}};
+}
+
+nlohmann::json NumberOrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+
+nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Material& m,
+                          const DrapeArgs& a) {
+  nlohmann::json j;
+  j["converged"] = r.converged;
+  j["message"] = r.message;
+  j["drape_coefficient"] = NumberOrNull(r.drape_coefficient);
+  j["drape_coefficient_sd"] = NumberOrNull(r.drape_coefficient_sd);
+  j["nodes"] = NumberOrNull(r.nodes);
+  j["nodes_sd"] = NumberOrNull(r.nodes_sd);
+  j["min_radius_mm"] = NumberOrNull(units::MToMm(r.min_radius));
+  j["max_radius_mm"] = NumberOrNull(units::MToMm(r.max_radius));
+  j["mean_radius_mm"] = NumberOrNull(units::MToMm(r.mean_radius));
+  j["seeds"] = nlohmann::json::array();
+  for (const DrapeSeedResult& s : r.per_seed) {
+    nlohmann::json js = {{"seed", s.seed}, {"converged", s.converged}, {"solver", SummaryJson(s.summary)}};
+    if (s.converged) {
+      js["drape_coefficient"] = s.drape_coefficient;
+      js["nodes"] = s.nodes.angles.size();
+      js["shadow_area_mm2"] = s.shadow.area * 1e6;
+      js["min_radius_mm"] = units::MToMm(s.min_radius);
+      js["max_radius_mm"] = units::MToMm(s.max_radius);
+      js["mean_radius_mm"] = units::MToMm(s.mean_radius);
+      nlohmann::json nodes = nlohmann::json::array();
+      for (size_t k = 0; k < s.nodes.angles.size(); ++k)
+        nodes.push_back({{"angle_deg", s.nodes.angles[k] / kDegree},
+                         {"radius_mm", units::MToMm(s.nodes.radii[k])},
+                         {"prominence_mm", units::MToMm(s.nodes.prominences[k])}});
+      js["node_list"] = nodes;
+    }
+    j["seeds"].push_back(js);
+  }
+  j["scene"] = {{"specimen_radius_mm", units::MToMm(o.specimen_radius)},
+                {"support_radius_mm", units::MToMm(o.support_radius)},
+                {"mount", DrapeMountName(o.mount)},
+                {"seams", DrapeSeamsName(o.seams)},
+                {"perturbation_mm", units::MToMm(o.perturbation)},
+                {"frame_deg", o.frame_angle / kDegree},
+                {"resolution_mm", units::MToMm(o.element_size)},
+                {"coarse_to_fine", o.coarse_to_fine},
+                {"tolerance", o.solver.tolerance},
+                {"raster_cell_mm", units::MToMm(o.raster_cell)},
+                {"vertices", r.mesh.num_vertices()},
+                {"triangles", r.mesh.num_triangles()},
+                {"coarse_vertices", r.coarse_vertices},
+                {"specimen_area_mm2", r.specimen_area * 1e6},
+                {"support_area_mm2", r.support_area * 1e6},
+                {"mass_g", r.mass * 1e3}};
+  if (o.seams != DrapeSeams::kNone) {
+    j["scene"]["seam_profile"] = SeamProfileToJson(o.seam_profile);
+    if (o.seams == DrapeSeams::kShifted) j["scene"]["shift_mm"] = units::MToMm(o.seam_shift);
+  }
+  j["material"] = MaterialToJson(m);
+  j["material"]["file"] = a.material;
+  j["seconds"] = r.seconds;
+  return j;
+}
+
+void Run(const DrapeArgs& a) {
+  DrapeOptions o = Options(a);
+  const Material m = ReadMaterial(a.material);
+  // Check the outputs' folders before computing.
+  AtomicFile result_file(a.out);
+  AtomicFile outline_file(OutlinePath(a.out));
+  std::optional<AtomicFile> png_file, obj_file;
+  if (!a.png.empty()) png_file.emplace(a.png);
+  if (!a.obj.empty()) obj_file.emplace(a.obj);
+
+  o.progress = [](const std::string& line) { Info("drape: " + line); };
+  DrapeResult r;
+  try {
+    r = SimulateDrape(m, o);
+  } catch (const InputError& e) {
+    throw InputError(a.material + ": " + e.what());
+  }
+  if (!r.converged) throw ComputeError("drape: not converged (" + r.message + "); no drape coefficient");
+
+  const DrapeSeedResult& first = r.per_seed.front();
+  nlohmann::json j = ResultJson(r, o, m, a);
+  j["outline_csv"] = outline_file.path();
+  WriteText(outline_file, OutlineCsv(first));
+  if (png_file) {
+    if (!cv::imwrite(png_file->temp_path(), ShadowImage(r, first, o)))
+      throw InputError("--png: cannot write " + a.png);
+    png_file->Commit();
+    j["png"] = a.png;
+  }
+  if (obj_file) {
+    TriangleMesh draped = r.mesh;
+    draped.vertices = first.positions;
+    WriteText(*obj_file, ObjText(draped));
+    j["obj"] = a.obj;
+  }
+  WriteText(result_file, j.dump(2) + "\n");
+
+  if (a.json) {
+    j["output"] = a.out;
+    PrintJson(j);
+    return;
+  }
+  std::cout << "material: " << (m.name.empty() ? a.material : m.name) << "  [" << a.material << "]\n"
+            << "scene: specimen " << Num(a.specimen_mm) << " mm on a " << Num(a.support_mm) << " mm support, "
+            << DrapeMountName(o.mount) << ", seams " << DrapeSeamsName(o.seams)
+            << (o.seams != DrapeSeams::kNone ? " (" + o.seam_profile.type + ")" : "") << ", "
+            << r.mesh.num_vertices() << " vertices (h = " << Num(units::MToMm(o.element_size)) << " mm)\n";
+  for (const DrapeSeedResult& s : r.per_seed) {
+    std::cout << "  seed " << s.seed << ": DC " << Num(s.drape_coefficient, 4) << ", " << s.nodes.angles.size()
+              << " nodes, r " << Num(units::MToMm(s.min_radius), 4) << ".." << Num(units::MToMm(s.max_radius), 4)
+              << " mm, " << s.summary.iterations << " iterations, " << Num(s.summary.seconds, 3) << " s\n";
+  }
+  std::cout << "drape coefficient: " << Num(r.drape_coefficient, 4);
+  if (r.per_seed.size() > 1) std::cout << " ± " << Num(r.drape_coefficient_sd, 3);
+  std::cout << "\nnodes: " << Num(r.nodes, 4);
+  if (r.per_seed.size() > 1) std::cout << " ± " << Num(r.nodes_sd, 3);
+  std::cout << "\ntime: " << Num(r.seconds, 3) << " s\nresult: " << a.out << "\noutline: " << outline_file.path()
+            << "\n";
+  if (!a.png.empty()) std::cout << "shadow: " << a.png << "\n";
+  if (!a.obj.empty()) std::cout << "mesh: " << a.obj << "\n";
+}
+
+}  // namespace
+
+void RegisterDrape(CLI::App& app) {
+  auto a = std::make_shared<DrapeArgs>();
+  CLI::App* sub = AddSubcommand(
+      app, "drape",
+      "Virtual drapemeter (Cusick test, Pabst 5.2): drape coefficient and nodes of a fabric disk, "
+      "with or without seams",
+      "textile drape --material samples/materials/pabst-fig8.json --seams weft --seam-type C-plain "
+      "--seeds 3 -o drape.json --png drape.png");
+  sub->add_option("-m,--material", a->material, "Material JSON file (cli.md format)")->required();
+  sub->add_option("--seams", a->seams, "none (default), weft, weft+warp or shifted");
+  sub->add_option("--seam-type", a->seam_type, "Table 2 seam type A-plain .. C-twill (default C-plain)");
+  sub->add_option("--seam-file", a->seam_file, "Seam JSON file (from fit-seam) instead of --seam-type");
+  sub->add_option("--mount", a->mount, "clamped (default: held between two disks) or resting (friction)");
+  sub->add_option("--seeds", a->seeds, "Number of perturbations (repeated tests; default 1)");
+  sub->add_option("--first-seed", a->first_seed, "First seed (default 1)");
+  sub->add_option("--resolution-mm", a->resolution_mm, "Element size away from seams [mm] (default 8)");
+  sub->add_option("--specimen-mm", a->specimen_mm, "Specimen radius [mm] (default 150)");
+  sub->add_option("--support-mm", a->support_mm, "Support radius [mm] (default 90)");
+  sub->add_option("--shift-mm", a->shift_mm, "Offset of the shifted seam from the centre [mm] (default 50)");
+  sub->add_option("--perturbation-mm", a->perturbation_mm, "Start perturbation at the rim [mm] (default 2)");
+  sub->add_option("--frame-deg", a->frame_deg, "Rotate seams and perturbation about the centre [deg]");
+  sub->add_option("--tolerance", a->tolerance, "Solver tolerance on the residual / weight (default 1e-4)");
+  sub->add_option("--max-seconds", a->max_seconds, "Solver wall-time cap per level and seed [s] (default 120)");
+  sub->add_flag("--no-coarse-to-fine", a->no_coarse, "Solve on the fine mesh only");
+  sub->add_option("-o,--output", a->out, "Result JSON file; the outline CSV goes next to it")->required();
+  sub->add_option("--png", a->png, "Top-view shadow picture (PNG)");
+  sub->add_option("--obj", a->obj, "Draped mesh of the first seed (OBJ)");
+  sub->add_flag("--json", a->json, "Print one JSON object instead of text");
+  sub->callback([a] { Run(*a); });
+}
+
+namespace {
+const bool kRegistered = AddCommand(60, RegisterDrape);
+}  // namespace
+
+}  // namespace textile::cli

@@ -19,7 +19,7 @@ using testing::Textile;
 namespace fs = std::filesystem;
 
 const std::string kFig8 = "--material samples/materials/pabst-fig8.json";
-const std::string kCoarse = " --resolution-mm 12 --no-coarse-to-fine";
+const std::string kCoarse = " --resolution-mm 15 --no-coarse-to-fine";
 
 TEST(CliDrape, PlainDrapeWritesResultOutlinePngAndObj) {
   const auto dir = Scratch("CliDrape.Plain");

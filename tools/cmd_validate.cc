@@ -97,6 +97,16 @@ void Run(const ValidateArgs& a) {
   const DirectFitSummary fit = FitDirect(profiles, rho, DirectFitOptions{});
   if (!fit.converged || !fit.law) throw ComputeError("fit: " + fit.message);
   const BendingLaw& law = *fit.law;
+  // Only a law a material file accepts is worth simulating (as textile fit checks): a fit to a
+  // straight or vertical strip can run to constants no fabric has.
+  try {
+    Material probe;
+    probe.areal_density = rho;
+    probe.bending = law;
+    ParseMaterialJson(MaterialToJson(probe).dump(), "fitted law");
+  } catch (const InputError& e) {
+    throw ComputeError(std::string("fit gave an implausible law: ") + e.what());
+  }
 
   // The same cantilevers simulated: the fitted law at each photo's overhang. The overhang is the
   // fitted L_i (the arc length of noisy data is biased long: 0.1 mm noise on 0.6 mm spacing

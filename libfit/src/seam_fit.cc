@@ -5,6 +5,7 @@
 #include <gsl/gsl_multifit.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <memory>
@@ -88,8 +89,11 @@ std::vector<SeamSample> ParseSeamSamplesCsv(const std::string& text, const std::
       } else if (fields == std::vector<std::string>{"d_mm", "factor", "sd"}) {
         columns = 3;
       } else {
-        throw InputError(where + ": expected the header d_mm,factor or d_mm,factor,sd, got '" + t +
-                         "'");
+        // Quote at most 40 printable characters of whatever the line holds (binary garbage).
+        std::string shown;
+        for (char ch : t.substr(0, 40)) shown += std::isprint(static_cast<unsigned char>(ch)) ? ch : '?';
+        throw InputError(where + ": expected the header d_mm,factor or d_mm,factor,sd, got '" +
+                         shown + (t.size() > 40 ? "...'" : "'"));
       }
       continue;
     }

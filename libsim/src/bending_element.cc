@@ -450,8 +450,16 @@ double BendingElements::EnergyGradient(const Vertices& x, Eigen::Ref<Vertices> g
 void BendingElements::AddHessianTriplets(const Vertices& x,
                                          std::vector<Eigen::Triplet<double>>* triplets,
                                          HessianProjection projection) const {
+  AddHessianTriplets(x, triplets, projection, 0, num_hinges());
+}
+
+void BendingElements::AddHessianTriplets(const Vertices& x,
+                                         std::vector<Eigen::Triplet<double>>* triplets,
+                                         HessianProjection projection, int first_hinge,
+                                         int end_hinge) const {
   assert(x.rows() == num_vertices_);
-  const int nh = num_hinges();
+  assert(0 <= first_hinge && first_hinge <= end_hinge && end_hinge <= num_hinges());
+  const int nh = end_hinge - first_hinge;
   const bool linear =
       options_.model == BendingModel::kVolino || options_.model == BendingModel::kIsometric;
   const size_t per_hinge = linear ? 48 : 144;
@@ -468,9 +476,10 @@ void BendingElements::AddHessianTriplets(const Vertices& x,
   ParallelChunks(nh, threads, [&](long begin, long end, int) {
     Mat12 block;
     Eigen::SelfAdjointEigenSolver<Mat12> eigen;
-    for (long h = begin; h < end; ++h) {
+    for (long k = begin; k < end; ++k) {
+      const long h = first_hinge + k;
       const HingeRest& r = rest_[h];
-      auto emit = [&, next = threads == 1 ? nullptr : triplets->data() + first + per_hinge * h](
+      auto emit = [&, next = threads == 1 ? nullptr : triplets->data() + first + per_hinge * k](
                       int row, int col, double value) mutable {
         if (next) {
           *next++ = {row, col, value};

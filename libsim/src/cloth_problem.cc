@@ -68,19 +68,38 @@ ClothProblem::ClothProblem(const TriangleMesh& rest, const Material& material,
   BuildPattern();
 }
 
+// Elements are assembled in chunks of this many triangles or hinges, so the triplet buffer stays
+// a few MB however large the mesh (a 100k-triangle sheet would otherwise need ~0.5 GB of it).
+constexpr int kAssemblyChunk = 4096;
+
 void ClothProblem::BuildPattern() {
-  const int n = 3 * num_vertices();
-  triplets_.clear();
-  const Vertices& x = rest_.vertices;
-  membrane_.AddHessianTriplets(x, &triplets_, false);
-  bending_.AddHessianTriplets(x, &triplets_, HessianProjection::kNone);
-  const size_t element_count = triplets_.size();
-  std::vector<Eigen::Triplet<double>> all = triplets_;
-  for (int i = 0; i < num_vertices(); ++i)
+  const int nv = num_vertices();
+  const int n = 3 * nv;
+  // Vertex-level pattern: every pair of vertices sharing a triangle or a hinge, and the diagonal
+  // (contact and anchor blocks). Each pair becomes a dense 3×3 block.
+  std::vector<Eigen::Triplet<double>> pairs;
+  pairs.reserve(9 * static_cast<size_t>(rest_.num_triangles()) + 16 * hinges_.size() + nv);
+  for (int f = 0; f < rest_.num_triangles(); ++f)
     for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) all.emplace_back(3 * i + a, 3 * i + b, 1.0);
+      for (int b = 0; b < 3; ++b) pairs.emplace_back(rest_.triangles(f, a), rest_.triangles(f, b), 1.0);
+  for (const Hinge& h : hinges_)
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) pairs.emplace_back(h.v[a], h.v[b], 1.0);
+  for (int i = 0; i < nv; ++i) pairs.emplace_back(i, i, 1.0);
+  Eigen::SparseMatrix<double> vertex_pattern(nv, nv);
+  vertex_pattern.setFromTriplets(pairs.begin(), pairs.end());
+  pairs = {};
+  Eigen::VectorXi column_sizes(n);
+  for (int j = 0; j < nv; ++j) {
+    const int count = 3 * (vertex_pattern.outerIndexPtr()[j + 1] - vertex_pattern.outerIndexPtr()[j]);
+    column_sizes.segment<3>(3 * j).setConstant(count);
+  }
   hessian_.resize(n, n);
-  hessian_.setFromTriplets(all.begin(), all.end());
+  hessian_.reserve(column_sizes);
+  for (int j = 0; j < nv; ++j)
+    for (int c = 0; c < 3; ++c)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(vertex_pattern, j); it; ++it)
+        for (int r = 0; r < 3; ++r) hessian_.insert(3 * static_cast<int>(it.row()) + r, 3 * j + c) = 0.0;
   hessian_.makeCompressed();
   const int* outer = hessian_.outerIndexPtr();
   const int* inner = hessian_.innerIndexPtr();
@@ -91,11 +110,24 @@ void ClothProblem::BuildPattern() {
     assert(it != end && *it == row);
     return static_cast<int>(it - inner);
   };
-  triplet_slot_.resize(element_count);
-  for (size_t k = 0; k < element_count; ++k)
-    triplet_slot_[k] = slot(triplets_[k].row(), triplets_[k].col());
-  diagonal_block_slot_.resize(9 * static_cast<size_t>(num_vertices()));
-  for (int i = 0; i < num_vertices(); ++i)
+  // Slots of every element entry, in the order the elements emit them.
+  triplet_slot_.clear();
+  const Vertices& x = rest_.vertices;
+  for (int f = 0; f < rest_.num_triangles(); f += kAssemblyChunk) {
+    triplets_.clear();
+    membrane_.AddHessianTriplets(x, &triplets_, false, f, std::min(f + kAssemblyChunk, rest_.num_triangles()));
+    for (const auto& t : triplets_) triplet_slot_.push_back(slot(t.row(), t.col()));
+  }
+  for (int h = 0; h < bending_.num_hinges(); h += kAssemblyChunk) {
+    triplets_.clear();
+    bending_.AddHessianTriplets(x, &triplets_, HessianProjection::kNone, h,
+                                std::min(h + kAssemblyChunk, bending_.num_hinges()));
+    for (const auto& t : triplets_) triplet_slot_.push_back(slot(t.row(), t.col()));
+  }
+  triplets_ = {};
+  triplet_slot_.shrink_to_fit();
+  diagonal_block_slot_.resize(9 * static_cast<size_t>(nv));
+  for (int i = 0; i < nv; ++i)
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) diagonal_block_slot_[9 * i + 3 * a + b] = slot(3 * i + a, 3 * i + b);
 }
@@ -214,14 +246,26 @@ double ClothProblem::EnergyGradient(const Vertices& x, Vertices* grad) const {
 
 const Eigen::SparseMatrix<double>& ClothProblem::Hessian(const Vertices& x,
                                                          HessianProjection projection) {
-  triplets_.clear();
   const bool project = projection != HessianProjection::kNone;
-  membrane_.AddHessianTriplets(x, &triplets_, project);
-  bending_.AddHessianTriplets(x, &triplets_, projection);
-  assert(triplets_.size() == triplet_slot_.size());
   double* values = hessian_.valuePtr();
   std::fill(values, values + hessian_.nonZeros(), 0.0);
-  for (size_t k = 0; k < triplets_.size(); ++k) values[triplet_slot_[k]] += triplets_[k].value();
+  size_t next = 0;  // position in triplet_slot_
+  auto scatter = [&] {
+    for (const auto& t : triplets_) values[triplet_slot_[next++]] += t.value();
+  };
+  for (int f = 0; f < rest_.num_triangles(); f += kAssemblyChunk) {
+    triplets_.clear();
+    membrane_.AddHessianTriplets(x, &triplets_, project, f,
+                                 std::min(f + kAssemblyChunk, rest_.num_triangles()));
+    scatter();
+  }
+  for (int h = 0; h < bending_.num_hinges(); h += kAssemblyChunk) {
+    triplets_.clear();
+    bending_.AddHessianTriplets(x, &triplets_, projection, h,
+                                std::min(h + kAssemblyChunk, bending_.num_hinges()));
+    scatter();
+  }
+  assert(next == triplet_slot_.size());
   if (!supports_.empty()) {
     for (int i = 0; i < num_vertices(); ++i) {
       if (is_fixed_[i]) continue;

@@ -298,9 +298,15 @@ void MembraneElements::AddGradient(Eigen::Ref<const Vertices> x, Eigen::Ref<Vert
 void MembraneElements::AddHessianTriplets(Eigen::Ref<const Vertices> x,
                                           std::vector<Eigen::Triplet<double>>* triplets,
                                           bool project_psd) const {
+  AddHessianTriplets(x, triplets, project_psd, 0, num_triangles());
+}
+
+void MembraneElements::AddHessianTriplets(Eigen::Ref<const Vertices> x,
+                                          std::vector<Eigen::Triplet<double>>* triplets,
+                                          bool project_psd, int first, int end) const {
   CheckSize(x);
-  triplets->reserve(triplets->size() + 81 * static_cast<std::size_t>(num_triangles()));
-  for (int f = 0; f < num_triangles(); ++f) {
+  triplets->reserve(triplets->size() + 81 * static_cast<std::size_t>(end - first));
+  for (int f = first; f < end; ++f) {
     const Eigen::Matrix<double, 9, 9> h =
         MembraneHessian(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f), project_psd);
     for (int a = 0; a < 3; ++a) {

@@ -55,49 +55,47 @@ class LinearSolver {
   // False when no usable direction came out (the caller falls back to steepest descent).
   bool Solve(const SparseMatrix& a, const Eigen::VectorXd& b, Eigen::VectorXd* d,
              SolveSummary* summary) {
-    if (cg_) {
-      cg_->compute(a);
-      if (cg_->info() != Eigen::Success) return Shifted(a, b, d, summary);
-      *d = cg_->solve(b);
-      summary->linear_iterations += static_cast<int>(cg_->iterations());
-      return d->allFinite();
-    }
-    if (!analysed_) {
+    if (!cg_ && !analysed_) {
       cholmod_->analyzePattern(a);
       analysed_ = true;
     }
-    cholmod_->factorize(a);
-    ++summary->factorizations;
-    if (cholmod_->info() == Eigen::Success) {
-      *d = cholmod_->solve(b);
-      if (d->allFinite()) return true;
+    // Singular or indefinite matrices (a flat sheet has no out-of-plane stiffness) get λ I
+    // added, λ growing ×100 from 1e-10 to 1e-2 of the mean diagonal. The last shift that
+    // worked is where the next solve starts (÷100), so a run of singular steps does not pay
+    // for the failed factorisations every time.
+    const double mean_diag = std::max(a.diagonal().cwiseAbs().mean(), 1e-300);
+    double lambda = shift_ > 1e-10 ? shift_ / 100.0 : 0.0;
+    for (; lambda <= 1e-2; lambda = lambda > 0.0 ? lambda * 100.0 : 1e-10) {
+      const SparseMatrix* m = &a;
+      if (lambda > 0.0) {
+        shifted_ = a;
+        for (int i = 0; i < shifted_.cols(); ++i) shifted_.coeffRef(i, i) += lambda * mean_diag;
+        m = &shifted_;
+      }
+      if (Factorize(*m, b, d, summary)) {
+        shift_ = lambda;
+        return true;
+      }
     }
-    return Shifted(a, b, d, summary);
+    shift_ = 0.0;
+    return false;
   }
 
  private:
-  // Singular or indefinite: add λ I, λ growing from 1e-10 to 1e-2 of the mean diagonal.
-  bool Shifted(const SparseMatrix& a, const Eigen::VectorXd& b, Eigen::VectorXd* d,
-               SolveSummary* summary) {
-    const double mean_diag = std::max(a.diagonal().cwiseAbs().mean(), 1e-300);
-    SparseMatrix shifted = a;
-    for (double lambda = 1e-10; lambda <= 1e-2; lambda *= 100.0) {
-      shifted = a;
-      for (int i = 0; i < shifted.cols(); ++i) shifted.coeffRef(i, i) += lambda * mean_diag;
-      if (cg_) {
-        cg_->compute(shifted);
-        if (cg_->info() != Eigen::Success) continue;
-        *d = cg_->solve(b);
-        summary->linear_iterations += static_cast<int>(cg_->iterations());
-      } else {
-        cholmod_->factorize(shifted);
-        ++summary->factorizations;
-        if (cholmod_->info() != Eigen::Success) continue;
-        *d = cholmod_->solve(b);
-      }
-      if (d->allFinite()) return true;
+  bool Factorize(const SparseMatrix& m, const Eigen::VectorXd& b, Eigen::VectorXd* d,
+                 SolveSummary* summary) {
+    if (cg_) {
+      cg_->compute(m);
+      if (cg_->info() != Eigen::Success) return false;
+      *d = cg_->solve(b);
+      summary->linear_iterations += static_cast<int>(cg_->iterations());
+    } else {
+      cholmod_->factorize(m);
+      ++summary->factorizations;
+      if (cholmod_->info() != Eigen::Success) return false;
+      *d = cholmod_->solve(b);
     }
-    return false;
+    return d->allFinite();
   }
 
   const SolveOptions& options_;
@@ -106,6 +104,8 @@ class LinearSolver {
                                            Eigen::IncompleteCholesky<double>>>
       cg_;
   bool analysed_ = false;
+  double shift_ = 0.0;      // the last diagonal shift that worked (relative)
+  SparseMatrix shifted_;    // scratch for a shifted copy
 };
 
 // What every method shares: start checks, the stop tests, the summary.

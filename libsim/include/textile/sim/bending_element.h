@@ -124,6 +124,10 @@ class BendingElements {
   // (so a fixed sparsity pattern can be filled by position).
   void AddHessianTriplets(const Vertices& x, std::vector<Eigen::Triplet<double>>* triplets,
                           HessianProjection projection) const;
+  // Only hinges first_hinge ≤ h < end_hinge, in order (assembly in chunks keeps the triplet
+  // buffer small on large meshes).
+  void AddHessianTriplets(const Vertices& x, std::vector<Eigen::Triplet<double>>* triplets,
+                          HessianProjection projection, int first_hinge, int end_hinge) const;
 
   // Per-hinge views, for tests, plots and seams.
   int num_hinges() const { return static_cast<int>(rest_.size()); }

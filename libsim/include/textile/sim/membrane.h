@@ -84,6 +84,10 @@ class MembraneElements {
   // Appends the Hessian [N/m] as (3 i + c, 3 j + d, value) triplets, 81 per triangle.
   void AddHessianTriplets(Eigen::Ref<const Vertices> x,
                           std::vector<Eigen::Triplet<double>>* triplets, bool project_psd) const;
+  // Only triangles first ≤ f < end, in order.
+  void AddHessianTriplets(Eigen::Ref<const Vertices> x,
+                          std::vector<Eigen::Triplet<double>>* triplets, bool project_psd,
+                          int first, int end) const;
 
   MembraneModel model() const { return model_; }
   const MembraneLame& lame() const { return lame_; }

@@ -391,16 +391,21 @@ std::vector<Vec2> LevelSetCentreline(const cv::Mat& mask, const std::vector<cv::
 // Moreover the moment, hence the curvature, of a cantilever falls from the edge towards its free
 // end: once the turn per `base` has passed its peak (the edge; before it the strip may lie flat
 // on a platform), in the outer half of the line it may not grow again by more than 12° over the
-// least turn seen since that peak; where it does, the line is cut.
-void CutAtSharpTurn(std::vector<Vec2>* line, double base, bool check_growth) {
+// least turn seen since that peak; where it does, the line is cut. Sharp turns count only from
+// `from_fraction` of the line on: a coarse line from the reduced image may kink where the strip
+// passes a platform's corner, far from the tip's fibres.
+void CutAtSharpTurn(std::vector<Vec2>* line, double base, bool check_growth,
+                    double from_fraction = 0.0) {
   const int b = static_cast<int>(base);
   const int n = static_cast<int>(line->size());
+  const int from = static_cast<int>(from_fraction * n);
   double peak = -1.0, least = 1e9;
   for (int i = b; i + b < n; ++i) {
     const Vec2 before = ((*line)[i] - (*line)[i - b]).normalized();
     const Vec2 after = ((*line)[i + b] - (*line)[i]).normalized();
     const double turn = std::acos(std::clamp(before.dot(after), -1.0, 1.0));
-    if (turn > 35.0 * kDeg || (check_growth && i > n / 2 && turn > least + 12.0 * kDeg)) {
+    if ((turn > 35.0 * kDeg && i >= from) ||
+        (check_growth && i > n / 2 && turn > least + 12.0 * kDeg)) {
       line->resize(i + 1);
       return;
     }
@@ -1079,7 +1084,8 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   coarse = SmoothPolyline(coarse, std::max(2.0, 0.5 * t_small));
   coarse = ResampleByArc(coarse, 1.0);
   const double t_full = t_small / scale;
-  CutAtSharpTurn(&coarse, std::max(10.0, 2.0 * t_full), /*check_growth=*/false);
+  CutAtSharpTurn(&coarse, std::max(10.0, 2.0 * t_full), /*check_growth=*/false,
+                 /*from_fraction=*/0.6);
 
   int direction;
   if (root_how == "border" && (root_borders & sides)) {

@@ -297,7 +297,7 @@ void RegisterFit(CLI::App& app) {
   CLI::App* sub = AddSubcommand(
       app, "fit", "Fit the bending law {b1, b2, c1} to cantilever profiles or photos of one strip",
       "textile fit samples/profiles/pabst-fig8_L0*.profile.csv --gsm 200 -o fitted.json --plot fit.png\n"
-      "  textile fit samples/photos/pabst-fig8_L0*.jpg --rig samples/photos/rig.json --gsm 200 -o fitted.json");
+      "  textile fit samples/photos/pabst-fig8_L0*.jpg --rig samples/photos/pabst-fig8.rig-truth.json --gsm 200 -o fitted.json");
   sub->add_option("inputs", a->inputs,
                   "Profile CSV files (s_mm,x_mm,y_mm) or photos (PNG, JPEG, TIFF, BMP; need --rig or "
                   "--mm-per-px) of the same strip")

@@ -73,12 +73,20 @@ fs::path OutDir(const std::string& case_name) {
   return fs::path(TEXTILE_BINARY_DIR) / "test_scratch" / "bad_inputs" / case_name;
 }
 
-// Splits at blanks; "..." groups (and "" is an empty argument). No other shell syntax.
+// Splits at blanks; "..." groups (and "" is an empty argument); \xHH is the byte HH (for
+// arguments that are not valid text). No other shell syntax.
 bool SplitArgs(const std::string& text, std::vector<std::string>* args, std::string* why) {
   std::string cur;
   bool in_arg = false, quoted = false;
-  for (char c : text) {
-    if (c == '"') {
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\\' && i + 3 < text.size() && text[i + 1] == 'x' &&
+        std::isxdigit(static_cast<unsigned char>(text[i + 2])) &&
+        std::isxdigit(static_cast<unsigned char>(text[i + 3]))) {
+      cur += static_cast<char>(std::stoi(text.substr(i + 2, 2), nullptr, 16));
+      in_arg = true;
+      i += 3;
+    } else if (c == '"') {
       quoted = !quoted;
       in_arg = true;
     } else if ((c == ' ' || c == '\t') && !quoted) {

@@ -33,8 +33,8 @@ struct DrapeArgs {
   double specimen_mm = 150.0, support_mm = 90.0, shift_mm = 50.0, perturbation_mm = 2.0;
   double frame_deg = 0.0;
   std::optional<double> tolerance;
-  double max_seconds = 120.0;
-  bool no_coarse = false;
+  double max_seconds = 600.0;
+  bool coarse = false, no_coarse = false;
   bool json = false;
 };
 
@@ -95,7 +95,8 @@ DrapeOptions Options(const DrapeArgs& a) {
     o.element_size = units::MmToM(h);
   }
   o.element_size = std::min(o.element_size, 0.25 * (o.specimen_radius - o.support_radius));
-  o.coarse_to_fine = !a.no_coarse;
+  if (a.coarse && a.no_coarse) throw InputError("--coarse-to-fine and --no-coarse-to-fine: give one");
+  o.coarse_to_fine = a.coarse;
   if (a.tolerance) {
     if (!(*a.tolerance > 0.0) || *a.tolerance > 0.1) throw InputError("--tolerance: must be in (0, 0.1]");
     o.solver.tolerance = *a.tolerance;
@@ -325,15 +326,16 @@ void RegisterDrape(CLI::App& app) {
   sub->add_option("--mount", a->mount, "clamped (default: held between two disks) or resting (friction)");
   sub->add_option("--seeds", a->seeds, "Number of perturbations (repeated tests; default 1)");
   sub->add_option("--first-seed", a->first_seed, "First seed (default 1)");
-  sub->add_option("--resolution-mm", a->resolution_mm, "Element size away from seams [mm] (default 8)");
+  sub->add_option("--resolution-mm", a->resolution_mm, "Element size away from seams [mm] (default 12)");
   sub->add_option("--specimen-mm", a->specimen_mm, "Specimen radius [mm] (default 150)");
   sub->add_option("--support-mm", a->support_mm, "Support radius [mm] (default 90)");
   sub->add_option("--shift-mm", a->shift_mm, "Offset of the shifted seam from the centre [mm] (default 50)");
   sub->add_option("--perturbation-mm", a->perturbation_mm, "Start perturbation at the rim [mm] (default 2)");
   sub->add_option("--frame-deg", a->frame_deg, "Rotate seams and perturbation about the centre [deg]");
   sub->add_option("--tolerance", a->tolerance, "Solver tolerance on the residual / weight (default 1e-4)");
-  sub->add_option("--max-seconds", a->max_seconds, "Solver wall-time cap per level and seed [s] (default 120)");
-  sub->add_flag("--no-coarse-to-fine", a->no_coarse, "Solve on the fine mesh only");
+  sub->add_option("--max-seconds", a->max_seconds, "Solver wall-time cap per level and seed [s] (default 600)");
+  sub->add_flag("--coarse-to-fine", a->coarse, "Solve on a mesh twice as coarse first (cascadic)");
+  sub->add_flag("--no-coarse-to-fine", a->no_coarse, "Solve on the fine mesh only (the default)");
   sub->add_option("-o,--output", a->out, "Result JSON file; the outline CSV goes next to it")->required();
   sub->add_option("--png", a->png, "Top-view shadow picture (PNG)");
   sub->add_option("--obj", a->obj, "Draped mesh of the first seed (OBJ)");

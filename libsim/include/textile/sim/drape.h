@@ -23,7 +23,7 @@
 // Start: flat (resting: drop_height above the support) plus a seeded smooth out-of-plane
 // perturbation w(r, θ) = A ((r - R_s) / (R - R_s))² Σ_k c_k cos(k (θ - frame) + φ_k) on the
 // overhang, so that folds can form; the static equilibrium is found by Newton (optionally
-// coarse → fine, SolveCascadic).
+// coarse → fine, SolveCascadic, which did not pay off here).
 //
 // Measurement (MeasureShadow): the draped mesh's triangles are projected on the plane z = 0 and
 // rasterised on a square grid (cell centres sampled); holes are filled (cells not reachable
@@ -90,10 +90,14 @@ struct DrapeOptions {
   double frame_angle = 0.0;
 
   // Target edge length of the fine mesh away from seams [m]. The default keeps a single-seed
-  // plain drape well under 5 s on a 2-core machine (docs/drapemeter.md has the curve).
-  double element_size = 0.008;
+  // plain drape near 2 CPU s (the budget is 5 s); 8 mm costs 13 CPU s and moves DC by
+  // less than the seed-to-seed spread (docs/drapemeter.md).
+  double element_size = 0.012;
   // Coarse → fine: solve on a mesh coarse_factor × element_size first and prolong (cascadic).
-  bool coarse_to_fine = true;
+  // Off by default: the folds of the coarse solution are not the fine mesh's, and the fine level
+  // spent more Newton steps re-folding than a cold start needs (8 mm: 236 steps and 13 CPU s
+  // against 138 and 7 s; docs/drapemeter.md).
+  bool coarse_to_fine = false;
   double coarse_factor = 2.0;
   // Points on the embedded support circle (also on the coarse mesh).
   int circle_segments = 0;  // 0: about one per element_size along the circle

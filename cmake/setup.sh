@@ -3,12 +3,18 @@
 #   bash cmake/setup.sh demo   install what is missing, build, run the demo on samples/
 #   bash cmake/setup.sh test   install what is missing, build, run the whole test suite
 #   bash cmake/setup.sh build  install what is missing, build only
-# Build tree: ${TEXTILE_BUILD_DIR:-build}. Extra CMake flags: ${TEXTILE_CMAKE_ARGS}.
+#   bash cmake/setup.sh sanitize  install, build with ASan + UBSan (build-asan/), run the whole suite
+# Build tree: ${TEXTILE_BUILD_DIR:-build} (sanitize: ${TEXTILE_BUILD_DIR:-build-asan}).
+# Extra CMake flags: ${TEXTILE_CMAKE_ARGS}.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$here"
 verb="${1:-demo}"
-build="${TEXTILE_BUILD_DIR:-build}"
+if [ "$verb" = sanitize ]; then
+  build="${TEXTILE_BUILD_DIR:-build-asan}"
+else
+  build="${TEXTILE_BUILD_DIR:-build}"
+fi
 
 install_missing() {
   local wanted missing=()
@@ -37,5 +43,14 @@ case "$verb" in
   test)
     install_missing; build_tree
     ctest --test-dir "$build" --output-on-failure -j "$(nproc)" --timeout 300 ;;
-  *) echo "usage: bash cmake/setup.sh demo|test|build" >&2; exit 2 ;;
+  sanitize)
+    # Every finding fails the run: the build has -fno-sanitize-recover=all, ASan and UBSan halt
+    # on the first error, LeakSanitizer reports leaks at exit (the tests set its suppressions,
+    # tests/lsan.supp). The tests' child `textile` processes inherit these options.
+    install_missing
+    TEXTILE_CMAKE_ARGS="-DTEXTILE_SANITIZE=address;undefined ${TEXTILE_CMAKE_ARGS:-}" build_tree
+    export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1"
+    export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+    ctest --test-dir "$build" --output-on-failure -j "$(nproc)" --timeout 900 ;;
+  *) echo "usage: bash cmake/setup.sh demo|test|build|sanitize" >&2; exit 2 ;;
 esac

@@ -5,6 +5,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "textile/sim/acpm_shell.h"
 #include "textile/sim/elastica.h"
 #include "textile/sim/error.h"
 #include "textile/sim/units.h"
@@ -133,8 +134,10 @@ AcpmSeamDirection ParseAcpmSeamDirection(const std::string& name) {
 }
 
 AcpmModel ShellAcpmModel() {
-  // The 3D engine (issue 6) plugs in here: return a function that runs the shell scene.
-  return {};
+  // The 3D engine's quasi-static push (acpm_shell.h), at its default resolution.
+  return [](const Material& material, const AcpmOptions& options, const std::vector<double>& z) {
+    return ShellAcpmCrossings(material, options, z);
+  };
 }
 
 bool AcpmOptions::Check(std::string* why) const {

@@ -66,15 +66,15 @@ TEST(CliAcpm, FittedSeamFileIsAccepted) {
   EXPECT_NE(r.out.find("seam: B-twill (3 layers) across"), std::string::npos) << r.out;
 }
 
-TEST(CliAcpm, SeamAlongOrShellModelIsAComputeErrorInThisBuild) {
+TEST(CliAcpm, SeamAlongRunsOnTheShellModel) {
   const auto dir = Scratch("CliAcpm.Shell");
-  for (const std::string args : {"--seam C-plain", "--model shell", "--seam A-twill --seam-at 30"}) {
-    const auto r = Textile("acpm " + kFig8 + " " + args + " -o " + (dir / "r.json").string());
-    EXPECT_EQ(r.exit_code, 3) << args << ": " << r.err;
-    EXPECT_EQ(testing::CountLines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find("shell model is not available in this build"), std::string::npos) << r.err;
-  }
-  EXPECT_FALSE(fs::exists(dir / "r.json"));
+  const auto r = Textile("acpm " + kFig8 + " --seam C-plain --rays 3 --json -o " + (dir / "r.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["model"], "shell");
+  ASSERT_EQ(j["rays"].size(), 3u);
+  EXPECT_GT(j["rays"][1]["factor"].get<double>(), 1.5);
+  EXPECT_TRUE(fs::exists(dir / "r.json"));
 }
 
 TEST(CliAcpm, RefusesBadInput) {

@@ -46,4 +46,14 @@ for f in samples/materials/pabst-fig8.json "$out/pabst-fig8.photos.fitted.json";
 done
 echo "   (overlay of the 60 mm photo: $out/photos/pabst-fig8_L060mm.overlay.png)"
 echo
+echo "== 5. The fitted law on the virtual ACPM200 and the Cusick drapemeter (textile acpm, drape)"
+"$textile" acpm --material "$out/pabst-fig8.photos.fitted.json" -o "$out/acpm.json" --png "$out/acpm.png" |
+  sed -n '4,6p;$p'
+"$textile" drape --material "$out/pabst-fig8.photos.fitted.json" --seams weft \
+  -o "$out/drape.json" --png "$out/drape.png" 2>/dev/null | grep -E '^(scene|drape coefficient|nodes):'
+echo
+echo "== 6. Closing the loop: photos -> fit -> the same cantilevers simulated -> compared (textile validate)"
+"$textile" validate samples/photos/pabst-fig8_L0{40,60,80}mm.jpg --rig "$out/pabst-fig8.rig.json" \
+  --gsm 200 -o "$out/validate" 2>/dev/null | tail -n 5
+echo
 echo "Pictures and outputs: $out"

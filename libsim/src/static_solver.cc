@@ -164,6 +164,27 @@ struct Run {
     return summary;
   }
 
+  // The checks at the top of every iteration: true (summary filled) when the run ends here,
+  // converged or not.
+  bool Done(int it, double energy, double residual, double slid) {
+    summary.iterations = it;
+    Trace(it, energy, residual, slid);
+    if (const std::string stop = Stop(energy, residual); !stop.empty()) {
+      summary.message = stop;
+      return true;
+    }
+    if (residual < options.tolerance && slid <= options.anchor_tolerance) {
+      summary.converged = true;
+      summary.message = "converged: residual below tolerance";
+      return true;
+    }
+    if (it >= options.max_iterations) {
+      summary.message = CapMessage(slid);
+      return true;
+    }
+    return false;
+  }
+
   std::string CapMessage(double slid) const {
     std::string m = "iteration cap of " + std::to_string(options.max_iterations) + " reached";
     if (slid > options.anchor_tolerance)
@@ -191,21 +212,7 @@ SolveSummary Newton(Run& run) {
   double slid = 0.0;
   Eigen::VectorXd d;
   for (int it = 0;; ++it) {
-    run.summary.iterations = it;
-    run.Trace(it, energy, residual, slid);
-    if (const std::string stop = run.Stop(energy, residual); !stop.empty()) {
-      run.summary.message = stop;
-      return run.Finish(energy, residual);
-    }
-    if (residual < o.tolerance && slid <= o.anchor_tolerance) {
-      run.summary.converged = true;
-      run.summary.message = "converged: residual below tolerance";
-      return run.Finish(energy, residual);
-    }
-    if (it >= o.max_iterations) {
-      run.summary.message = run.CapMessage(slid);
-      return run.Finish(energy, residual);
-    }
+    if (run.Done(it, energy, residual, slid)) return run.Finish(energy, residual);
     const SparseMatrix& h = p.Hessian(x, o.projection);
     const Eigen::VectorXd g = Flat(grad);
     if (!linear.Solve(h, -g, &d, &run.summary) || d.dot(g) >= 0.0) d = -g;
@@ -267,21 +274,7 @@ SolveSummary KineticDamping(Run& run) {
   double slid = 0.0;
   SparseMatrix a;
   for (int it = 0;; ++it) {
-    run.summary.iterations = it;
-    run.Trace(it, energy, residual, slid);
-    if (const std::string stop = run.Stop(energy, residual); !stop.empty()) {
-      run.summary.message = stop;
-      return run.Finish(energy, residual);
-    }
-    if (residual < o.tolerance && slid <= o.anchor_tolerance) {
-      run.summary.converged = true;
-      run.summary.message = "converged: residual below tolerance";
-      return run.Finish(energy, residual);
-    }
-    if (it >= o.max_iterations) {
-      run.summary.message = run.CapMessage(slid);
-      return run.Finish(energy, residual);
-    }
+    if (run.Done(it, energy, residual, slid)) return run.Finish(energy, residual);
     const SparseMatrix& hess = p.Hessian(x, o.projection);
     // (M + h² H) Δv = h (f - h H v), f = -∇E (Baraff and Witkin 1998, eq. 16, no damping).
     a = hess * (h * h);

@@ -20,7 +20,8 @@ export LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 status=0
 for t in "${targets[@]}"; do
-  work="build-fuzz/corpus/$t"
+  # Absolute paths: fuzz_cli changes into its scratch folder before libFuzzer reads them.
+  work="$PWD/build-fuzz/corpus/$t"
   mkdir -p "$work"
   cp -n tests/fuzz/corpus/"$t"/* "$work"/ 2>/dev/null || true
   # Photos need room for a small image; the others are text.
@@ -28,7 +29,7 @@ for t in "${targets[@]}"; do
   [ "$t" = photo ] && max_len=65536
   echo "fuzz_$t: ${seconds}s"
   if ! build-fuzz/tests/fuzz/fuzz_"$t" -max_total_time="$seconds" -max_len="$max_len" -timeout=10 \
-      -rss_limit_mb=3072 -artifact_prefix=build-fuzz/findings/"$t"- "$work" \
+      -rss_limit_mb=3072 -artifact_prefix="$PWD/build-fuzz/findings/$t-" "$work" \
       > "build-fuzz/findings/$t.log" 2>&1; then
     echo "fuzz_$t: FOUND A PROBLEM, see build-fuzz/findings/$t.log"; status=1
   else

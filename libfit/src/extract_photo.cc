@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
@@ -147,6 +148,8 @@ bool ParseBmp(const std::vector<uint8_t>& b, Header* h) {
 }  // namespace
 
 cv::Mat ReadPhotoGray(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a folder, not a photo");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open photo");
   std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)),

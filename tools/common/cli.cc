@@ -17,6 +17,15 @@ CLI::App* AddSubcommand(CLI::App& app, const std::string& name, const std::strin
   return sub;
 }
 
+bool IsValidUtf8(const std::string& s) {
+  try {
+    (void)nlohmann::json(s).dump();
+    return true;
+  } catch (const nlohmann::json::type_error&) {
+    return false;
+  }
+}
+
 void PrintJson(const nlohmann::json& j) { std::cout << j.dump(2) << std::endl; }
 
 std::string Num(double v, int digits) {

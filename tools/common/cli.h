@@ -26,6 +26,9 @@ void PrintJson(const nlohmann::json& j);
 // Compact number for people: 6 significant digits, no trailing zeros.
 std::string Num(double v, int digits = 6);
 
+// True if s is valid UTF-8 (JSON output needs it; names and notes from flags are checked).
+bool IsValidUtf8(const std::string& s);
+
 // Progress/info line on stderr (never on stdout, which may carry JSON).
 void Info(const std::string& line);
 

@@ -25,6 +25,7 @@ struct ExtractArgs {
   PhotoFlags photo;
   int overlay_px = 2000;
   bool json = false;
+  bool progress = false;  // progress lines on stderr even when it is not a terminal
 };
 
 nlohmann::json Point(const Eigen::Vector2d& p) { return {p.x(), p.y()}; }
@@ -46,24 +47,29 @@ void Run(const ExtractArgs& a) {
   }
   EnsureDirectory(a.out_dir);
 
+  // All or nothing: every photo's profile and overlay wait in temporary files until the last
+  // photo has succeeded, so a photo that cannot be read or extracted leaves no output of the
+  // others behind either; the report waits as well (stdout stays empty on failure, cli.md).
+  AtomicFileSet outputs;
+  std::string report;
   nlohmann::json results = nlohmann::json::array();
   for (const auto& photo : a.photos) {
     const cv::Mat gray = ReadPhotoGray(photo);
-    if (a.photos.size() > 1 || gray.total() > 4e6) Info("extracting " + photo + " ...");
+    if (a.photos.size() > 1 || gray.total() > 4e6) {
+      Progress("extracting " + photo + " ...", a.progress);
+    }
     const ExtractionSummary r = ExtractProfile(gray, rig, o, photo);
     if (!r.success) throw ComputeError(photo + ": " + r.message);
     const std::string stem = std::filesystem::path(photo).stem().string();
     const std::string csv = (std::filesystem::path(a.out_dir) / (stem + ".profile.csv")).string();
     const std::string png = (std::filesystem::path(a.out_dir) / (stem + ".overlay.png")).string();
     {
-      // Both files are complete before either is moved into place.
-      AtomicFile profile_file(csv), overlay_file(png);
+      AtomicFile& profile_file = outputs.Add(csv);
+      AtomicFile& overlay_file = outputs.Add(png);
       std::ofstream(profile_file.temp_path(), std::ios::binary) << ProfileToCsv(r.profile);
       if (!cv::imwrite(overlay_file.temp_path(), DrawExtractionOverlay(gray, r, a.overlay_px))) {
         throw InputError(png + ": cannot write the overlay");
       }
-      profile_file.Commit();
-      overlay_file.Commit();
     }
     results.push_back({{"photo", photo},
                        {"profile_csv", csv},
@@ -89,10 +95,10 @@ void Run(const ExtractArgs& a) {
                        {"rejected_sections", r.rejected_sections},
                        {"warnings", r.warnings},
                        {"seconds", r.seconds}});
-    if (!a.json) {
-      std::cout << r.BriefReport() << "\n  wrote " << csv << " and " << png << "\n";
-    }
+    report += r.BriefReport() + "\n  wrote " + csv + " and " + png + "\n";
   }
+  outputs.Commit();
+  if (!a.json) std::cout << report << std::flush;
   if (a.json) PrintJson({{"output_dir", a.out_dir}, {"rig", rig.source}, {"photos", results}});
 }
 
@@ -111,6 +117,8 @@ void RegisterExtract(CLI::App& app) {
   sub->add_option("--overlay-px", a->overlay_px,
                   "Long side of the overlay PNG [px] (default 2000)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
+  sub->add_flag("--progress", a->progress,
+                "Print a progress line per photo on stderr even when it is not a terminal");
   sub->callback([a] { Run(*a); });
 }
 

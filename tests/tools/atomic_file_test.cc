@@ -72,5 +72,37 @@ TEST(AtomicFile, CommitWithoutContentThrows) {
   EXPECT_FALSE(fs::exists(d / "x.json"));
 }
 
+TEST(AtomicFileSet, AllOrNothing) {
+  const fs::path d = ScratchDir("atomic_set");
+  WriteFileAtomically((d / "a.csv").string(), "old a");
+  const auto count = [&d] {
+    return std::distance(fs::directory_iterator(d), fs::directory_iterator{});
+  };
+  {
+    // One file of the set was never written: Commit moves none, the old file stays, and the
+    // temporary files go with the set.
+    AtomicFileSet set;
+    std::ofstream(set.Add((d / "a.csv").string()).temp_path()) << "new a";
+    set.Add((d / "b.png").string());
+    EXPECT_THROW(set.Commit(), InputError);
+  }
+  EXPECT_EQ(Slurp(d / "a.csv"), "old a");
+  EXPECT_EQ(count(), 1);
+  {
+    // A failure before Commit (an exception while staging) leaves nothing either.
+    AtomicFileSet set;
+    std::ofstream(set.Add((d / "c.csv").string()).temp_path()) << "c";
+    EXPECT_THROW(set.Add((d / "missing" / "d.csv").string()), InputError);
+  }
+  EXPECT_EQ(count(), 1);
+  AtomicFileSet set;
+  std::ofstream(set.Add((d / "a.csv").string()).temp_path()) << "new a";
+  std::ofstream(set.Add((d / "b.png").string()).temp_path()) << "b";
+  set.Commit();
+  EXPECT_EQ(Slurp(d / "a.csv"), "new a");
+  EXPECT_EQ(Slurp(d / "b.png"), "b");
+  EXPECT_EQ(count(), 2);
+}
+
 }  // namespace
 }  // namespace textile

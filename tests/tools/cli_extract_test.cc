@@ -257,6 +257,32 @@ TEST(CliExtract, DetectionFailuresExitThreeAndKeepGoodOutputs) {
             (std::set<std::string>{"strip.overlay.png", "strip.profile.csv"}));
 }
 
+TEST(CliExtract, SeveralPhotosAreAllOrNothing) {
+  // Outputs appear only when every photo succeeded; progress lines go to stderr only on request
+  // (or to a terminal), so a failed run's stderr is its one error line.
+  const fs::path dir = Scratch("cli_extract_several");
+  const fs::path a = WritePhoto(dir, "a.png", Strip());
+  PhotoScene blank = Strip();
+  blank.strip = blank.background;
+  const fs::path b = WritePhoto(dir, "b.png", blank);
+  const std::string out = " --mm-per-px 0.1 -o " + Quote(dir / "out");
+  ExpectOneLineError(Textile("extract " + Quote(a) + " " + Quote(b) + out), 3,
+                     "b.png: no strip found");
+  EXPECT_TRUE(Listing(dir / "out").empty());
+
+  const fs::path c = WritePhoto(dir, "c.png", Strip());
+  const auto quiet = Textile("extract " + Quote(a) + " " + Quote(c) + out);
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "");
+  EXPECT_EQ(Listing(dir / "out"), (std::set<std::string>{"a.overlay.png", "a.profile.csv",
+                                                         "c.overlay.png", "c.profile.csv"}));
+  const auto verbose = Textile("extract " + Quote(a) + " " + Quote(c) + out + " --progress");
+  ASSERT_EQ(verbose.exit_code, 0) << verbose.err;
+  EXPECT_EQ(CountLines(verbose.err), 2) << verbose.err;
+  EXPECT_NE(verbose.err.find("extracting " + a.string() + " ..."), std::string::npos)
+      << verbose.err;
+}
+
 TEST(CliExtract, RealPhotos) {
   const fs::path photos = fs::path(TEXTILE_SOURCE_DIR) / ".." / "shared" / "data" / "real-photos";
   if (!fs::exists(photos / "broberg-example.jpg") || !fs::exists(photos / "broberg-break.jpg")) {

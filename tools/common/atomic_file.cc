@@ -38,14 +38,29 @@ AtomicFile::~AtomicFile() {
   }
 }
 
-void AtomicFile::Commit() {
+void AtomicFile::CheckWritten() const {
   std::error_code ec;
   if (!fs::exists(temp_, ec) || fs::file_size(temp_, ec) == 0) {
     throw InputError(path_ + ": writing failed (nothing was written)");
   }
+}
+
+void AtomicFile::Commit() {
+  CheckWritten();
+  std::error_code ec;
   fs::rename(temp_, path_, ec);
   if (ec) throw InputError(path_ + ": cannot move output into place: " + ec.message());
   committed_ = true;
+}
+
+AtomicFile& AtomicFileSet::Add(std::string path) {
+  files_.push_back(std::make_unique<AtomicFile>(std::move(path)));
+  return *files_.back();
+}
+
+void AtomicFileSet::Commit() {
+  for (const auto& f : files_) f->CheckWritten();
+  for (const auto& f : files_) f->Commit();
 }
 
 void WriteFileAtomically(const std::string& path, std::string_view text) {

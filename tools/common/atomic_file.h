@@ -9,8 +9,10 @@
 //   std::ofstream(out.temp_path()) << text;      // or let a library write to temp_path()
 //   out.Commit();                                // rename; without it the temp file is removed
 
+#include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace textile {
 
@@ -28,10 +30,31 @@ class AtomicFile {
   const std::string& temp_path() const { return temp_; }
   // Moves the finished temporary file into place. Throws InputError if it is missing/empty.
   void Commit();
+  // Throws InputError, as Commit would, if the temporary file is missing or empty.
+  void CheckWritten() const;
 
  private:
   std::string path_, temp_;
   bool committed_ = false;
+};
+
+// Outputs of one run that appear together or not at all (extract: a profile and an overlay per
+// photo). Files not committed are removed with the set.
+//
+//   textile::AtomicFileSet outputs;
+//   for (...) std::ofstream(outputs.Add(path).temp_path()) << text;  // throws: nothing appears
+//   outputs.Commit();
+//
+// Commit checks every temporary file before moving any into place; the renames themselves
+// (same folder) are not one atomic step, so only a rename failing midway could leave a part.
+class AtomicFileSet {
+ public:
+  // Stages one more output; throws InputError like AtomicFile.
+  AtomicFile& Add(std::string path);
+  void Commit();
+
+ private:
+  std::vector<std::unique_ptr<AtomicFile>> files_;
 };
 
 // Writes text to path atomically. Throws InputError naming the path on failure.

@@ -1,5 +1,7 @@
 #include "common/cli.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -26,7 +28,11 @@ bool IsValidUtf8(const std::string& s) {
   }
 }
 
-void PrintJson(const nlohmann::json& j) { std::cout << j.dump(2) << std::endl; }
+// Bytes that are not UTF-8 (a path or name given as such) become U+FFFD instead of an exception
+// at the very end of a run whose outputs are already written.
+void PrintJson(const nlohmann::json& j) {
+  std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
+}
 
 std::string Num(double v, int digits) {
   if (std::isnan(v)) return "nan";
@@ -37,6 +43,36 @@ std::string Num(double v, int digits) {
 }
 
 void Info(const std::string& line) { std::cerr << line << std::endl; }
+
+void Progress(const std::string& line, bool always) {
+  if (always || ::isatty(STDERR_FILENO) == 1) std::cerr << line << std::endl;
+}
+
+namespace {
+// CLI11's name of an option's value type without its validators' notes ("FLOAT:POSITIVE")
+// and list brackets: FLOAT, INT, UINT, TEXT, ...
+std::string BaseTypeName(const CLI::Option& option) {
+  std::string t = option.get_type_name();
+  t = t.substr(0, t.find(':'));
+  std::erase_if(t, [](char c) { return c == '[' || c == ']'; });
+  return t;
+}
+}  // namespace
+
+void RefuseEmptyNumbers(CLI::App& app) {
+  static const CLI::Validator kNotEmpty(
+      [](std::string& value) {
+        return value.empty() ? std::string("an empty value is not a number") : std::string();
+      },
+      "", "NOT_EMPTY");
+  for (CLI::Option* option : app.get_options()) {
+    const std::string type = BaseTypeName(*option);  // empty for flags
+    if (type == "FLOAT" || type == "INT" || type == "UINT" || type == "NUMBER") {
+      option->check(kNotEmpty);
+    }
+  }
+  for (CLI::App* sub : app.get_subcommands({})) RefuseEmptyNumbers(*sub);
+}
 
 namespace {
 std::vector<std::pair<int, CommandRegistrar>>& Commands() {
@@ -55,6 +91,7 @@ void RegisterAllCommands(CLI::App& app) {
   std::stable_sort(commands.begin(), commands.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   for (const auto& [order, registrar] : commands) registrar(app);
+  RefuseEmptyNumbers(app);
 }
 
 }  // namespace textile::cli

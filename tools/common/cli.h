@@ -20,7 +20,8 @@ inline constexpr int kExitComputeFailed = 3;
 CLI::App* AddSubcommand(CLI::App& app, const std::string& name, const std::string& description,
                         const std::string& example);
 
-// Prints one JSON object on stdout (pretty, newline-terminated).
+// Prints one JSON object on stdout (pretty, newline-terminated); text that is not valid UTF-8
+// is printed with U+FFFD in place of the bad bytes rather than failing.
 void PrintJson(const nlohmann::json& j);
 
 // Compact number for people: 6 significant digits, no trailing zeros.
@@ -32,14 +33,27 @@ bool IsValidUtf8(const std::string& s);
 // Progress/info line on stderr (never on stdout, which may carry JSON).
 void Info(const std::string& line);
 
+// Progress line on stderr ("Progress for anything over about a second goes to stderr", cli.md),
+// printed only when stderr is a terminal or when `always` is set (a --progress flag), as git
+// does: a script or a test reading stderr sees nothing there but the one `error: ...` line of a
+// failed run. Warnings and notes the user must see go through Info.
+void Progress(const std::string& line, bool always = false);
+
 // Subcommands register themselves, one file each (tools/cmd_<name>.cc), with a namespace-scope
 //   const bool kRegistered = AddCommand(40, RegisterFit);
 // `order` sorts them in --help (the pipeline order: law 10, synth-profile 20, calibrate 25,
 // extract 30, render-photo 35, fit 40, fit-seam 45, acpm 50, drape 60, validate 70, bench 90).
 using CommandRegistrar = void (*)(CLI::App& app);
 bool AddCommand(int order, CommandRegistrar registrar);
-// Adds every registered subcommand to app, in order.
+// Adds every registered subcommand to app, in order, and makes every number option of theirs
+// refuse an empty value (RefuseEmptyNumbers).
 void RegisterAllCommands(CLI::App& app);
+
+// CLI11 2.1 reads an empty value of a number option as 0, and of a number list as no value
+// (`textile law --kappa ""` printed the default curvatures): this adds a check to every option
+// of app and its subcommands whose type is a number or a list of numbers, so that such a value
+// is a usage error naming the flag (exit 2).
+void RefuseEmptyNumbers(CLI::App& app);
 
 }  // namespace textile::cli
 

@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -124,6 +125,8 @@ bool ClappOptions::Check(std::string* why) const {
     problem = "num_starts must be >= 1, got " + std::to_string(num_starts);
   } else if (max_iterations < 1) {
     problem = "max_iterations must be >= 1, got " + std::to_string(max_iterations);
+  } else if (!(std::isfinite(max_seconds) && max_seconds >= 0.0)) {
+    problem = "max_seconds must be a finite number >= 0 [s], got " + std::to_string(max_seconds);
   }
   if (why != nullptr) *why = problem;
   return problem.empty();
@@ -237,6 +240,11 @@ ClappProfileFit FitClappProfile(const Profile& profile, double areal_density,
 
 ClappResult FitClapp(const std::vector<Profile>& profiles, double areal_density,
                      const ClappOptions& options) {
+  const auto start_time = std::chrono::steady_clock::now();
+  const auto seconds_left = [&] {
+    return options.max_seconds -
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  };
   CheckOptions(options);
   CheckDensity(areal_density);
   if (profiles.empty()) throw InputError("Clapp fit: no profiles given");
@@ -324,8 +332,19 @@ ClappResult FitClapp(const std::vector<Profile>& profiles, double areal_density,
   std::array<double, 3> best{};
   double best_cost = std::numeric_limits<double>::infinity();
   std::string last_failure;
-  for (const auto& start : starts) {
-    std::array<double, 3> p = start;
+  // Past the cap nothing is trusted, not even a converged start: the others might fit better.
+  const auto time_cap = [&](size_t starts_run) {
+    std::ostringstream why;
+    why << "Clapp fit: time cap of " << options.max_seconds << " s (ClappOptions::max_seconds)"
+        << " reached with " << starts_run << " of " << starts.size()
+        << " regression starts run; no law";
+    result.message = why.str();
+    return result;
+  };
+  for (size_t i = 0; i < starts.size(); ++i) {
+    const double left = seconds_left();
+    if (left <= 0.0) return time_cap(i);
+    std::array<double, 3> p = starts[i];
     ceres::Problem problem;
     for (const ClappPoint& pt : result.points) {
       ceres::LossFunction* loss = nullptr;
@@ -339,8 +358,10 @@ ClappResult FitClapp(const std::vector<Profile>& profiles, double areal_density,
       problem.SetParameterLowerBound(p.data(), k, lower[k]);
       problem.SetParameterUpperBound(p.data(), k, upper[k]);
     }
+    solver_options.max_solver_time_in_seconds = left;
     ceres::Solver::Summary summary;
     ceres::Solve(solver_options, &problem, &summary);
+    if (seconds_left() <= 0.0) return time_cap(i + 1);
     const bool finite = std::all_of(p.begin(), p.end(), [](double v) { return std::isfinite(v); });
     // A start that runs out of iterations is not trusted (max_iterations is generous for
     // three parameters); another start usually converges.

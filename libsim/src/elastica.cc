@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -62,6 +63,9 @@ constexpr double kSwitchAngle = kHalfPi - kSwitchGap;
 constexpr double kAbortAngle = -1.0;
 // Per shot cap on accepted steps; a strip 300 bending lengths long needs ~10⁴.
 constexpr int kMaxStepsPerShot = 400000;
+// Steps between readings of the wall clock for ElasticaOptions::max_seconds (a step costs about
+// a microsecond, a reading tens of nanoseconds).
+constexpr int kClockStride = 1024;
 // Moments [N] below this are treated as 0 when forming κ(m)/m (its limit 1/B(0) is then exact
 // to far below double precision: the relative correction is c1 m / b1²).
 constexpr double kTinyMoment = 1e-200;
@@ -279,6 +283,12 @@ class Shooter {
     full_ = std::make_unique<Integrator>(kMaxDim, direct_scale.data(), log_scale.data());
   }
 
+  // Shots stop with kFailed once max_seconds have passed since start (ElasticaOptions).
+  void SetTimeCap(std::chrono::steady_clock::time_point start, double max_seconds) {
+    start_ = start;
+    max_seconds_ = max_seconds;
+  }
+
   const Strip& strip() const { return strip_; }
   const std::array<double, kMaxDim>& final_state() const { return y_; }
   int total_steps() const { return total_steps_; }
@@ -350,6 +360,19 @@ class Shooter {
         result->failure = "more than " + std::to_string(kMaxStepsPerShot) +
                           " integration steps in one shot (strip too long or too soft?)";
         return false;
+      }
+      // The wall clock at the first step of every shot, then every kClockStride steps.
+      if (steps_ % kClockStride == 1) {
+        const double elapsed =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+        if (elapsed >= max_seconds_) {
+          result->kind = ShotResult::Kind::kFailed;
+          std::ostringstream why;
+          why << "time cap: the solve ran for " << elapsed << " s, max_seconds = " << max_seconds_
+              << " s (stopped at s/L = " << 1.0 - t_ << ")";
+          result->failure = why.str();
+          return false;
+        }
       }
       std::copy_n(y_.begin(), dim_, y_prev.begin());
       const double t_prev = t_, h_prev = h_;
@@ -445,6 +468,8 @@ class Shooter {
   double kink_t_ = kNaN;
   int steps_ = 0;
   int total_steps_ = 0;
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+  double max_seconds_ = std::numeric_limits<double>::infinity();
   double first_step_ = kNaN;  // first accepted step of the last shot
 };
 
@@ -485,6 +510,8 @@ bool ElasticaOptions::Check(std::string* why) const {
     s << "num_samples must be >= 2 (the edge and the tip), got " << num_samples;
   } else if (max_shooting_iterations < 2) {
     s << "max_shooting_iterations must be >= 2, got " << max_shooting_iterations;
+  } else if (!(std::isfinite(max_seconds) && max_seconds >= 0.0)) {
+    s << "max_seconds must be a finite number >= 0, got " << max_seconds;
   } else if (!std::isnan(tip_angle_guess) &&
              !(tip_angle_guess >= 0.0 && tip_angle_guess < kHalfPi)) {
     s << "tip_angle_guess must be NaN or in [0, pi/2) rad, got " << tip_angle_guess;
@@ -528,6 +555,7 @@ std::string ElasticaProfile::BriefReport() const {
 
 ElasticaProfile SolveHeavyElastica(const BendingLaw& law, double areal_density, double length,
                                    const ElasticaOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
   if (std::string why; !options.Check(&why)) throw InputError("elastica options: " + why);
   if (!(std::isfinite(areal_density) && areal_density > 0.0))
     throw InputError("areal density must be a finite number > 0 kg/m², got " +
@@ -563,6 +591,7 @@ ElasticaProfile SolveHeavyElastica(const BendingLaw& law, double areal_density, 
                        law.Stiffness(0.0);
   Shooter shooter(law, areal_density, length, alpha / 6.0,
                   options.variation.empty() ? nullptr : &options.variation);
+  shooter.SetTimeCap(start, options.max_seconds);
   const int final_directions = options.sensitivities ? kMaxDirections : 1;
 
   // Safeguarded Newton on z with a bracket [lo, hi]: the residual at z = 0 (a flat tip) is

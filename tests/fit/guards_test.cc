@@ -165,6 +165,20 @@ TEST(ClappGuards, IterationCapEndsInFailureWithoutALaw) {
   EXPECT_TRUE(ok.success) << ok.message;
 }
 
+TEST(ClappGuards, TimeCapEndsInFailureWithoutALaw) {
+  // A cap of 0 s has passed before the first regression start, whatever the machine's speed.
+  ClappOptions o;
+  o.max_seconds = 0.0;
+  const ClappResult r = FitClapp(Fig8Profiles(), kRho, o);
+  EXPECT_FALSE(r.success);
+  EXPECT_FALSE(r.law.has_value());
+  EXPECT_NE(r.message.find("time cap of 0 s"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("0 of 6 regression starts"), std::string::npos) << r.message;
+  EXPECT_NE(r.BriefReport().find("no law: " + r.message), std::string::npos) << r.BriefReport();
+  // The default cap leaves the same fit alone (IterationCapEndsInFailureWithoutALaw fits it).
+  EXPECT_GT(ClappOptions{}.max_seconds, 0.0);
+}
+
 TEST(ClappGuards, NonFiniteInputsAndOptionsAreRefused) {
   for (const double bad : {kNaN, kInf, -kInf}) {
     std::vector<Profile> p = Fig8Profiles();
@@ -182,6 +196,14 @@ TEST(ClappGuards, NonFiniteInputsAndOptionsAreRefused) {
   ClappOptions o;
   o.max_iterations = 0;
   EXPECT_THROW(FitClapp(Fig8Profiles(), kRho, o), InputError);
+  for (const double bad : {kNaN, kInf, -1.0}) {
+    o = {};
+    o.max_seconds = bad;
+    std::string why;
+    EXPECT_FALSE(o.Check(&why)) << bad;
+    EXPECT_NE(why.find("max_seconds"), std::string::npos) << why;
+    EXPECT_THROW(FitClapp(Fig8Profiles(), kRho, o), InputError) << bad;
+  }
 }
 
 TEST(ClappGuards, AStraightStripGivesNoLaw) {

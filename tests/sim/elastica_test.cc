@@ -449,6 +449,32 @@ TEST(Elastica, NonConvergenceIsReportedNotReturned) {
   EXPECT_NE(p.BriefReport().find("FAILED"), std::string::npos);
 }
 
+TEST(Elastica, TimeCapEndsInFailureWithoutNumbers) {
+  // A cap of 0 s has passed at the first clock reading (the first step of the first
+  // integration), whatever the machine's speed: the failure path without timing luck.
+  const BendingLaw law = LawOf(kFabrics[0]);
+  for (const bool sensitivities : {false, true}) {
+    SCOPED_TRACE(sensitivities ? "with sensitivities" : "plain");
+    ElasticaOptions options;
+    options.max_seconds = 0.0;
+    options.sensitivities = sensitivities;
+    const ElasticaProfile p = SolveHeavyElastica(law, 0.2, 0.1, options);
+    EXPECT_FALSE(p.converged);
+    EXPECT_NE(p.message.find("time cap"), std::string::npos) << p.message;
+    EXPECT_NE(p.message.find("max_seconds = 0 s"), std::string::npos) << p.message;
+    EXPECT_EQ(p.shooting_iterations, 1);
+    EXPECT_TRUE(p.s.empty() && p.x.empty() && p.y.empty() && p.theta.empty() &&
+                p.kappa.empty() && p.moment.empty());
+    EXPECT_EQ(p.dx_dp.rows(), 0);
+    EXPECT_TRUE(std::isnan(p.tip_x) && std::isnan(p.tip_y) && std::isnan(p.tip_angle));
+    EXPECT_NE(p.BriefReport().find("FAILED: time cap"), std::string::npos) << p.BriefReport();
+  }
+  // The same strip under the default cap converges: the failure above is the cap's.
+  const ElasticaProfile ok = Solve(law, 0.2, 0.1);
+  EXPECT_GT(ElasticaOptions{}.max_seconds, 0.0);
+  EXPECT_TRUE(ok.converged);
+}
+
 TEST(Elastica, OptionsCheckRejectsBadValues) {
   std::string why;
   EXPECT_TRUE(ElasticaOptions{}.Check(&why)) << why;
@@ -475,6 +501,14 @@ TEST(Elastica, OptionsCheckRejectsBadValues) {
   o = {};
   o.arc_lengths = {-0.01};
   rejects(o, "arc_lengths[0]");
+  for (const double bad : {-1.0, std::nan(""), HUGE_VAL}) {
+    o = {};
+    o.max_seconds = bad;
+    rejects(o, "max_seconds");
+  }
+  o = {};
+  o.max_seconds = 0.0;  // allowed: fails at once (TimeCapEndsInFailureWithoutNumbers)
+  EXPECT_TRUE(o.Check(&why)) << why;
 }
 
 TEST(Elastica, BadInputThrowsWithMessage) {

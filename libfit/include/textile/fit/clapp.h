@@ -69,6 +69,12 @@ struct ClappOptions {
   int num_starts = 6;
   // Ceres iterations per start; ≥ 1.
   int max_iterations = 200;
+  // Wall-clock cap on the whole fit [s], finite and ≥ 0. A fit takes milliseconds; the caps
+  // above bound its work, this bounds its time on a slow or loaded machine. Checked before
+  // each start and passed to Ceres as the time left; a fit that reaches it returns
+  // success = false with a "time cap" message and no law (a best start found so far is not
+  // trusted: the starts not run might fit better). 0 stops before the first start (for tests).
+  double max_seconds = 10.0;
 
   // True when the options are usable; otherwise false with the reason in *why (if non-null).
   bool Check(std::string* why) const;

@@ -73,6 +73,12 @@ struct ElasticaOptions {
   bool sensitivities = false;
   // Cap on integrations of the strip during shooting (each one is an initial value problem).
   int max_shooting_iterations = 60;
+  // Wall-clock cap on the whole solve [s], finite and >= 0. A solve takes about a millisecond;
+  // the two caps above bound its work (60 integrations of up to 400 000 steps) but not its time
+  // on a slow or loaded machine. The clock is read at the first step of every integration and
+  // every 1024 steps after, so a solve stops within a few milliseconds of the cap with
+  // converged = false and a "time cap" message; 0 stops at the first step (for tests).
+  double max_seconds = 5.0;
   // θ(L) [rad] to start the shooting from, in [0, π/2), e.g. from the previous solve of a
   // continuation in L; NaN lets the solver estimate it (small-load or hanging-chain limit).
   double tip_angle_guess = std::numeric_limits<double>::quiet_NaN();

@@ -8,6 +8,7 @@
 #include <cassert>
 #include <cmath>
 #include <sstream>
+#include <utility>
 #include <thread>
 
 #include "textile/sim/error.h"
@@ -29,6 +30,55 @@ inline Eigen::Map<const Vec3> Row(const Vertices& x, int i) {
   return Eigen::Map<const Vec3>(x.data() + 3 * i);
 }
 
+// The SIMD kernels below are compiled twice on x86-64 Linux with GCC: for AVX2 and for the
+// baseline, picked at load time (function multiversioning); elsewhere once. No FMA in either
+// clone, so both give the same bits.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define TEXTILE_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define TEXTILE_SIMD_CLONES
+#endif
+#if defined(__GNUC__)
+#define TEXTILE_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define TEXTILE_ALWAYS_INLINE inline
+#endif
+
+// atan2(y, x) in (-π, π] without a library call, so that it vectorises: octant reduction to
+// |t| ≤ tan(π/8) (one division), then t + t s P(s), s = t², P a degree-10 Chebyshev fit of
+// (atan t - t)/(t s) whose error is 3e-17 (so ≤ 6e-18 relative in atan); the result is within
+// ~1 ulp of π of the exact angle. atan2(0, 0) = 0.
+TEXTILE_ALWAYS_INLINE double Atan2(double y, double x) {
+  constexpr double kP[11] = {-0.01917688711906226,  0.039231658295587189, -0.050854497379402598,
+                             0.0585814891280221,    -0.066645114473819475, 0.076921831908260865,
+                             -0.090909045781239026, 0.11111111015256361,   -0.14285714284666542,
+                             0.19999999999995521,   -0.33333333333333331};
+  constexpr double kTanPi8 = 0.41421356237309503, kPi4 = 0.78539816339744828;
+  constexpr double kPi2 = 1.5707963267948966, kPi = 3.1415926535897931;
+  const double ax = std::abs(x), ay = std::abs(y);
+  const double lo = ay < ax ? ay : ax, hi = ay < ax ? ax : ay;
+  const bool mid = lo > kTanPi8 * hi;  // atan(lo/hi) = π/4 + atan((lo - hi)/(lo + hi))
+  const double num = mid ? lo - hi : lo;
+  double den = mid ? lo + hi : hi;
+  den = den > 0.0 ? den : 1.0;
+  const double t = num / den, s = t * t;
+  // Horner, written out (a loop here is not unrolled at -O2 and would stop vectorisation).
+  double p = kP[0] * s + kP[1];
+  p = p * s + kP[2];
+  p = p * s + kP[3];
+  p = p * s + kP[4];
+  p = p * s + kP[5];
+  p = p * s + kP[6];
+  p = p * s + kP[7];
+  p = p * s + kP[8];
+  p = p * s + kP[9];
+  p = p * s + kP[10];
+  double r = (mid ? kPi4 : 0.0) + (t + t * s * p);
+  r = ay > ax ? kPi2 - r : r;
+  r = x < 0.0 ? kPi - r : r;
+  return std::copysign(r, y);
+}
+
 // Geometry of one hinge at positions x: everything the gradient of θ needs (docs/bending.md,
 // "Gradient of the bend angle"). n0 = e × a0 and n1 = a1 × e are the unnormalised normals of
 // (x0, x2, x3) and (x1, x3, x2); |n_k| = |e| h_k.
@@ -47,7 +97,7 @@ struct HingeGeometry {
     cos_term = n0.dot(n1);
     sin_term = l * n1.dot(a0);  // (n1 × n0)·e/|e| = |e| (a1 × e)·a0
   }
-  double Angle() const { return std::atan2(sin_term, cos_term); }
+  double Angle() const { return Atan2(sin_term, cos_term); }
   // ∂θ/∂x_i for the four vertices: g0 = |e| n0/|n0|², g1 = |e| n1/|n1|², the edge vertices take
   // the reactions at the wings' feet t0, t1 (Bridson et al. 2003's u_i).
   void Gradient(std::array<Vec3, 4>* g) const {
@@ -101,6 +151,358 @@ void AddAngleHessian(const Vertices& x, const std::array<int, 4>& v, double scal
   AddTriangleAngleHessian(x1, x2, x3, (x1 - x2).cross(e), {-e, x3 - x1, x1 - x2}, 1, scale, h);
 }
 
+constexpr int kLanes = 8;  // hinges per SIMD block
+
+// Positions of a block of hinges, lane-minor: p[3 i + c][l] = coordinate c of vertex v[i] of
+// hinge (first + l).
+struct LanePositions {
+  alignas(64) double p[12][kLanes];
+};
+
+// The moment-curvature law's coefficients, for branch-free evaluation (same expressions as
+// BendingLaw, so that the results are the same bits).
+struct LawCoefficients {
+  double b1, b2, c1, kappa0, moment0, energy0;
+  explicit LawCoefficients(const BendingLaw& law)
+      : b1(law.b1()),
+        b2(law.b2()),
+        c1(law.c1()),
+        kappa0(law.kappa0()),
+        moment0(law.moment0()),
+        energy0(law.Energy(law.kappa0())) {}
+  TEXTILE_ALWAYS_INLINE double Moment(double kappa) const {
+    const double k = std::abs(kappa);
+    const double m = k <= kappa0 ? (b1 + c1 * k) * k : moment0 + b2 * k;
+    return std::copysign(m, kappa);
+  }
+  TEXTILE_ALWAYS_INLINE double Stiffness(double kappa) const {
+    const double k = std::abs(kappa);
+    return k <= kappa0 ? b1 + 2.0 * c1 * k : b2;
+  }
+  TEXTILE_ALWAYS_INLINE double Energy(double kappa) const {
+    const double k = std::abs(kappa);
+    return k <= kappa0 ? (0.5 * b1 + c1 * k / 3.0) * k * k
+                       : energy0 + moment0 * (k - kappa0) + 0.5 * b2 * (k * k - kappa0 * kappa0);
+  }
+};
+
+// Inputs of the dihedral kernel for one block of kLanes hinges (rest arrays start at the block).
+struct DihedralLanesIn {
+  bool pabst;        // else Bridson
+  bool anisotropic;  // blend warp and weft with warp_weight
+  const LawCoefficients* warp;
+  const LawCoefficients* weft;
+  const double *rest_angle, *inv_height, *weight, *warp_weight, *sin_half, *cos_half;
+};
+
+// Outputs: energy[l] (when asked), dE/dθ times ∂θ/∂x as grad[3 i + c][l] (when asked),
+// and for the Hessian dE/dθ, d²E/dθ² and ∂θ/∂x (unscaled) in grad.
+struct DihedralLanesOut {
+  alignas(64) double energy[kLanes];
+  alignas(64) double d_energy[kLanes];
+  alignas(64) double d2_energy[kLanes];
+  alignas(64) double grad[12][kLanes];
+};
+
+// One block of dihedral hinges: bend angle, law, gradient (docs/bending.md). kHessian: grad is
+// ∂θ/∂x unscaled and d_energy, d2_energy are filled.
+enum class LaneModel { kPabst, kPabstWarpWeft, kBridson };
+
+template <LaneModel kModel, bool kEnergy, bool kGradient, bool kHessian>
+TEXTILE_ALWAYS_INLINE void DihedralLanesImpl(const DihedralLanesIn& in, const LanePositions& pos,
+                                             DihedralLanesOut* out) {
+  // Local copies: loads in the arms of a conditional through a pointer would not if-convert.
+  const LawCoefficients warp = *in.warp, weft = *in.weft;
+#pragma omp simd
+  for (int l = 0; l < kLanes; ++l) {
+    const double x2x = pos.p[6][l], x2y = pos.p[7][l], x2z = pos.p[8][l];
+    const double ex = pos.p[9][l] - x2x, ey = pos.p[10][l] - x2y, ez = pos.p[11][l] - x2z;
+    const double a0x = pos.p[0][l] - x2x, a0y = pos.p[1][l] - x2y, a0z = pos.p[2][l] - x2z;
+    const double a1x = pos.p[3][l] - x2x, a1y = pos.p[4][l] - x2y, a1z = pos.p[5][l] - x2z;
+    // n0 = e × a0, n1 = a1 × e.
+    const double n0x = ey * a0z - ez * a0y, n0y = ez * a0x - ex * a0z, n0z = ex * a0y - ey * a0x;
+    const double n1x = a1y * ez - a1z * ey, n1y = a1z * ex - a1x * ez, n1z = a1x * ey - a1y * ex;
+    const double l2 = ex * ex + ey * ey + ez * ez, len = std::sqrt(l2);
+    const double cos_term = n0x * n1x + n0y * n1y + n0z * n1z;
+    const double sin_term = len * (n1x * a0x + n1y * a0y + n1z * a0z);
+    double energy = 0.0, d_energy, d2_energy = 0.0;
+    if constexpr (kModel != LaneModel::kBridson) {
+      const double kappa = (Atan2(sin_term, cos_term) - in.rest_angle[l]) * in.inv_height[l];
+      const double w = in.weight[l], ih = in.inv_height[l];
+      double m = warp.Moment(kappa);
+      if constexpr (kModel == LaneModel::kPabstWarpWeft) {
+        const double ww = in.warp_weight[l];
+        m = ww * m + (1.0 - ww) * weft.Moment(kappa);
+      }
+      d_energy = w * m * ih;
+      if constexpr (kHessian) {
+        double b = warp.Stiffness(kappa);
+        if constexpr (kModel == LaneModel::kPabstWarpWeft) {
+          const double ww = in.warp_weight[l];
+          b = ww * b + (1.0 - ww) * weft.Stiffness(kappa);
+        }
+        d2_energy = w * b * ih * ih;
+      }
+      if constexpr (kEnergy) {
+        double psi = warp.Energy(kappa);
+        if constexpr (kModel == LaneModel::kPabstWarpWeft) {
+          const double ww = in.warp_weight[l];
+          psi = ww * psi + (1.0 - ww) * weft.Energy(kappa);
+        }
+        energy = w * psi;
+      }
+    } else {
+      // Bridson: half angles from (cos θ, sin θ) without cancellation on either side of 90°.
+      const double inv_rn = 1.0 / std::sqrt(cos_term * cos_term + sin_term * sin_term);
+      const double c = cos_term * inv_rn, s = sin_term * inv_rn;
+      const double q = std::sqrt(0.5 * (1.0 + std::abs(c)));  // cos θ/2 if c ≥ 0, else |sin θ/2|
+      const double r = 0.5 * s / q;
+      const double sh = c >= 0.0 ? r : std::copysign(q, s);
+      const double ch = c >= 0.0 ? q : std::abs(r);
+      const double sb = in.sin_half[l], cb = in.cos_half[l], w = in.weight[l];
+      d_energy = w * (sh - sb);
+      if constexpr (kHessian) d2_energy = w * 0.5 * ch;
+      if constexpr (kEnergy) {
+        double e = 2.0 * (sh - sb) * (sh + sb) / (cb + ch);  // 2(cos θ̄/2 - cos θ/2)
+        // The angle only matters for a bent rest state (sb = 0 otherwise).
+        e -= (Atan2(sin_term, cos_term) - in.rest_angle[l]) * sb;
+        energy = w * e;
+      }
+    }
+    if constexpr (kEnergy) out->energy[l] = energy;
+    if constexpr (kHessian) {
+      out->d_energy[l] = d_energy;
+      out->d2_energy[l] = d2_energy;
+    }
+    if constexpr (kGradient || kHessian) {
+      // ∂θ/∂x0 = |e| n0/|n0|², ∂θ/∂x1 = |e| n1/|n1|², the edge takes the reactions at the feet.
+      const double n0sq = n0x * n0x + n0y * n0y + n0z * n0z;
+      const double n1sq = n1x * n1x + n1y * n1y + n1z * n1z;
+      const double inv = 1.0 / (n0sq * n1sq), inv_l2 = 1.0 / l2;
+      const double scale = kHessian ? 1.0 : d_energy;
+      const double c0 = scale * len * n1sq * inv, c1 = scale * len * n0sq * inv;
+      const double t0 = (a0x * ex + a0y * ey + a0z * ez) * inv_l2;
+      const double t1 = (a1x * ex + a1y * ey + a1z * ez) * inv_l2;
+      // (Named scalars, not small arrays: GCC's loop vectoriser takes no arrays in a lane.)
+      const double g0x = c0 * n0x, g0y = c0 * n0y, g0z = c0 * n0z;
+      const double g1x = c1 * n1x, g1y = c1 * n1y, g1z = c1 * n1z;
+      out->grad[0][l] = g0x;
+      out->grad[1][l] = g0y;
+      out->grad[2][l] = g0z;
+      out->grad[3][l] = g1x;
+      out->grad[4][l] = g1y;
+      out->grad[5][l] = g1z;
+      out->grad[6][l] = (t0 - 1.0) * g0x + (t1 - 1.0) * g1x;
+      out->grad[7][l] = (t0 - 1.0) * g0y + (t1 - 1.0) * g1y;
+      out->grad[8][l] = (t0 - 1.0) * g0z + (t1 - 1.0) * g1z;
+      out->grad[9][l] = -t0 * g0x - t1 * g1x;
+      out->grad[10][l] = -t0 * g0y - t1 * g1y;
+      out->grad[11][l] = -t0 * g0z - t1 * g1z;
+    }
+  }
+}
+
+template <LaneModel kModel>
+TEXTILE_ALWAYS_INLINE void DihedralLanesModel(const DihedralLanesIn& in, const LanePositions& pos,
+                                              bool energy, bool gradient, DihedralLanesOut* out) {
+  if (energy && gradient) {
+    DihedralLanesImpl<kModel, true, true, false>(in, pos, out);
+  } else if (gradient) {
+    DihedralLanesImpl<kModel, false, true, false>(in, pos, out);
+  } else if (energy) {
+    DihedralLanesImpl<kModel, true, false, false>(in, pos, out);
+  } else {
+    DihedralLanesImpl<kModel, false, false, true>(in, pos, out);
+  }
+}
+
+// energy and/or gradient; neither: the Hessian's inputs (d_energy, d2_energy, ∂θ/∂x).
+TEXTILE_SIMD_CLONES void DihedralLanes(const DihedralLanesIn& in, const LanePositions& pos,
+                                       bool energy, bool gradient, DihedralLanesOut* out) {
+  if (!in.pabst) {
+    DihedralLanesModel<LaneModel::kBridson>(in, pos, energy, gradient, out);
+  } else if (in.anisotropic) {
+    DihedralLanesModel<LaneModel::kPabstWarpWeft>(in, pos, energy, gradient, out);
+  } else {
+    DihedralLanesModel<LaneModel::kPabst>(in, pos, energy, gradient, out);
+  }
+}
+
+// Packed index of entry (r, c), r ≤ c, of a 12×12 block's upper triangle (row-major).
+constexpr int kPackedSize = 78;
+constexpr int Packed(int r, int c) { return r * 12 - r * (r - 1) / 2 + (c - r); }
+
+// One triangle's part of ∇²θ (docs/bending.md, "Hessian"), only the vertex blocks (p, q) with
+// p ≤ q in hinge order and, on the diagonal blocks, entries a ≤ b; added to u (packed). The
+// triangle is (w, x2, x3) with wing `wing` (0 or 1), normal n, eps[p] the edge opposite p.
+TEXTILE_ALWAYS_INLINE void AddTriangleAngleHessianUpper(const Vec3& w, const Vec3& x2,
+                                                        const Vec3& x3, const Vec3& n,
+                                                        const Vec3 (&eps)[3], int wing, double* u) {
+  const Vec3 e = x3 - x2, aw = w - x2, bw = x3 - w;
+  const double l2 = e.squaredNorm(), l = std::sqrt(l2), nsq = n.squaredNorm();
+  const double inv = 1.0 / (l * nsq), inv_l2 = 1.0 / l2, two_inv_nsq = 2.0 / nsq;
+  const double phi[3] = {l2 * inv, -bw.dot(e) * inv, -aw.dot(e) * inv};
+  const Vec3 zero = Vec3::Zero();
+  // ∇_q f_p (rows p, columns q, both in the order wing, x2, x3) and ∇_q log |e| + ∇_q log |N|².
+  const Vec3 grad_f[3][3] = {{zero, -2.0 * e, 2.0 * e}, {e, bw, -e - bw}, {-e, e + aw, -aw}};
+  Vec3 grad_log[3];
+  grad_log[0] = n.cross(eps[0]) * two_inv_nsq;
+  grad_log[1] = n.cross(eps[1]) * two_inv_nsq - e * inv_l2;
+  grad_log[2] = n.cross(eps[2]) * two_inv_nsq + e * inv_l2;
+  const int index[3] = {wing, 2, 3};
+  for (int p = 0; p < 3; ++p) {
+    for (int q = p; q < 3; ++q) {
+      const Vec3 d_phi = grad_f[p][q] * inv - phi[p] * grad_log[q];
+      // n d_phiᵀ + φ_p [eps_q]×.
+      const Vec3& s = eps[q];
+      const double skew[3][3] = {{0.0, -s.z(), s.y()}, {s.z(), 0.0, -s.x()}, {-s.y(), s.x(), 0.0}};
+      for (int a = 0; a < 3; ++a) {
+        for (int b = p == q ? a : 0; b < 3; ++b) {
+          u[Packed(3 * index[p] + a, 3 * index[q] + b)] += n[a] * d_phi[b] + phi[p] * skew[a][b];
+        }
+      }
+    }
+  }
+}
+
+// Packed upper Hessian blocks of a block of hinges, lane-minor: u[k][l] is entry k of hinge l.
+struct LaneHessian {
+  alignas(64) double u[kPackedSize][kLanes];
+};
+
+// A 3-vector of named scalars (no array inside): what GCC's loop vectoriser can take in a lane.
+struct V3 {
+  double x, y, z;
+  template <int I> TEXTILE_ALWAYS_INLINE double at() const {
+    if constexpr (I == 0) return x; else if constexpr (I == 1) return y; else return z;
+  }
+};
+TEXTILE_ALWAYS_INLINE V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+TEXTILE_ALWAYS_INLINE V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+TEXTILE_ALWAYS_INLINE V3 operator-(V3 a) { return {-a.x, -a.y, -a.z}; }
+TEXTILE_ALWAYS_INLINE V3 operator*(double s, V3 a) { return {s * a.x, s * a.y, s * a.z}; }
+TEXTILE_ALWAYS_INLINE V3 operator*(V3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+TEXTILE_ALWAYS_INLINE double Dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+TEXTILE_ALWAYS_INLINE V3 Cross(V3 a, V3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+// Entry (A, B) of the cross-product matrix [s]×.
+template <int A, int B> TEXTILE_ALWAYS_INLINE double SkewAt(V3 s) {
+  if constexpr (A == B) return 0.0;
+  else if constexpr (A == 0 && B == 1) return -s.z;
+  else if constexpr (A == 0 && B == 2) return s.y;
+  else if constexpr (A == 1 && B == 0) return s.z;
+  else if constexpr (A == 1 && B == 2) return -s.x;
+  else if constexpr (A == 2 && B == 0) return -s.y;
+  else return s.x;
+}
+// f(integral_constant<0>) ... f(integral_constant<N - 1>): loops with compile-time indices, so that
+// no small array is left in a lane (GCC's loop vectoriser takes none).
+template <int N, class F>
+TEXTILE_ALWAYS_INLINE void Unroll(F&& f) {
+  [&]<int... I>(std::integer_sequence<int, I...>) __attribute__((always_inline)) { (f(std::integral_constant<int, I>{}), ...); }(std::make_integer_sequence<int, N>{});
+}
+
+// One triangle's part of ∇²θ in one lane (the formula of AddTriangleAngleHessianUpper, with
+// compile-time indices): vertex blocks (p, q), p ≤ q in hinge order, entries a ≤ b on the
+// diagonal. kAdd: the edge blocks add to the other triangle's (written first).
+template <int kWing, bool kAdd>
+TEXTILE_ALWAYS_INLINE void TriangleLane(V3 w, V3 x2, V3 x3, V3 n, V3 eps0, V3 eps1, V3 eps2, int l, LaneHessian* out) {
+  const V3 e = x3 - x2, aw = w - x2, bw = x3 - w;
+  const double l2 = Dot(e, e), len = std::sqrt(l2), nsq = Dot(n, n);
+  const double inv = 1.0 / (len * nsq), inv_l2 = 1.0 / l2, two_inv_nsq = 2.0 / nsq;
+  const double phi0 = l2 * inv, phi1 = -Dot(bw, e) * inv, phi2 = -Dot(aw, e) * inv;
+  const V3 gl0 = Cross(n, eps0) * two_inv_nsq;
+  const V3 gl1 = Cross(n, eps1) * two_inv_nsq - e * inv_l2;
+  const V3 gl2 = Cross(n, eps2) * two_inv_nsq + e * inv_l2;
+  auto block = [&](auto pc, auto qc) __attribute__((always_inline)) {
+    constexpr int P = decltype(pc)::value, Q = decltype(qc)::value;
+    if constexpr (Q >= P) {
+      const double phi = P == 0 ? phi0 : P == 1 ? phi1 : phi2;
+      const V3 eps = Q == 0 ? eps0 : Q == 1 ? eps1 : eps2;
+      const V3 gl = Q == 0 ? gl0 : Q == 1 ? gl1 : gl2;
+      V3 gf;  // ∇_q f_p
+      if constexpr (P == 0) gf = Q == 1 ? -2.0 * e : 2.0 * e;  // Q == 0 excluded below
+      else if constexpr (P == 1) gf = Q == 1 ? bw : -e - bw;
+      else gf = -aw;
+      V3 d_phi;
+      if constexpr (P == 0 && Q == 0) d_phi = -(phi * gl);
+      else d_phi = gf * inv - phi * gl;
+      constexpr int rp = 3 * (P == 0 ? kWing : P + 1), rq = 3 * (Q == 0 ? kWing : Q + 1);
+      Unroll<3>([&](auto ac) __attribute__((always_inline)) {
+        constexpr int A = decltype(ac)::value;
+        Unroll<3>([&](auto bc) __attribute__((always_inline)) {
+          constexpr int B = decltype(bc)::value;
+          if constexpr (P != Q || B >= A) {
+            const double v = n.at<A>() * d_phi.at<B>() + phi * SkewAt<A, B>(eps);
+            double& dst = out->u[Packed(rp + A, rq + B)][l];
+            if constexpr (kAdd && P >= 1) dst += v; else dst = v;
+          }
+        });
+      });
+    }
+  };
+  Unroll<3>([&](auto pc) __attribute__((always_inline)) { Unroll<3>([&](auto qc) __attribute__((always_inline)) { block(pc, qc); }); });
+}
+
+// u = E' u + E'' ∇θ ∇θᵀ (upper), the wing-wing block (0, 1) having no angle-Hessian part.
+template <bool kAngle>
+TEXTILE_ALWAYS_INLINE void ScaleAndAddOuter(const DihedralLanesOut& in, int l, LaneHessian* out) {
+  [[maybe_unused]] const double de = in.d_energy[l];
+  const double d2 = kAngle ? in.d2_energy[l] : std::max(in.d2_energy[l], 0.0);
+  Unroll<12>([&](auto ac) __attribute__((always_inline)) {
+    constexpr int A = decltype(ac)::value;
+    Unroll<12>([&](auto bc) __attribute__((always_inline)) {
+      constexpr int B = decltype(bc)::value;
+      if constexpr (B >= A) {
+        double& dst = out->u[Packed(A, B)][l];
+        if constexpr (!kAngle || (A < 3 && B >= 3 && B < 6)) {
+          dst = d2 * in.grad[A][l] * in.grad[B][l];
+        } else {
+          dst = dst * de + d2 * in.grad[A][l] * in.grad[B][l];
+        }
+      }
+    });
+  });
+}
+
+// u = E' ∇²θ + E'' ∇θ ∇θᵀ per lane (kAngle) or max(E'', 0) ∇θ ∇θᵀ (Gauss-Newton), from the
+// dihedral kernel's Hessian outputs. Plain loop (restrict, no omp simd: the aggregates V3 would
+// become per-lane arrays under OpenMP lowering); -O2 vectorises it.
+template <bool kAngle>
+TEXTILE_ALWAYS_INLINE void HessianLanesImpl(const LanePositions& __restrict pos,
+                                            const DihedralLanesOut& __restrict in,
+                                            LaneHessian* __restrict out) {
+  for (int l = 0; l < kLanes; ++l) {
+    const V3 x0{pos.p[0][l], pos.p[1][l], pos.p[2][l]}, x1{pos.p[3][l], pos.p[4][l], pos.p[5][l]};
+    const V3 x2{pos.p[6][l], pos.p[7][l], pos.p[8][l]}, x3{pos.p[9][l], pos.p[10][l], pos.p[11][l]};
+    const V3 e = x3 - x2;
+    if constexpr (kAngle) {
+      TriangleLane<0, false>(x0, x2, x3, Cross(e, x0 - x2), e, x0 - x3, x2 - x0, l, out);
+      TriangleLane<1, true>(x1, x2, x3, Cross(x1 - x2, e), -e, x3 - x1, x1 - x2, l, out);
+    }
+    ScaleAndAddOuter<kAngle>(in, l, out);
+  }
+}
+
+TEXTILE_SIMD_CLONES void HessianLanes(const LanePositions& pos, const DihedralLanesOut& in,
+                                      bool angle_term, LaneHessian* out) {
+  if (angle_term) {
+    HessianLanesImpl<true>(pos, in, out);
+  } else {
+    HessianLanesImpl<false>(pos, in, out);
+  }
+}
+
+// Local entry k = 12 r + c of a hinge's 12×12 block -> its packed upper-triangle entry.
+constexpr std::array<int, 144> MakeFullToPacked() {
+  std::array<int, 144> m{};
+  for (int r = 0; r < 12; ++r)
+    for (int c = 0; c < 12; ++c) m[12 * r + c] = r <= c ? Packed(r, c) : Packed(c, r);
+  return m;
+}
+constexpr std::array<int, 144> kFullToPacked = MakeFullToPacked();
+
 // Runs f(begin, end) over [0, n) in `threads` contiguous chunks, the first on this thread.
 template <class F>
 void ParallelChunks(int n, int threads, F&& f) {
@@ -130,7 +532,7 @@ std::string HingeName(int h, const Hinge& hinge) {
 double HingeBendAngle(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3) {
   const Vec3 e = x3 - x2, a0 = x0 - x2, a1 = x1 - x2;
   const Vec3 n0 = e.cross(a0), n1 = a1.cross(e);
-  return std::atan2(e.norm() * n1.dot(a0), n0.dot(n1));
+  return Atan2(e.norm() * n1.dot(a0), n0.dot(n1));
 }
 
 std::string BendingModelName(BendingModel model) {
@@ -280,6 +682,28 @@ BendingElements::BendingElements(const TriangleMesh& rest, const std::vector<Hin
     }
   }
 
+  if (!linear) {
+    // Padded by one SIMD block with a harmless hinge (weight 0), so that blocks never read past.
+    const size_t padded = static_cast<size_t>(nh) + kLanes;
+    DihedralRest& d = dihedral_;
+    d.rest_angle.assign(padded, 0.0);
+    d.inv_height.assign(padded, 1.0);
+    d.weight.assign(padded, 0.0);
+    d.warp_weight.assign(padded, 1.0);
+    d.sin_half.assign(padded, 0.0);
+    d.cos_half.assign(padded, 1.0);
+    for (int h = 0; h < nh; ++h) {
+      d.rest_angle[h] = rest_[h].rest_angle;
+      d.inv_height[h] = rest_[h].inv_height;
+      d.weight[h] = rest_[h].weight;
+      d.warp_weight[h] = rest_[h].warp_weight;
+      if (options_.model == BendingModel::kBridson) {
+        d.sin_half[h] = half_angle_[2 * h];
+        d.cos_half[h] = half_angle_[2 * h + 1];
+      }
+    }
+  }
+
   // Vertex -> (hinge, slot) lists for the threaded gather, in hinge order (deterministic).
   vertex_offsets_.assign(num_vertices_ + 1, 0);
   for (const HingeRest& r : rest_)
@@ -331,7 +755,7 @@ double BendingElements::DihedralTerms(double cos_term, double sin_term, int h, d
                                       double* d2_energy, bool want_energy) const {
   const HingeRest& r = rest_[h];
   if (options_.model == BendingModel::kPabst) {
-    const double kappa = (std::atan2(sin_term, cos_term) - r.rest_angle) * r.inv_height;
+    const double kappa = (Atan2(sin_term, cos_term) - r.rest_angle) * r.inv_height;
     if (d_energy) *d_energy = r.weight * LawMoment(r, kappa) * r.inv_height;
     if (d2_energy) *d2_energy = r.weight * LawStiffness(r, kappa) * r.inv_height * r.inv_height;
     return want_energy ? r.weight * LawEnergy(r, kappa) : 0.0;
@@ -353,7 +777,7 @@ double BendingElements::DihedralTerms(double cos_term, double sin_term, int h, d
   if (d2_energy) *d2_energy = r.weight * 0.5 * ch;
   if (!want_energy) return 0.0;
   double energy = 2.0 * (sh - sb) * (sh + sb) / (cb + ch);  // 2(cos θ̄/2 - cos θ/2)
-  if (sb != 0.0) energy -= (std::atan2(sin_term, cos_term) - r.rest_angle) * sb;
+  if (sb != 0.0) energy -= (Atan2(sin_term, cos_term) - r.rest_angle) * sb;
   return r.weight * energy;
 }
 
@@ -383,37 +807,85 @@ double BendingElements::Evaluate(const Vertices& x, double* grad) const {
   std::array<double, kMaxThreads> partial{};
   const BendingModel model = options_.model;
 
-  auto run = [&](long begin, long end, int thread) {
+  const bool linear = model == BendingModel::kVolino || model == BendingModel::kIsometric;
+  const LawCoefficients warp(warp_), weft(weft_);
+
+  auto linear_run = [&](long begin, long end, int thread) {
     double energy = 0.0;
     for (long h = begin; h < end; ++h) {
       const HingeRest& r = rest_[h];
-      std::array<Vec3, 4> g;
-      if (model == BendingModel::kVolino || model == BendingModel::kIsometric) {
-        const auto& al = linear_[h].alpha;
-        const Vec3 rv = al[0] * Row(x, r.v[0]) + al[1] * Row(x, r.v[1]) + al[2] * Row(x, r.v[2]) +
-                        al[3] * Row(x, r.v[3]) - linear_[h].rest_vector;
-        if constexpr (kWithEnergy) energy += 0.5 * r.weight * rv.squaredNorm();
-        if constexpr (!kWithGradient) continue;
-        const Vec3 wr = r.weight * rv;
-        for (int i = 0; i < 4; ++i) g[i] = al[i] * wr;
-      } else {
-        HingeGeometry geo;
-        geo.Compute(x, r.v);
-        double d_energy;
-        energy += DihedralTerms(geo.cos_term, geo.sin_term, static_cast<int>(h),
-                                kWithGradient ? &d_energy : nullptr, nullptr, kWithEnergy);
-        if constexpr (!kWithGradient) continue;
-        geo.Gradient(&g);
-        for (int i = 0; i < 4; ++i) g[i] *= d_energy;
-      }
+      const auto& al = linear_[h].alpha;
+      const Vec3 rv = al[0] * Row(x, r.v[0]) + al[1] * Row(x, r.v[1]) + al[2] * Row(x, r.v[2]) +
+                      al[3] * Row(x, r.v[3]) - linear_[h].rest_vector;
+      if constexpr (kWithEnergy) energy += 0.5 * r.weight * rv.squaredNorm();
+      if constexpr (!kWithGradient) continue;
+      const Vec3 wr = r.weight * rv;
       if (direct) {
-        for (int i = 0; i < 4; ++i) Eigen::Map<Vec3>(grad + 3 * r.v[i]) += g[i];
+        for (int i = 0; i < 4; ++i) Eigen::Map<Vec3>(grad + 3 * r.v[i]) += al[i] * wr;
       } else {
         double* out = hinge_gradient_.data() + 12 * h;
-        for (int i = 0; i < 4; ++i) Eigen::Map<Vec3>(out + 3 * i) = g[i];
+        for (int i = 0; i < 4; ++i) Eigen::Map<Vec3>(out + 3 * i) = al[i] * wr;
       }
     }
     partial[thread] = energy;
+  };
+
+  // Dihedral models: blocks of kLanes hinges, gathered into lanes, evaluated by the SIMD kernel,
+  // scattered in hinge order (the same additions in the same order as a hinge-by-hinge loop).
+  auto dihedral_run = [&](long begin, long end, int thread) {
+    double energy = 0.0;
+    LanePositions pos;
+    DihedralLanesOut out;
+    const double* xd = x.data();
+    for (long b = begin; b < end; b += kLanes) {
+      const int n = static_cast<int>(std::min<long>(kLanes, end - b));
+      for (int l = 0; l < kLanes; ++l) {
+        const HingeRest& r = rest_[b + (l < n ? l : 0)];  // spare lanes repeat the first hinge
+        for (int i = 0; i < 4; ++i) {
+          const double* p = xd + 3 * r.v[i];
+          pos.p[3 * i][l] = p[0];
+          pos.p[3 * i + 1][l] = p[1];
+          pos.p[3 * i + 2][l] = p[2];
+        }
+      }
+      const DihedralLanesIn in{model == BendingModel::kPabst,
+                               anisotropic_,
+                               &warp,
+                               &weft,
+                               dihedral_.rest_angle.data() + b,
+                               dihedral_.inv_height.data() + b,
+                               dihedral_.weight.data() + b,
+                               dihedral_.warp_weight.data() + b,
+                               dihedral_.sin_half.data() + b,
+                               dihedral_.cos_half.data() + b};
+      DihedralLanes(in, pos, kWithEnergy, kWithGradient, &out);
+      if constexpr (kWithEnergy)
+        for (int l = 0; l < n; ++l) energy += out.energy[l];
+      if constexpr (kWithGradient) {
+        for (int l = 0; l < n; ++l) {
+          const HingeRest& r = rest_[b + l];
+          double* dst = direct ? nullptr : hinge_gradient_.data() + 12 * (b + l);
+          for (int i = 0; i < 4; ++i) {
+            double* g = direct ? grad + 3 * r.v[i] : dst + 3 * i;
+            for (int c = 0; c < 3; ++c) {
+              if (direct) {
+                g[c] += out.grad[3 * i + c][l];
+              } else {
+                g[c] = out.grad[3 * i + c][l];
+              }
+            }
+          }
+        }
+      }
+    }
+    partial[thread] = energy;
+  };
+  auto run = [&](long begin, long end, int thread) {
+    if (linear) {
+      linear_run(begin, end, thread);
+    } else {
+      dihedral_run(begin, end, thread);
+    }
   };
 
   if (!kWithGradient || direct) {
@@ -526,6 +998,234 @@ void BendingElements::AddHessianTriplets(const Vertices& x,
               emit(3 * r.v[i] + a, 3 * r.v[j] + b, block(3 * i + a, 3 * j + b));
     }
   });
+}
+
+void BendingElements::HingeHessianUpper(const Vertices& x, int h, HessianProjection projection,
+                                        double* u) const {
+  const HingeRest& r = rest_[h];
+  std::fill(u, u + kPackedSize, 0.0);
+  if (options_.model == BendingModel::kVolino || options_.model == BendingModel::kIsometric) {
+    // Constant Hessian: k α_i α_j I₃ for every vertex pair.
+    const auto& al = linear_[h].alpha;
+    for (int i = 0; i < 4; ++i)
+      for (int j = i; j < 4; ++j)
+        for (int c = 0; c < 3; ++c) u[Packed(3 * i + c, 3 * j + c)] = r.weight * al[i] * al[j];
+    return;
+  }
+  double d_energy, d2_energy;
+  HingeGeometry geo;
+  geo.Compute(x, r.v);
+  DihedralTerms(geo.cos_term, geo.sin_term, h, &d_energy, &d2_energy, false);
+  std::array<Vec3, 4> g;
+  geo.Gradient(&g);
+  double gv[12];
+  for (int i = 0; i < 4; ++i)
+    for (int c = 0; c < 3; ++c) gv[3 * i + c] = g[i][c];
+  if (projection == HessianProjection::kEigen) {
+    // The projected block, as the triplet path makes it, then its upper triangle.
+    Mat12 block;
+    const Eigen::Map<const Eigen::Matrix<double, 12, 1>> gm(gv);
+    block.noalias() = d2_energy * gm * gm.transpose();
+    AddAngleHessian(x, r.v, d_energy, &block);
+    Eigen::SelfAdjointEigenSolver<Mat12> eigen(block);
+    const auto& values = eigen.eigenvalues();
+    if (values.minCoeff() < 0.0) {
+      block.noalias() = eigen.eigenvectors() * values.cwiseMax(0.0).asDiagonal() *
+                        eigen.eigenvectors().transpose();
+    }
+    for (int a = 0; a < 12; ++a)
+      for (int b = a; b < 12; ++b) u[Packed(a, b)] = block(a, b);
+    return;
+  }
+  if (projection == HessianProjection::kNone) {
+    // E'(θ) ∇²θ: both triangles' parts (see AddAngleHessian), upper blocks only.
+    const Vec3 x0 = Row(x, r.v[0]), x1 = Row(x, r.v[1]), x2 = Row(x, r.v[2]), x3 = Row(x, r.v[3]);
+    const Vec3 e = x3 - x2;
+    const Vec3 eps0[3] = {e, x0 - x3, x2 - x0}, eps1[3] = {-e, x3 - x1, x1 - x2};
+    AddTriangleAngleHessianUpper(x0, x2, x3, e.cross(x0 - x2), eps0, 0, u);
+    AddTriangleAngleHessianUpper(x1, x2, x3, (x1 - x2).cross(e), eps1, 1, u);
+    for (int k = 0; k < kPackedSize; ++k) u[k] *= d_energy;
+  } else {
+    d2_energy = std::max(d2_energy, 0.0);  // Gauss-Newton
+  }
+  for (int a = 0; a < 12; ++a)
+    for (int b = a; b < 12; ++b) u[Packed(a, b)] += d2_energy * gv[a] * gv[b];
+}
+
+void BendingElements::HessianBlocks(const Vertices& x, HessianProjection projection, long first,
+                                    int count, double* u) const {
+  static_assert(kSimdLanes == kLanes);
+  auto* lanes = reinterpret_cast<LaneHessian*>(u);
+  const bool linear =
+      options_.model == BendingModel::kVolino || options_.model == BendingModel::kIsometric;
+  if (linear || projection == HessianProjection::kEigen) {
+    double block[kPackedSize];
+    for (int l = 0; l < count; ++l) {
+      HingeHessianUpper(x, static_cast<int>(first + l), projection, block);
+      for (int k = 0; k < kPackedSize; ++k) lanes->u[k][l] = block[k];
+    }
+    return;
+  }
+  LanePositions pos;
+  const double* xd = x.data();
+  for (int l = 0; l < kLanes; ++l) {
+    const HingeRest& r = rest_[first + (l < count ? l : 0)];  // spare lanes repeat the first
+    for (int i = 0; i < 4; ++i) {
+      const double* p = xd + 3 * r.v[i];
+      pos.p[3 * i][l] = p[0];
+      pos.p[3 * i + 1][l] = p[1];
+      pos.p[3 * i + 2][l] = p[2];
+    }
+  }
+  const LawCoefficients warp(warp_), weft(weft_);
+  const DihedralLanesIn in{options_.model == BendingModel::kPabst,
+                           anisotropic_,
+                           &warp,
+                           &weft,
+                           dihedral_.rest_angle.data() + first,
+                           dihedral_.inv_height.data() + first,
+                           dihedral_.weight.data() + first,
+                           dihedral_.warp_weight.data() + first,
+                           dihedral_.sin_half.data() + first,
+                           dihedral_.cos_half.data() + first};
+  DihedralLanesOut out;
+  DihedralLanes(in, pos, false, false, &out);
+  HessianLanes(pos, out, projection == HessianProjection::kNone, lanes);
+}
+
+Eigen::SparseMatrix<double> BendingElements::HessianPattern(bool upper) const {
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve((upper ? kPackedSize : 144) * static_cast<size_t>(num_hinges()));
+  for (const HingeRest& r : rest_) {
+    for (int i = 0; i < 4; ++i)
+      for (int j = upper ? i : 0; j < 4; ++j)
+        for (int a = 0; a < 3; ++a)
+          for (int b = (upper && i == j) ? a : 0; b < 3; ++b) {
+            int row = 3 * r.v[i] + a, col = 3 * r.v[j] + b;
+            if (upper && row > col) std::swap(row, col);
+            entries.emplace_back(row, col, 0.0);
+          }
+  }
+  Eigen::SparseMatrix<double> pattern(3 * num_vertices_, 3 * num_vertices_);
+  pattern.setFromTriplets(entries.begin(), entries.end());
+  pattern.makeCompressed();
+  return pattern;
+}
+
+BendingHessianSlots BendingElements::HessianSlots(const Eigen::SparseMatrix<double>& pattern,
+                                                  bool upper) const {
+  const int n = 3 * num_vertices_;
+  if (pattern.rows() != n || pattern.cols() != n) {
+    throw InputError("bending: Hessian pattern is " + std::to_string(pattern.rows()) + "×" +
+                     std::to_string(pattern.cols()) + ", expected " + std::to_string(n) + "×" +
+                     std::to_string(n));
+  }
+  if (!pattern.isCompressed()) throw InputError("bending: Hessian pattern is not compressed");
+  BendingHessianSlots slots;
+  slots.upper = upper;
+  slots.per_hinge = upper ? kPackedSize : 144;
+  slots.nonzeros = pattern.nonZeros();
+  const int nh = num_hinges();
+  slots.slot.resize(static_cast<size_t>(slots.per_hinge) * nh);
+  std::vector<int> source(slots.slot.size());  // packed entry of each slot
+  const int* outer = pattern.outerIndexPtr();
+  const int* inner = pattern.innerIndexPtr();
+  size_t next = 0;
+  for (int h = 0; h < nh; ++h) {
+    const auto& v = rest_[h].v;
+    auto add = [&](int r, int c) {  // local entry (r, c) of the 12×12 block
+      int row = 3 * v[r / 3] + r % 3, col = 3 * v[c / 3] + c % 3;
+      if (upper && row > col) std::swap(row, col);
+      const int* begin = inner + outer[col];
+      const int* end = inner + outer[col + 1];
+      const int* it = std::lower_bound(begin, end, row);
+      if (it == end || *it != row) {
+        throw InputError(HingeName(h, hinges_[h]) + ": Hessian pattern lacks entry (" +
+                         std::to_string(row) + ", " + std::to_string(col) + ")");
+      }
+      source[next] = kPackedSize * h + (r <= c ? Packed(r, c) : Packed(c, r));
+      slots.slot[next++] = static_cast<int>(it - inner);
+    };
+    if (upper) {
+      for (int r = 0; r < 12; ++r)
+        for (int c = r; c < 12; ++c) add(r, c);
+    } else {
+      for (int r = 0; r < 12; ++r)
+        for (int c = 0; c < 12; ++c) add(r, c);
+    }
+  }
+  // Per value position, its sources in hinge order (a counting sort keeps the order).
+  slots.source_offsets.assign(slots.nonzeros + 1, 0);
+  for (int p : slots.slot) ++slots.source_offsets[p + 1];
+  for (long p = 0; p < slots.nonzeros; ++p) slots.source_offsets[p + 1] += slots.source_offsets[p];
+  slots.sources.resize(slots.slot.size());
+  std::vector<int> fill(slots.source_offsets.begin(), slots.source_offsets.end() - 1);
+  for (size_t k = 0; k < slots.slot.size(); ++k) slots.sources[fill[slots.slot[k]]++] = source[k];
+  return slots;
+}
+
+void BendingElements::AddHessianValues(const Vertices& x, HessianProjection projection,
+                                       const BendingHessianSlots& slots, double* values) const {
+  assert(x.rows() == num_vertices_);
+  const int nh = num_hinges();
+  if (slots.slot.size() != static_cast<size_t>(slots.per_hinge) * nh ||
+      slots.source_offsets.size() != static_cast<size_t>(slots.nonzeros) + 1) {
+    throw InputError("bending: Hessian slots were made for other elements (" +
+                     std::to_string(slots.slot.size()) + " slots for " + std::to_string(nh) +
+                     " hinges)");
+  }
+  const int threads = NumThreads();
+  const int per_hinge = slots.per_hinge;
+  if (threads == 1) {
+    LaneHessian u;
+    for (long b = 0; b < nh; b += kLanes) {
+      const int n = static_cast<int>(std::min<long>(kLanes, nh - b));
+      HessianBlocks(x, projection, b, n, &u.u[0][0]);
+      for (int l = 0; l < n; ++l) {
+        const int* slot = slots.slot.data() + static_cast<size_t>(per_hinge) * (b + l);
+        if (slots.upper) {
+          for (int k = 0; k < kPackedSize; ++k) values[slot[k]] += u.u[k][l];
+        } else {
+          for (int k = 0; k < 144; ++k) values[slot[k]] += u.u[kFullToPacked[k]][l];
+        }
+      }
+    }
+    return;
+  }
+  // Threads: blocks into a per-hinge buffer (blocks of kLanes hinges from the start, as in the
+  // serial loop, so that every hinge gets the same bits), then a per-position gather in hinge
+  // order (the serial additions in the serial order).
+  hinge_hessian_.resize(static_cast<size_t>(kPackedSize) * nh);
+  const int num_blocks = (nh + kLanes - 1) / kLanes;
+  ParallelChunks(num_blocks, threads, [&](long begin, long end, int) {
+    LaneHessian u;
+    for (long blk = begin; blk < end; ++blk) {
+      const long b = blk * kLanes;
+      const int n = static_cast<int>(std::min<long>(kLanes, nh - b));
+      HessianBlocks(x, projection, b, n, &u.u[0][0]);
+      for (int l = 0; l < n; ++l)
+        for (int k = 0; k < kPackedSize; ++k) hinge_hessian_[kPackedSize * (b + l) + k] = u.u[k][l];
+    }
+  });
+  ParallelChunks(static_cast<int>(slots.nonzeros), threads, [&](long begin, long end, int) {
+    const double* u = hinge_hessian_.data();
+    for (long p = begin; p < end; ++p) {
+      double v = values[p];
+      for (int k = slots.source_offsets[p]; k < slots.source_offsets[p + 1]; ++k)
+        v += u[slots.sources[k]];
+      values[p] = v;
+    }
+  });
+}
+
+void BendingElements::SetHessian(const Vertices& x, HessianProjection projection,
+                                 const BendingHessianSlots& slots,
+                                 Eigen::SparseMatrix<double>* hessian) const {
+  if (hessian->nonZeros() != slots.nonzeros || !hessian->isCompressed()) {
+    throw InputError("bending: SetHessian needs the compressed matrix the slots were made for");
+  }
+  std::fill(hessian->valuePtr(), hessian->valuePtr() + hessian->nonZeros(), 0.0);
+  AddHessianValues(x, projection, slots, hessian->valuePtr());
 }
 
 }  // namespace textile

@@ -473,5 +473,174 @@ TEST(BendingElements, MaterialConstructorAppliesBeta) {
   EXPECT_NEAR(with_beta, 2.0 * plain, 1e-13 * with_beta);  // M_β = β M
 }
 
+TEST(HingeBendAngle, MatchesTheLibraryAtan2InEveryOctant) {
+  // Our atan2 is a polynomial (it vectorises); it must agree with the C library to round-off:
+  // ~1 ulp of π absolute over (-π, π], ~1 ulp relative for small angles.
+  constexpr double kAbsolute = 1e-15, kRelative = 1e-15;
+  std::mt19937 rng(67);
+  std::uniform_real_distribution<double> fold(-3.14159, 3.14159), u(-1.0, 1.0);
+  for (int k = 0; k < 20000; ++k) {
+    const double f = k < 10000 ? fold(rng) : 1e-3 * fold(rng);
+    const Eigen::Vector3d x2(u(rng), u(rng), u(rng)), x3 = x2 + Eigen::Vector3d(0.1, 1.0, -0.2);
+    const Eigen::Vector3d x0(-std::cos(f / 2), 0.3 + u(rng), std::sin(f / 2) + 0.1 * u(rng));
+    const Eigen::Vector3d x1(std::cos(f / 2), 0.5 + u(rng), std::sin(f / 2));
+    const Eigen::Vector3d e = x3 - x2, a0 = x0 - x2, a1 = x1 - x2;
+    const Eigen::Vector3d n0 = e.cross(a0), n1 = a1.cross(e);
+    const double expected = std::atan2(e.norm() * n1.dot(a0), n0.dot(n1));
+    const double got = HingeBendAngle(x0, x1, x2, x3);
+    EXPECT_LE(std::abs(got - expected), kAbsolute) << expected;
+    if (std::abs(expected) < 0.1) {
+      EXPECT_LE(std::abs(got - expected), kRelative * std::abs(expected)) << expected;
+    }
+  }
+  // Flat is exactly 0.
+  const Eigen::Vector3d x2(0, 0, 0), x3(0, 1, 0);
+  EXPECT_EQ(HingeBendAngle({-1, 0.5, 0}, {1, 0.5, 0}, x2, x3), 0.0);
+}
+
+TEST(BendingElements, GradientMatchesFiniteDifferencesForWarpWeftAndCurvedRest) {
+  // The SIMD kernel's other branches: the warp/weft blend (Pabst) and a bent rest state
+  // (Bridson's energy then needs the angle, Pabst's θ̄ ≠ 0).
+  for (BendingModel model : {BendingModel::kPabst, BendingModel::kBridson}) {
+    std::mt19937 rng(71);
+    TriangleMesh rest = SmallPattern(&rng);
+    rest.vertices = Perturbed(rest.vertices, 0.002, &rng);
+    const BendingElements b(rest, BuildHinges(rest), Fig8(), Interlining(), {.model = model});
+    const Vertices x = Perturbed(rest.vertices, 0.003, &rng);
+    const Vertices g = Gradient(b, x);
+    Vertices fd(x.rows(), 3);
+    for (int i = 0; i < x.rows(); ++i)
+      for (int c = 0; c < 3; ++c) {
+        Vertices xp = x, xm = x;
+        xp(i, c) += kFdStep;
+        xm(i, c) -= kFdStep;
+        fd(i, c) = (b.Energy(xp) - b.Energy(xm)) / (2 * kFdStep);
+      }
+    EXPECT_LT((g - fd).cwiseAbs().maxCoeff(), kFdRelTolerance * g.cwiseAbs().maxCoeff())
+        << Name(model);
+    // The per-hinge views (scalar code) sum to the kernel's energy.
+    double sum = 0.0;
+    for (int h = 0; h < b.num_hinges(); ++h) sum += b.HingeEnergy(x, h);
+    EXPECT_NEAR(sum, b.Energy(x), 1e-13 * sum) << Name(model);
+  }
+}
+
+// The fixed-pattern Hessian and the triplet path compute the same blocks with round-off
+// differences (the triplet block is symmetric to ~1e-12 only, the other is symmetrised).
+constexpr double kPathAgreement = 1e-12;
+
+Eigen::MatrixXd TripletHessian(const BendingElements& b, const Vertices& x,
+                               HessianProjection projection) {
+  std::vector<Eigen::Triplet<double>> t;
+  b.AddHessianTriplets(x, &t, projection);
+  Eigen::SparseMatrix<double> h(3 * x.rows(), 3 * x.rows());
+  h.setFromTriplets(t.begin(), t.end());
+  return Eigen::MatrixXd(h);
+}
+
+TEST(BendingElements, FixedPatternHessianEqualsTheTripletPath) {
+  std::mt19937 rng(73);
+  TriangleMesh rest = SmallPattern(&rng);
+  TriangleMesh curved = rest;
+  curved.vertices = Perturbed(rest.vertices, 0.002, &rng);
+  const Vertices x = Perturbed(rest.vertices, 0.004, &rng);
+  for (const TriangleMesh* r : {&rest, &curved}) {
+    for (BendingModel model : kAllModels) {
+      const BendingElements b(*r, BuildHinges(*r), Fig8(), Interlining(), {.model = model});
+      for (HessianProjection projection :
+           {HessianProjection::kNone, HessianProjection::kGaussNewton, HessianProjection::kEigen}) {
+        const Eigen::MatrixXd expected = TripletHessian(b, x, projection);
+        const double scale = expected.cwiseAbs().maxCoeff();
+        ASSERT_GT(scale, 0.0);
+        for (bool upper : {false, true}) {
+          Eigen::SparseMatrix<double> h = b.HessianPattern(upper);
+          const BendingHessianSlots slots = b.HessianSlots(h, upper);
+          EXPECT_EQ(slots.per_hinge, upper ? 78 : 144);
+          h.coeffRef(0, 0) = 123.0;  // SetHessian overwrites
+          b.SetHessian(x, projection, slots, &h);
+          const Eigen::MatrixXd got = Eigen::MatrixXd(h);
+          if (upper) {
+            EXPECT_EQ(Eigen::MatrixXd(got.triangularView<Eigen::StrictlyLower>()).cwiseAbs().maxCoeff(), 0.0);
+            const Eigen::MatrixXd full = got.selfadjointView<Eigen::Upper>();
+            EXPECT_LT((full - expected).cwiseAbs().maxCoeff(), kPathAgreement * scale)
+                << Name(model) << " upper, projection " << static_cast<int>(projection);
+          } else {
+            EXPECT_LT((got - expected).cwiseAbs().maxCoeff(), kPathAgreement * scale)
+                << Name(model) << " full, projection " << static_cast<int>(projection);
+            EXPECT_EQ(got, got.transpose()) << Name(model);  // symmetrised exactly
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST(BendingElements, FixedPatternHessianAddsIntoASharedPattern) {
+  // A solver's matrix holds more than bending (membranes, contact): slots into a superset
+  // pattern, values added to what is there.
+  std::mt19937 rng(79);
+  const TriangleMesh rest = CrissCrossGridMesh(0.03, 0.03, 3, 3);
+  const auto hinges = BuildHinges(rest);
+  const Vertices x = Perturbed(rest.vertices, 0.002, &rng);
+  const int n = 3 * static_cast<int>(rest.num_vertices());
+  std::vector<Eigen::Triplet<double>> other;
+  for (int i = 0; i < n; ++i) other.emplace_back(i, i, 2.0);
+  for (int i = 0; i + 7 < n; ++i) other.emplace_back(i, i + 7, -0.5);  // some in, some outside
+  Eigen::SparseMatrix<double> shared(n, n), extra(n, n);
+  extra.setFromTriplets(other.begin(), other.end());
+  const Eigen::MatrixXd dense_extra(extra);
+  for (BendingModel model : kAllModels) {
+    const BendingElements b(rest, hinges, Interlining(), std::nullopt, {.model = model});
+    shared = b.HessianPattern(false) + extra;
+    shared.makeCompressed();
+    const BendingHessianSlots slots = b.HessianSlots(shared, false);
+    b.AddHessianValues(x, HessianProjection::kNone, slots, shared.valuePtr());
+    const Eigen::MatrixXd expected = TripletHessian(b, x, HessianProjection::kNone) + dense_extra;
+    EXPECT_LT((Eigen::MatrixXd(shared) - expected).cwiseAbs().maxCoeff(),
+              kPathAgreement * expected.cwiseAbs().maxCoeff())
+        << Name(model);
+  }
+}
+
+TEST(BendingElements, FixedPatternHessianThreadsGiveTheSerialValues) {
+  std::mt19937 rng(83);
+  const TriangleMesh rest = CrissCrossGridMesh(0.1, 0.1, 12, 12);
+  const auto hinges = BuildHinges(rest);
+  const Vertices x = Perturbed(rest.vertices, 0.002, &rng);
+  for (BendingModel model : kAllModels) {
+    const BendingElements serial(rest, hinges, Fig8(), std::nullopt, {.model = model});
+    const BendingElements threaded(rest, hinges, Fig8(), std::nullopt,
+                                   {.model = model, .threads = 3});
+    for (bool upper : {false, true}) {
+      Eigen::SparseMatrix<double> a = serial.HessianPattern(upper), b = a;
+      const BendingHessianSlots slots = serial.HessianSlots(a, upper);
+      serial.SetHessian(x, HessianProjection::kNone, slots, &a);
+      threaded.SetHessian(x, HessianProjection::kNone, threaded.HessianSlots(b, upper), &b);
+      ASSERT_EQ(a.nonZeros(), b.nonZeros());
+      for (long k = 0; k < a.nonZeros(); ++k) {
+        ASSERT_EQ(a.valuePtr()[k], b.valuePtr()[k]) << Name(model) << " entry " << k;
+      }
+    }
+  }
+}
+
+TEST(BendingElements, HessianSlotsRejectAForeignPattern) {
+  const TriangleMesh rest = RegularGridMesh(0.02, 0.02, 2, 2);
+  const auto hinges = BuildHinges(rest);
+  const BendingElements b(rest, hinges, Fig8(), std::nullopt, {});
+  const int n = 3 * static_cast<int>(rest.num_vertices());
+  ExpectInputError([&] { b.HessianSlots(Eigen::SparseMatrix<double>(n + 3, n + 3), false); },
+                   "Hessian pattern is " + std::to_string(n + 3));
+  Eigen::SparseMatrix<double> upper = b.HessianPattern(true);
+  ExpectInputError([&] { b.HessianSlots(upper, false); }, "Hessian pattern lacks entry");
+  Eigen::SparseMatrix<double> loose = b.HessianPattern(false);
+  loose.uncompress();
+  ExpectInputError([&] { b.HessianSlots(loose, false); }, "not compressed");
+  const BendingHessianSlots slots = b.HessianSlots(upper, true);
+  Eigen::SparseMatrix<double> full = b.HessianPattern(false);
+  ExpectInputError([&] { b.SetHessian(rest.vertices, HessianProjection::kNone, slots, &full); },
+                   "needs the compressed matrix the slots were made for");
+}
+
 }  // namespace
 }  // namespace textile

@@ -13,6 +13,12 @@
 //   grad);   // J and J/m; forces are -grad std::vector<Eigen::Triplet<double>> triplets;
 //   bending.AddHessianTriplets(x, &triplets, /*project_psd=*/true);  // 3V×3V, for Newton
 //
+//   // Newton steps on a fixed sparsity pattern: no triplets, no sorting, no allocation a call.
+//   Eigen::SparseMatrix<double> hessian = bending.HessianPattern(/*upper=*/true);
+//   const textile::BendingHessianSlots slots = bending.HessianSlots(hessian, /*upper=*/true);
+//   bending.SetHessian(x, textile::HessianProjection::kNone, slots, &hessian);
+//   // hessian.selfadjointView<Eigen::Upper>() is ∇²E
+//
 // Hinge h has wings v[0], v[1] and edge (v[2], v[3]) (mesh.h). Its bend angle θ is the signed
 // angle between the two triangle normals, 0 when flat, positive when the hinge bends towards
 // the side its normals point to (e.g. a flat pattern laid on a cylinder below it).
@@ -82,6 +88,18 @@ struct BendingOptions {
 double HingeBendAngle(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1,
                       const Eigen::Vector3d& x2, const Eigen::Vector3d& x3);
 
+// Where every hinge's Hessian entries live in the value array of one compressed column-major
+// sparse matrix (BendingElements::HessianSlots), so that a call adds them by position.
+struct BendingHessianSlots {
+  bool upper = false;    // only entries with row ≤ col are stored (a symmetric matrix's upper half)
+  int per_hinge = 0;     // entries per hinge: 78 (upper) or 144
+  long nonzeros = 0;     // nonZeros() of the matrix the slots were made for
+  std::vector<int> slot;  // #H × per_hinge positions in valuePtr(), hinge-major
+  // For threaded filling, per value position p: sources[source_offsets[p] .. source_offsets[p+1])
+  // are the contributions (78 h + packed entry) in hinge order, the serial order of additions.
+  std::vector<int> source_offsets, sources;
+};
+
 class BendingElements {
  public:
   // @param rest        rest mesh: #V×3 rest positions [m] (flat patterns: z = 0; a curved
@@ -129,6 +147,24 @@ class BendingElements {
   void AddHessianTriplets(const Vertices& x, std::vector<Eigen::Triplet<double>>* triplets,
                           HessianProjection projection, int first_hinge, int end_hinge) const;
 
+  // Fixed-pattern Hessian (for Newton solvers that refill one matrix every step).
+  // The 3V×3V pattern of the bending Hessian (dof 3·i + c): every pair of vertices of a hinge a
+  // dense 3×3 block, all values 0, compressed. upper: only entries with row ≤ col.
+  Eigen::SparseMatrix<double> HessianPattern(bool upper) const;
+  // Positions of every hinge's entries in `pattern` (3V×3V, compressed; any pattern that holds
+  // all of HessianPattern(upper)'s entries, e.g. one shared with other elements). Throws
+  // InputError if the size is wrong, the matrix is not compressed or an entry is missing.
+  BendingHessianSlots HessianSlots(const Eigen::SparseMatrix<double>& pattern, bool upper) const;
+  // values[p] += ∇²E [N/m] at the positions of `slots` (values = valuePtr() of the matrix the
+  // slots were made for): the same numbers as AddHessianTriplets to round-off, upper-half
+  // entries when slots.upper. Each hinge block is symmetrised (its exact value is symmetric; the
+  // triplet path's is to ~1e-12). No allocation unless threaded (a scratch buffer, reused).
+  void AddHessianValues(const Vertices& x, HessianProjection projection,
+                        const BendingHessianSlots& slots, double* values) const;
+  // hessian = ∇²E: zeroes the values of `hessian` (the matrix `slots` was made for), then adds.
+  void SetHessian(const Vertices& x, HessianProjection projection,
+                  const BendingHessianSlots& slots, Eigen::SparseMatrix<double>* hessian) const;
+
   // Per-hinge views, for tests, plots and seams.
   int num_hinges() const { return static_cast<int>(rest_.size()); }
   const Hinge& hinge(int h) const { return hinges_[h]; }
@@ -159,9 +195,21 @@ class BendingElements {
     Eigen::Vector3d rest_vector;
   };
 
+  // Dihedral models, structure of arrays padded to a multiple of the SIMD block (hot loop).
+  struct DihedralRest {
+    std::vector<double> rest_angle, inv_height, weight, warp_weight, sin_half, cos_half;
+  };
+
   static constexpr int kMaxThreads = 64;
   template <bool kWithEnergy, bool kWithGradient>
   double Evaluate(const Vertices& x, double* grad) const;
+  // Hinge h's Hessian block, packed upper triangle of the 12×12 block (78 values) into u.
+  void HingeHessianUpper(const Vertices& x, int h, HessianProjection projection, double* u) const;
+  // The same for hinges first ≤ h < first + count (count ≤ kSimdLanes), lane-minor:
+  // u[kSimdLanes k + l] is entry k of hinge first + l (the SIMD kernel for the dihedral models).
+  static constexpr int kSimdLanes = 8;
+  void HessianBlocks(const Vertices& x, HessianProjection projection, long first, int count,
+                     double* u) const;
   double HingeTerms(const Vertices& x, int h, double* d_energy, double* d2_energy) const;
   double DihedralTerms(double cos_term, double sin_term, int h, double* d_energy, double* d2_energy,
                        bool want_energy) const;
@@ -179,9 +227,11 @@ class BendingElements {
   std::vector<double> edge_length_, multiplier_;
   std::vector<double> half_angle_;  // Bridson: {sin θ̄/2, cos θ̄/2} per hinge
   std::vector<LinearRest> linear_;  // Volino and isometric only
+  DihedralRest dihedral_;           // Pabst and Bridson only
   // Threaded gradient: per-hinge 12-vectors gathered per vertex (CSR of (hinge, slot)).
   std::vector<int> vertex_offsets_, vertex_slots_;
   mutable std::vector<double> hinge_gradient_;  // scratch: not for concurrent threaded calls
+  mutable std::vector<double> hinge_hessian_;   // scratch of threaded AddHessianValues (78 a hinge)
 };
 
 }  // namespace textile

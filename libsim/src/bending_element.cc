@@ -449,7 +449,9 @@ TEXTILE_ALWAYS_INLINE void TriangleLane(V3 w, V3 x2, V3 x3, V3 n, V3 eps0, V3 ep
 template <bool kAngle>
 TEXTILE_ALWAYS_INLINE void ScaleAndAddOuter(const DihedralLanesOut& in, int l, LaneHessian* out) {
   [[maybe_unused]] const double de = in.d_energy[l];
-  const double d2 = kAngle ? in.d2_energy[l] : std::max(in.d2_energy[l], 0.0);
+  // A ternary, not std::max: that takes the lane value's address, and the loop would not vectorise.
+  const double d2_raw = in.d2_energy[l];
+  const double d2 = kAngle || d2_raw > 0.0 ? d2_raw : 0.0;
   Unroll<12>([&](auto ac) __attribute__((always_inline)) {
     constexpr int A = decltype(ac)::value;
     Unroll<12>([&](auto bc) __attribute__((always_inline)) {

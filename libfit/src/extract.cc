@@ -46,18 +46,24 @@ enum Border : int { kNoBorder = 0, kLeft = 1, kRight = 2, kTop = 4, kBottom = 8 
 
 // ---------------------------------------------------------------- reduced-image detection
 
-// Geodesic distance inside `mask` from `seeds`, 8-connected (steps 1 and √2) [px]; +inf outside
-// or unreachable.
-cv::Mat GeodesicDistance(const cv::Mat& mask, const std::vector<cv::Point>& seeds) {
+// Geodesic distance inside `mask` from `seeds`, 8-connected (steps 1 and √2) [px], over `box`
+// only (the mask's bounding box: nothing outside it is reachable). Returns a box-sized map, the
+// distance of pixel (x, y) at (x - box.x, y - box.y); +inf outside the mask or unreachable.
+// Box-sized maps keep the many sweeps of the detection cheap: a strip's box is a fraction of the
+// image, and a full-sized map would cost more to allocate and fill than the search itself.
+cv::Mat GeodesicDistance(const cv::Mat& mask, const cv::Rect& box,
+                         const std::vector<cv::Point>& seeds) {
   const float inf = std::numeric_limits<float>::infinity();
-  cv::Mat dist(mask.size(), CV_32F, cv::Scalar(inf));
+  cv::Mat dist(box.size(), CV_32F, cv::Scalar(inf));
   using Item = std::pair<float, int>;
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-  const int w = mask.cols, h = mask.rows;
+  const cv::Mat m = mask(box);
+  const int w = box.width, h = box.height;
   for (const cv::Point& s : seeds) {
-    if (!mask.at<uchar>(s)) continue;
-    dist.at<float>(s) = 0.0f;
-    queue.push({0.0f, s.y * w + s.x});
+    const cv::Point q = s - box.tl();
+    if (!box.contains(s) || !m.at<uchar>(q)) continue;
+    dist.at<float>(q) = 0.0f;
+    queue.push({0.0f, q.y * w + q.x});
   }
   static const int dx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
   static const int dy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
@@ -70,7 +76,7 @@ cv::Mat GeodesicDistance(const cv::Mat& mask, const std::vector<cv::Point>& seed
     if (d > dist.at<float>(y, x)) continue;
     for (int k = 0; k < 8; ++k) {
       const int nx = x + dx[k], ny = y + dy[k];
-      if (nx < 0 || ny < 0 || nx >= w || ny >= h || !mask.at<uchar>(ny, nx)) continue;
+      if (nx < 0 || ny < 0 || nx >= w || ny >= h || !m.at<uchar>(ny, nx)) continue;
       const float nd = d + step[k];
       if (nd < dist.at<float>(ny, nx)) {
         dist.at<float>(ny, nx) = nd;
@@ -81,15 +87,16 @@ cv::Mat GeodesicDistance(const cv::Mat& mask, const std::vector<cv::Point>& seed
   return dist;
 }
 
+// The farthest reachable pixel of a box-sized distance map, in image coordinates.
 cv::Point Farthest(const cv::Mat& dist, const cv::Rect& box, float* value) {
   cv::Point best(-1, -1);
   float top = -1.0f;
-  for (int y = box.y; y < box.y + box.height; ++y) {
+  for (int y = 0; y < dist.rows; ++y) {
     const float* row = dist.ptr<float>(y);
-    for (int x = box.x; x < box.x + box.width; ++x) {
+    for (int x = 0; x < dist.cols; ++x) {
       if (std::isfinite(row[x]) && row[x] > top) {
         top = row[x];
-        best = {x, y};
+        best = {x + box.x, y + box.y};
       }
     }
   }
@@ -101,8 +108,11 @@ cv::Point Farthest(const cv::Mat& dist, const cv::Rect& box, float* value) {
 struct Sweep {
   cv::Rect box;  // bounding box of the mask
   cv::Point a, b;
-  cv::Mat dist_a, dist_b;
+  cv::Mat dist_a, dist_b;  // box-sized (GeodesicDistance)
   double length = 0.0;
+  // Distance from end a (or b) of image pixel (x, y), which must lie in the box.
+  float DistA(int x, int y) const { return dist_a.at<float>(y - box.y, x - box.x); }
+  float DistB(int x, int y) const { return dist_b.at<float>(y - box.y, x - box.x); }
 };
 
 Sweep DoubleSweep(const cv::Mat& mask) {
@@ -114,11 +124,11 @@ Sweep DoubleSweep(const cv::Mat& mask) {
     if (mask.at<uchar>(s.box.y, x)) any = {x, s.box.y};
   }
   float v;
-  s.a = Farthest(GeodesicDistance(mask, {any}), s.box, &v);
-  s.dist_a = GeodesicDistance(mask, {s.a});
+  s.a = Farthest(GeodesicDistance(mask, s.box, {any}), s.box, &v);
+  s.dist_a = GeodesicDistance(mask, s.box, {s.a});
   s.b = Farthest(s.dist_a, s.box, &v);
   s.length = v;
-  s.dist_b = GeodesicDistance(mask, {s.b});
+  s.dist_b = GeodesicDistance(mask, s.box, {s.b});
   return s;
 }
 
@@ -160,8 +170,8 @@ struct Strip {
 void CollectStrips(const cv::Mat& hat, int polarity, std::vector<Strip>* out) {
   const double min_length = kMinLengthFraction * std::hypot(hat.cols, hat.rows);
   cv::Mat binary = hat > HatThreshold(hat);
-  cv::Mat labels, stats, centroids;
-  const int n = cv::connectedComponentsWithStats(binary, labels, stats, centroids, 8, CV_32S);
+  cv::Mat labels, stats;
+  const int n = extract_internal::ConnectedComponents(binary, &labels, &stats);
   std::vector<double> mass(n, 0.0);
   for (int y = 0; y < hat.rows; ++y) {
     const int* l = labels.ptr<int>(y);
@@ -179,27 +189,34 @@ void CollectStrips(const cv::Mat& hat, int polarity, std::vector<Strip>* out) {
   for (const int l : order) {
     Strip s;
     s.polarity = polarity;
-    s.mask = labels == l;
-    const Sweep sweep = DoubleSweep(s.mask);
+    // The sweep runs on the component's own box; the image-sized mask is made only for a
+    // candidate that is kept.
+    const cv::Rect box(stats.at<int>(l, cv::CC_STAT_LEFT), stats.at<int>(l, cv::CC_STAT_TOP),
+                       stats.at<int>(l, cv::CC_STAT_WIDTH), stats.at<int>(l, cv::CC_STAT_HEIGHT));
+    const cv::Mat own = labels(box) == l;
+    const Sweep sweep = DoubleSweep(own);
     s.length = sweep.length;
     s.thickness = stats.at<int>(l, cv::CC_STAT_AREA) / std::max(1.0, s.length);
     // Length times mean contrast: a long, clear band beats a broad faint area (a shadow's rim)
     // of the same total contrast.
     s.score = s.length * mass[l] / std::max(1, stats.at<int>(l, cv::CC_STAT_AREA));
-    if (s.length >= min_length && s.length >= kMinElongation * s.thickness)
+    if (s.length >= min_length && s.length >= kMinElongation * s.thickness) {
+      s.mask = cv::Mat::zeros(hat.size(), CV_8U);
+      own.copyTo(s.mask(box));
       out->push_back(std::move(s));
+    }
   }
 }
 
 // Direction in which a band leaves its end: from the centroid of the pixels 2-4 thicknesses
-// back (by geodesic distance from the end) to the end.
+// back (by geodesic distance from the end) to the end. `dist` is box-sized (GeodesicDistance).
 Vec2 EndDirection(const cv::Mat& mask, const cv::Mat& dist, const cv::Rect& box,
                   const cv::Point& end, double thickness) {
   Vec2 sum = Vec2::Zero();
   int count = 0;
   for (int y = box.y; y < box.y + box.height; ++y) {
     for (int x = box.x; x < box.x + box.width; ++x) {
-      const float d = dist.at<float>(y, x);
+      const float d = dist.at<float>(y - box.y, x - box.x);
       if (mask.at<uchar>(y, x) && d >= 2.0 * thickness && d <= 4.0 * thickness + 2.0) {
         sum += Vec2(x, y);
         ++count;
@@ -256,23 +273,35 @@ void MergeContinuations(const cv::Mat& hat, double threshold, Strip* strip) {
 
 // The largest 8-connected component of a mask (empty if there is none).
 cv::Mat LargestComponent(const cv::Mat& mask) {
-  cv::Mat labels, stats, centroids;
-  const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  const cv::Rect box = cv::boundingRect(mask);
+  if (box.empty()) return cv::Mat();
+  cv::Mat labels, stats;
+  const int n = extract_internal::ConnectedComponents(mask(box), &labels, &stats);
   int best = 0;
   for (int l = 1; l < n; ++l) {
     if (best == 0 || stats.at<int>(l, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA)) {
       best = l;
     }
   }
-  return best > 0 ? cv::Mat(labels == best) : cv::Mat();
+  if (best == 0) return cv::Mat();
+  cv::Mat out = cv::Mat::zeros(mask.size(), CV_8U);
+  out(box).setTo(255, labels == best);
+  return out;
 }
 
 // A clamp of the strip's own shade that is thinner than the hat kernel merges with the strip:
 // parts much thicker than the strip that reach in from the photo's border are split off and
 // returned as blocks; the strip keeps its largest remaining piece.
 std::vector<Block> SplitOffThickParts(Strip* strip) {
+  // All of it runs on the mask's box with a margin (for the distances, the opening's kernel)
+  // rather than on the whole image: the results are the same.
+  const cv::Rect image(0, 0, strip->mask.cols, strip->mask.rows);
+  const cv::Rect box = cv::boundingRect(strip->mask);
+  if (box.empty()) return {};
   cv::Mat dt;
-  cv::distanceTransform(strip->mask, dt, cv::DIST_L2, 3);
+  cv::distanceTransform(strip->mask(cv::Rect(box.x - 1, box.y - 1, box.width + 2, box.height + 2) &
+                                    image),
+                        dt, cv::DIST_L2, 3);
   // The band's width from its ridge (local maxima of the distance to its outside), where a long
   // band outnumbers a compact block.
   std::vector<double> ridge;
@@ -287,22 +316,25 @@ std::vector<Block> SplitOffThickParts(Strip* strip) {
   }
   const double width = ridge.empty() ? strip->thickness : std::max(2.0, 2.0 * Median(ridge) - 1.0);
   const int d = std::max(5, static_cast<int>(3.0 * width)) | 1;
+  const cv::Rect roi = cv::Rect(box.x - d, box.y - d, box.width + 2 * d, box.height + 2 * d) & image;
   cv::Mat thick;
-  cv::morphologyEx(strip->mask, thick, cv::MORPH_OPEN,
+  cv::morphologyEx(strip->mask(roi), thick, cv::MORPH_OPEN,
                    cv::getStructuringElement(cv::MORPH_ELLIPSE, {d, d}));
-  cv::Mat labels, stats, centroids;
-  const int n = cv::connectedComponentsWithStats(thick, labels, stats, centroids, 8, CV_32S);
+  cv::Mat labels, stats;
+  const int n = extract_internal::ConnectedComponents(thick, &labels, &stats);
   std::vector<Block> blocks;
   cv::Mat removed(strip->mask.size(), CV_8U, cv::Scalar(0));
   for (int l = 1; l < n; ++l) {
-    const cv::Rect box(stats.at<int>(l, cv::CC_STAT_LEFT), stats.at<int>(l, cv::CC_STAT_TOP),
+    const cv::Rect own(stats.at<int>(l, cv::CC_STAT_LEFT) + roi.x,
+                       stats.at<int>(l, cv::CC_STAT_TOP) + roi.y,
                        stats.at<int>(l, cv::CC_STAT_WIDTH), stats.at<int>(l, cv::CC_STAT_HEIGHT));
     // Only fixtures reaching in from outside the photo count (a frayed tip's brush does not).
-    if (box.x > 0 && box.y > 0 && box.br().x < thick.cols && box.br().y < thick.rows) continue;
+    if (own.x > 0 && own.y > 0 && own.br().x < image.width && own.br().y < image.height) continue;
     Block b;
-    b.mask = labels == l;
+    b.mask = cv::Mat::zeros(strip->mask.size(), CV_8U);
+    b.mask(roi).setTo(255, labels == l);
     b.sign = strip->polarity;
-    b.box = box;
+    b.box = own;
     removed |= b.mask;
     blocks.push_back(std::move(b));
   }
@@ -340,12 +372,13 @@ double DistanceToBlocks(const std::vector<Block>& blocks, const cv::Point& p) {
   return best;
 }
 
-// Which image borders a set of mask pixels (those within `radius` of an end) touches.
+// Which image borders a set of mask pixels (those within `radius` of an end) touches. `dist` is
+// box-sized (GeodesicDistance).
 int BordersNear(const cv::Mat& mask, const cv::Mat& dist, const cv::Rect& box, double radius) {
   int borders = kNoBorder;
   for (int y = box.y; y < box.y + box.height; ++y) {
     for (int x = box.x; x < box.x + box.width; ++x) {
-      if (!mask.at<uchar>(y, x) || !(dist.at<float>(y, x) <= radius)) continue;
+      if (!mask.at<uchar>(y, x) || !(dist.at<float>(y - box.y, x - box.x) <= radius)) continue;
       if (x == 0) borders |= kLeft;
       if (x == mask.cols - 1) borders |= kRight;
       if (y == 0) borders |= kTop;
@@ -359,7 +392,8 @@ int BordersNear(const cv::Mat& mask, const cv::Mat& dist, const cv::Rect& box, d
 // in 1 px bins (level sets of a band cut straight across it). Widths [px] per point.
 std::vector<Vec2> LevelSetCentreline(const cv::Mat& mask, const std::vector<cv::Point>& seeds,
                                      std::vector<double>* widths) {
-  const cv::Mat d = GeodesicDistance(mask, seeds);
+  const cv::Rect box = cv::boundingRect(mask);
+  const cv::Mat d = GeodesicDistance(mask, box, seeds);
   std::vector<Vec2> sum;
   std::vector<int> count;
   for (int y = 0; y < d.rows; ++y) {
@@ -371,7 +405,7 @@ std::vector<Vec2> LevelSetCentreline(const cv::Mat& mask, const std::vector<cv::
         sum.resize(k + 1, Vec2::Zero());
         count.resize(k + 1, 0);
       }
-      sum[k] += Vec2(x, y);
+      sum[k] += Vec2(x + box.x, y + box.y);
       ++count[k];
     }
   }
@@ -485,17 +519,33 @@ SectionSet AnalyseSections(const cv::Mat& gray, const std::vector<Vec2>& line, i
   const int half = static_cast<int>(std::lround(half_width / kAcrossStep));
   const int cols = 2 * half + 1;
   cv::Mat raw(m, cols, CV_32F), inside(m, cols, CV_8U);
+  const double x_max = gray.cols - 1.0, y_max = gray.rows - 1.0;
   for (int i = 0; i < m; ++i) {
+    float* out = raw.ptr<float>(i);
+    uchar* in_row = inside.ptr<uchar>(i);
+    const Vec2 q0 = line[i] - half * kAcrossStep * set.n[i], dq = kAcrossStep * set.n[i];
+    const Vec2 q1 = q0 + (cols - 1) * dq;
+    // A section wholly inside the photo (the usual case) is sampled without per-sample checks.
+    const bool all_in = std::min(q0.x(), q1.x()) >= 0.0 && std::max(q0.x(), q1.x()) <= x_max &&
+                        std::min(q0.y(), q1.y()) >= 0.0 && std::max(q0.y(), q1.y()) <= y_max;
     for (int j = 0; j < cols; ++j) {
-      const Vec2 q = line[i] + (j - half) * kAcrossStep * set.n[i];
+      const double x = q0.x() + j * dq.x(), y = q0.y() + j * dq.y();
       double v;
-      const bool in = SampleGray(gray, q.x(), q.y(), &v);
-      if (!in) {
-        SampleGray(gray, std::clamp(q.x(), 0.0, gray.cols - 1.0),
-                   std::clamp(q.y(), 0.0, gray.rows - 1.0), &v);
+      if (all_in) {
+        const int x0 = std::min(static_cast<int>(x), gray.cols - 2);
+        const int y0 = std::min(static_cast<int>(y), gray.rows - 2);
+        const double fx = x - x0, fy = y - y0;
+        const uchar* r0 = gray.ptr<uchar>(y0);
+        const uchar* r1 = r0 + gray.step[0];
+        v = (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x0 + 1]) +
+            fy * ((1 - fx) * r1[x0] + fx * r1[x0 + 1]);
+        in_row[j] = 1;
+      } else {
+        const bool in = SampleGray(gray, x, y, &v);
+        if (!in) SampleGray(gray, std::clamp(x, 0.0, x_max), std::clamp(y, 0.0, y_max), &v);
+        in_row[j] = in;
       }
-      raw.at<float>(i, j) = static_cast<float>(v);
-      inside.at<uchar>(i, j) = in;
+      out[j] = static_cast<float>(v);
     }
   }
   // Noise is smoothed across (σ = 1 px) and along (σ = 1.5 stations) the strip; both are far
@@ -566,24 +616,35 @@ SectionSet AnalyseSections(const cv::Mat& gray, const std::vector<Vec2>& line, i
   return set;
 }
 
-// Running quantile q (0.5: median) of values[i] over valid stations within ±reach.
+// Running quantile q (0.5: median) of values[i] over valid stations within ±reach. The window
+// is kept sorted as it slides (one insertion and one removal per station), which gives exactly
+// the quantile of each window for far less than selecting it anew every time.
 std::vector<double> RunningQuantile(const std::vector<double>& values, const std::vector<char>& ok,
                                     int reach, double q = 0.5) {
   const int m = static_cast<int>(values.size());
   std::vector<double> out(m, kNaN);
-  std::vector<double> window;
+  std::vector<double> window;  // sorted
+  const auto add = [&](int k) {
+    if (ok[k] && !std::isnan(values[k]))
+      window.insert(std::upper_bound(window.begin(), window.end(), values[k]), values[k]);
+  };
+  const auto remove = [&](int k) {
+    if (ok[k] && !std::isnan(values[k]))
+      window.erase(std::lower_bound(window.begin(), window.end(), values[k]));
+  };
+  for (int k = 0; k <= std::min(m - 1, reach); ++k) add(k);
   for (int i = 0; i < m; ++i) {
-    window.clear();
-    for (int k = std::max(0, i - reach); k <= std::min(m - 1, i + reach); ++k) {
-      if (ok[k]) window.push_back(values[k]);
+    if (i > 0) {
+      if (i - reach - 1 >= 0) remove(i - reach - 1);
+      if (i + reach < m) add(i + reach);
     }
-    if (window.empty()) continue;
+    const size_t n = window.size();
+    if (n == 0) continue;
     if (q == 0.5) {
-      out[i] = Median(window);
+      // As Median(): the middle value, or the mean of the two middle values.
+      out[i] = n % 2 == 1 ? window[n / 2] : 0.5 * (window[n / 2 - 1] + window[n / 2]);
     } else {
-      const size_t at = static_cast<size_t>(std::lround(q * (window.size() - 1)));
-      std::nth_element(window.begin(), window.begin() + at, window.end());
-      out[i] = window[at];
+      out[i] = window[static_cast<size_t>(std::lround(q * (n - 1)))];
     }
   }
   return out;
@@ -764,52 +825,91 @@ std::vector<Vec2> Extend(const std::vector<Vec2>& line, double at_start, double 
   return out;
 }
 
+// The guide for the next tracking pass, from a set of sections (in that set's pixels): the
+// strip's solid core through a running median and a wide Gaussian, resampled every pixel.
+// *w_max is the 95 % quantile of the silhouette widths [px]. False if too little was measured.
+bool NextGuide(const SectionSet& set, std::vector<Vec2>* guide, double* w_max) {
+  double w_end;
+  const std::pair<int, int> run = TrimmedRun(set, TraceLine::kMid, &w_end);
+  std::vector<double> w;
+  for (const auto& s : set.s) {
+    if (s.valid) w.push_back(s.width());
+  }
+  if (run.second - run.first < 10 || w.empty()) return false;
+  // The guide must be smooth more than exact: it follows the strip's solid core (a silhouette
+  // whose faint part comes and goes, an oblique face, would make the mid-line jump), through a
+  // running median and a wide Gaussian; the next pass measures the boundaries again anyway.
+  std::vector<double> core(run.second - run.first + 1);
+  std::vector<char> has(core.size());
+  for (int i = run.first; i <= run.second; ++i) {
+    core[i - run.first] = set.s[i].solid_mid;
+    has[i - run.first] = set.s[i].present;
+  }
+  core = RunningQuantile(core, has, std::max(10, static_cast<int>(set.width)));
+  guide->clear();
+  for (int i = run.first; i <= run.second; ++i) {
+    const double n = core[i - run.first];
+    guide->push_back(set.p[i] + (std::isnan(n) ? 0.0 : n) * set.n[i]);
+  }
+  *guide = ResampleByArc(SmoothPolyline(*guide, std::max(3.0, 0.5 * set.width)), 1.0);
+  // A lit end face or a brush of fibres can still bend the end of the guide away.
+  CutAtSharpTurn(guide, std::max(20.0, set.width), /*check_growth=*/true);
+  std::sort(w.begin(), w.end());
+  *w_max = w[static_cast<size_t>(0.95 * (w.size() - 1))];
+  return true;
+}
+
+// Full-resolution pixel <-> pixel of an image reduced by the integer factor f (box average of
+// f x f pixels, cv::INTER_AREA).
+Vec2 ReducedFromFull(const Vec2& p, int f) { return (p.array() + 0.5) / f - 0.5; }
+Vec2 FullFromReduced(const Vec2& p, int f) { return (p.array() + 0.5) * f - 0.5; }
+
 // Cross-sections along the strip at full resolution: a first pass on the coarse line (width
 // about t_full px), then passes on the measured line (whose normals cross the strip squarely),
 // extended along the strip for as long as it continues, so that tracking goes on past where the
 // reduced image lost the strip. root_ext: how far to look back beyond the held end [px].
-SectionSet TrackStrip(const cv::Mat& gray, const std::vector<Vec2>& coarse, int direction,
-                      int polarity, double t_full, double root_ext) {
+// The first pass, whose window is wide, may run on `mid`, the photo reduced by the integer
+// factor `f` (f = 1: none): it only places the guide, which the later passes measure again at
+// full resolution, and it costs f² less there. *ok is false if the first pass found too little
+// to follow.
+SectionSet TrackStrip(const cv::Mat& gray, const cv::Mat& mid, int f, const std::vector<Vec2>& coarse,
+                      int direction, int polarity, double t_full, double root_ext, bool* ok) {
+  *ok = true;
   // The reduced image may show only the strip's brightest part (a lit edge): the first window is
   // wide enough for an oblique face several times wider, and the core is looked for widely.
   const double half_1 =
       std::max({3.0 * t_full + 15.0, 0.06 * std::max(gray.cols, gray.rows), 20.0});
   std::vector<Vec2> line =
       Extend(coarse, root_ext, 2.0 * t_full + 20.0, std::max(10.0, 2.0 * t_full));
-  SectionSet set = AnalyseSections(gray, line, direction, polarity, half_1, 0.6 * half_1);
+  SectionSet set;
+  int set_f = 1;  // full-resolution pixels per pixel of `set`
+  if (f > 1) {
+    for (Vec2& p : line) p = ReducedFromFull(p, f);
+    line = ResampleByArc(line, 1.0);
+    set = AnalyseSections(mid, line, direction, polarity, half_1 / f, 0.6 * half_1 / f);
+    set_f = f;
+  } else {
+    set = AnalyseSections(gray, line, direction, polarity, half_1, 0.6 * half_1);
+  }
   RejectOutliers(&set);
   for (int pass = 0; pass < 8; ++pass) {
-    double w_end;
-    const std::pair<int, int> run = TrimmedRun(set, TraceLine::kMid, &w_end);
-    std::vector<double> w;
-    for (const auto& s : set.s) {
-      if (s.valid) w.push_back(s.width());
-    }
-    if (run.second - run.first < 10 || w.empty()) break;
-    // The guide must be smooth more than exact: it follows the strip's solid core (a silhouette
-    // whose faint part comes and goes, an oblique face, would make the mid-line jump), through a
-    // running median and a wide Gaussian; the next pass measures the boundaries again anyway.
-    std::vector<double> core(run.second - run.first + 1);
-    std::vector<char> has(core.size());
-    for (int i = run.first; i <= run.second; ++i) {
-      core[i - run.first] = set.s[i].solid_mid;
-      has[i - run.first] = set.s[i].present;
-    }
-    core = RunningQuantile(core, has, std::max(10, static_cast<int>(set.width)));
     std::vector<Vec2> guide;
-    for (int i = run.first; i <= run.second; ++i) {
-      const double n = core[i - run.first];
-      guide.push_back(set.p[i] + (std::isnan(n) ? 0.0 : n) * set.n[i]);
+    double w_max;
+    if (!NextGuide(set, &guide, &w_max)) {
+      *ok = set_f == 1;
+      break;
     }
-    guide = ResampleByArc(SmoothPolyline(guide, std::max(3.0, 0.5 * set.width)), 1.0);
-    // A lit end face or a brush of fibres can still bend the end of the guide away.
-    CutAtSharpTurn(&guide, std::max(20.0, set.width), /*check_growth=*/true);
-    std::sort(w.begin(), w.end());
-    const double w_max = w[static_cast<size_t>(0.95 * (w.size() - 1))];
-    const double half_2 = 0.5 * w_max + std::max(12.0, 0.75 * set.width);
-    const double ahead = std::max(60.0, 4.0 * set.width);
-    line = Extend(guide, root_ext, ahead, std::max(10.0, 2.0 * set.width));
+    const double width = set.width * set_f;
+    w_max *= set_f;
+    if (set_f > 1) {
+      for (Vec2& p : guide) p = FullFromReduced(p, set_f);
+      guide = ResampleByArc(guide, 1.0);
+    }
+    const double half_2 = 0.5 * w_max + std::max(12.0, 0.75 * width);
+    const double ahead = std::max(60.0, 4.0 * width);
+    line = Extend(guide, root_ext, ahead, std::max(10.0, 2.0 * width));
     set = AnalyseSections(gray, line, direction, polarity, half_2, 0.5 * w_max + 3.0);
+    set_f = 1;
     RejectOutliers(&set);
     // Done unless the strip still shows at the far end of the extension.
     double unused;
@@ -957,8 +1057,23 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
 
   // ---- 1. Find the strip on a reduced image.
   const double scale = std::min(1.0, options.detect_side_px / double(std::max(W, H)));
+  // Large photos get an intermediate level too, reduced by an integer factor to about 2000 px
+  // (a box average, the fast case of cv::INTER_AREA; the photo's last f - 1 rows and columns
+  // are left out): the first, wide tracking pass runs on it, and the detection image is
+  // reduced from it rather than from the photo.
+  const int mid_factor = std::max(1, std::max(W, H) / 2000);
+  cv::Mat mid;
+  if (mid_factor > 1) {
+    const int mw = W / mid_factor, mh = H / mid_factor;
+    cv::resize(gray(cv::Rect(0, 0, mw * mid_factor, mh * mid_factor)), mid, cv::Size(mw, mh), 0,
+               0, cv::INTER_AREA);
+  }
   cv::Mat small;
-  if (scale < 1.0) {
+  if (scale < 1.0 && mid_factor > 1) {
+    const cv::Size size(static_cast<int>(std::lround(W * scale)),
+                        static_cast<int>(std::lround(H * scale)));
+    cv::resize(mid, small, size, 0, 0, cv::INTER_AREA);
+  } else if (scale < 1.0) {
     cv::resize(gray, small, cv::Size(), scale, scale, cv::INTER_AREA);
   } else {
     small = gray;
@@ -1068,10 +1183,10 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   std::vector<cv::Point> seeds;
   if (root_how == "border" && (root_borders & sides)) {
     const int x_border = (root_borders & kLeft) ? 0 : small.cols - 1;
-    const cv::Mat& dist_root = root_is_a ? sweep.dist_a : sweep.dist_b;
     for (int y = 0; y < small.rows; ++y) {
       if (strip.mask.at<uchar>(y, x_border) &&
-          dist_root.at<float>(y, x_border) <= end_radius + 2.0 * t_small) {
+          (root_is_a ? sweep.DistA(x_border, y) : sweep.DistB(x_border, y)) <=
+              end_radius + 2.0 * t_small) {
         seeds.emplace_back(x_border, y);
       }
     }
@@ -1138,7 +1253,14 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
 
   // ---- 5. Cross-sections at full resolution, along the strip.
   const double root_ext = root_how == "border" ? 3.0 * t_full + 10.0 : 2.0 * t_full + 10.0;
-  const SectionSet set = TrackStrip(gray, coarse, direction, strip.polarity, t_full, root_ext);
+  // The first pass runs on the intermediate level if the strip is at least 4 px thick there.
+  const int first_f = mid_factor > 1 && t_full >= 4.0 * mid_factor ? mid_factor : 1;
+  bool tracked;
+  SectionSet set = TrackStrip(gray, mid, first_f, coarse, direction, strip.polarity, t_full,
+                              root_ext, &tracked);
+  if (!tracked) {
+    set = TrackStrip(gray, mid, 1, coarse, direction, strip.polarity, t_full, root_ext, &tracked);
+  }
   double w_end = 0.0;
   const std::pair<int, int> run = TrimmedRun(set, options.trace, &w_end);
   if (run.second - run.first < 10) return fail("no strip found: its edges could not be measured");
@@ -1273,9 +1395,26 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   // The profile starts where the traced line crosses x = 0 (the vertical through the origin).
   size_t start = 0;
   Vec2 first_mm;
+  std::vector<Vec2> bridge;  // points between first_mm and the traced line
   if (mm.front().x() >= 0.0) {
     const Vec2 d = (mm[std::min<size_t>(5, mm.size() - 1)] - mm[0]).normalized();
-    first_mm = mm[0] - (mm[0].x() / std::max(d.x(), 1e-3)) * d;
+    if (platform.found && !options.edge_px && d.x() > 1e-3) {
+      // A strip resting on a platform leaves its edge level (θ(0) = 0, cantilever.md): the gap
+      // to the first measured point is bridged by the parabola that is level at x = 0 and meets
+      // that point with its slope. A straight line along that slope would put the start too
+      // high by half the drop across the gap.
+      const double x1 = mm[0].x(), m1 = d.y() / d.x();
+      const double c = m1 / (2.0 * std::max(x1, 1e-9));
+      const double y0 = mm[0].y() - c * x1 * x1;
+      first_mm = Vec2(0.0, y0);
+      const int pieces = static_cast<int>(std::ceil(x1 / (0.25 * options.step_mm)));
+      for (int k = 1; k < pieces; ++k) {
+        const double x = x1 * k / pieces;
+        bridge.emplace_back(x, y0 + c * x * x);
+      }
+    } else {
+      first_mm = mm[0] - (mm[0].x() / std::max(d.x(), 1e-3)) * d;
+    }
     if (mm[0].x() > std::max(3.0 * set.width * r.mm_per_px, 1.0)) {
       r.warnings.push_back("the traced line starts " + Fmt(mm[0].x(), 2) +
                            " mm beyond the edge; extrapolated to it");
@@ -1288,6 +1427,7 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
     ++start;
   }
   std::vector<Vec2> curve{first_mm};
+  curve.insert(curve.end(), bridge.begin(), bridge.end());
   curve.insert(curve.end(), mm.begin() + start, mm.end());
   const std::vector<Vec2> resampled = ResampleByArc(curve, options.step_mm);
   // Arc length along the traced line (not along the chords between samples): k·step, and the

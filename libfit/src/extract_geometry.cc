@@ -2,7 +2,9 @@
 // polylines, bilinear sampling.
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
+#include <opencv2/imgproc.hpp>
 
 #include "extract_internal.h"
 
@@ -58,6 +60,33 @@ std::vector<Vec2> ResampleByArc(const std::vector<Vec2>& p, double step) {
     out.push_back(p.back());
   }
   return out;
+}
+
+int ConnectedComponents(const cv::Mat& mask, cv::Mat* labels, cv::Mat* stats) {
+  const int n = cv::connectedComponents(mask, *labels, 8, CV_32S);
+  std::vector<int> x0(n, INT_MAX), y0(n, INT_MAX), x1(n, -1), y1(n, -1), area(n, 0);
+  for (int y = 0; y < labels->rows; ++y) {
+    const int* row = labels->ptr<int>(y);
+    for (int x = 0; x < labels->cols; ++x) {
+      const int l = row[x];
+      x0[l] = std::min(x0[l], x);
+      x1[l] = std::max(x1[l], x);
+      y0[l] = std::min(y0[l], y);
+      y1[l] = std::max(y1[l], y);
+      ++area[l];
+    }
+  }
+  stats->create(n, 5, CV_32S);
+  for (int l = 0; l < n; ++l) {
+    int* s = stats->ptr<int>(l);
+    const bool any = area[l] > 0;
+    s[cv::CC_STAT_LEFT] = any ? x0[l] : 0;
+    s[cv::CC_STAT_TOP] = any ? y0[l] : 0;
+    s[cv::CC_STAT_WIDTH] = any ? x1[l] - x0[l] + 1 : 0;
+    s[cv::CC_STAT_HEIGHT] = any ? y1[l] - y0[l] + 1 : 0;
+    s[cv::CC_STAT_AREA] = area[l];
+  }
+  return n;
 }
 
 bool SampleGray(const cv::Mat& gray, double x, double y, double* value) {

@@ -26,6 +26,12 @@ std::vector<Vec2> ResampleByArc(const std::vector<Vec2>& p, double step);
 // Bilinear sample of an 8-bit grey image at (x, y) [px]; false outside the pixel centres' hull.
 bool SampleGray(const cv::Mat& gray, double x, double y, double* value);
 
+// 8-connected components of a CV_8U mask: labels (CV_32S) and stats (n × 5 CV_32S, columns
+// cv::CC_STAT_LEFT, TOP, WIDTH, HEIGHT, AREA) as cv::connectedComponentsWithStats gives them,
+// without the centroids, which cost more than the labelling itself. Returns n, the number of
+// labels including the background (0).
+int ConnectedComponents(const cv::Mat& mask, cv::Mat* labels, cv::Mat* stats);
+
 // A large region that differs from the background (clamp, platform, fixture), found on the
 // reduced image.
 struct Block {

@@ -101,40 +101,37 @@ std::vector<Block> FindBlocks(const cv::Mat& small, const cv::Mat& ignore, doubl
   // Background model: quadratic in normalised coordinates, fitted on a grid of about 20k
   // samples with outliers (the strip, blocks) trimmed at 2.5σ.
   const int g = std::max(1, static_cast<int>(std::lround(std::sqrt(w * h / 20000.0))));
-  const auto terms = [&](double x, double y) {
-    const double u = (x - w / 2.0) / (w / 2.0), v = (y - h / 2.0) / (h / 2.0);
-    Eigen::Matrix<double, 6, 1> t;
-    t << 1.0, u, v, u * u, u * v, v * v;
-    return t;
-  };
-  std::vector<Eigen::Matrix<double, 6, 1>> rows;
-  std::vector<double> values;
+  const auto u_of = [&](double x) { return (x - w / 2.0) / (w / 2.0); };
+  const auto v_of = [&](double y) { return (y - h / 2.0) / (h / 2.0); };
+  std::vector<Eigen::Matrix<double, 1, 6>> grid;
+  std::vector<double> samples;
   for (int y = g / 2; y < h; y += g) {
     for (int x = g / 2; x < w; x += g) {
       if (ignore.at<uchar>(y, x)) continue;
-      rows.push_back(terms(x, y));
-      values.push_back(small.at<uchar>(y, x));
+      const double u = u_of(x), v = v_of(y);
+      grid.push_back((Eigen::Matrix<double, 1, 6>() << 1.0, u, v, u * u, u * v, v * v).finished());
+      samples.push_back(small.at<uchar>(y, x));
     }
   }
-  if (rows.size() < 50) return {};
+  if (grid.size() < 50) return {};
+  const Eigen::Index count = static_cast<Eigen::Index>(grid.size());
+  Eigen::Matrix<double, Eigen::Dynamic, 6> rows(count, 6);
+  for (Eigen::Index i = 0; i < count; ++i) rows.row(i) = grid[i];
+  const Eigen::Map<const Eigen::VectorXd> values(samples.data(), count);
   // Trimmed least squares from a starting set of inliers: fit, then keep samples within 2.5σ.
-  const auto robust_fit = [&](std::vector<char> inlier, Eigen::Matrix<double, 6, 1>* coef) {
+  const auto robust_fit = [&](Eigen::VectorXd inlier, Eigen::Matrix<double, 6, 1>* coef) {
     double sigma = 0.5;
+    std::vector<double> abs_in;
     for (int iter = 0; iter < 8; ++iter) {
-      Eigen::Matrix<double, 6, 6> n = Eigen::Matrix<double, 6, 6>::Zero();
-      Eigen::Matrix<double, 6, 1> r = Eigen::Matrix<double, 6, 1>::Zero();
-      for (size_t i = 0; i < rows.size(); ++i) {
-        if (!inlier[i]) continue;
-        n += rows[i] * rows[i].transpose();
-        r += rows[i] * values[i];
-      }
+      const Eigen::Matrix<double, 6, 6> n = rows.transpose() * inlier.asDiagonal() * rows;
+      const Eigen::Matrix<double, 6, 1> r = rows.transpose() * inlier.cwiseProduct(values);
       *coef = n.ldlt().solve(r);
-      std::vector<double> abs_in;
-      for (size_t i = 0; i < rows.size(); ++i)
-        if (inlier[i]) abs_in.push_back(std::abs(values[i] - coef->dot(rows[i])));
+      const Eigen::VectorXd res = (values - rows * *coef).cwiseAbs();
+      abs_in.clear();
+      for (Eigen::Index i = 0; i < count; ++i)
+        if (inlier(i) > 0.0) abs_in.push_back(res(i));
       sigma = std::max(0.5, 1.4826 * Median(abs_in));
-      for (size_t i = 0; i < rows.size(); ++i)
-        inlier[i] = std::abs(values[i] - coef->dot(rows[i])) <= 2.5 * sigma;
+      inlier = (res.array() <= 2.5 * sigma).cast<double>();
     }
     return sigma;
   };
@@ -143,7 +140,7 @@ std::vector<Block> FindBlocks(const cv::Mat& small, const cv::Mat& ignore, doubl
   // more, and its trimming then keeps both; the second can stay on a patch of a background whose
   // light falls off strongly. The fit that explains more samples within a tight band wins.
   std::vector<double> hist(256, 0.0);
-  for (double v : values) {
+  for (double v : samples) {
     for (int k = -4; k <= 4; ++k) {
       const int b = static_cast<int>(v) + k;
       if (b >= 0 && b < 256) hist[b] += 1.0;
@@ -151,22 +148,15 @@ std::vector<Block> FindBlocks(const cv::Mat& small, const cv::Mat& ignore, doubl
   }
   const double mode =
       static_cast<double>(std::max_element(hist.begin(), hist.end()) - hist.begin());
-  std::vector<char> near_mode(rows.size());
-  size_t count_near = 0;
-  for (size_t i = 0; i < rows.size(); ++i) {
-    near_mode[i] = std::abs(values[i] - mode) <= 20.0;
-    count_near += near_mode[i];
-  }
+  const Eigen::VectorXd near_mode = ((values.array() - mode).abs() <= 20.0).cast<double>();
+  const double count_near = near_mode.sum();
   Eigen::Matrix<double, 6, 1> coef, coef_mode;
-  double sigma = robust_fit(std::vector<char>(rows.size(), 1), &coef);
+  double sigma = robust_fit(Eigen::VectorXd::Ones(count), &coef);
   if (count_near >= 50) {
     const double sigma_mode = robust_fit(near_mode, &coef_mode);
     const double band = std::max(3.0 * std::min(sigma, sigma_mode), 3.0);
-    size_t explained = 0, explained_mode = 0;
-    for (size_t i = 0; i < rows.size(); ++i) {
-      explained += std::abs(values[i] - coef.dot(rows[i])) <= band;
-      explained_mode += std::abs(values[i] - coef_mode.dot(rows[i])) <= band;
-    }
+    const Eigen::Index explained = ((values - rows * coef).array().abs() <= band).count();
+    const Eigen::Index explained_mode = ((values - rows * coef_mode).array().abs() <= band).count();
     if (explained_mode > explained) {
       coef = coef_mode;
       sigma = sigma_mode;
@@ -175,11 +165,20 @@ std::vector<Block> FindBlocks(const cv::Mat& small, const cv::Mat& ignore, doubl
   const double thr = std::max(5.0 * sigma, 3.0);
   cv::Mat pos(small.size(), CV_8U, cv::Scalar(0)), neg(small.size(), CV_8U, cv::Scalar(0));
   for (int y = 0; y < h; ++y) {
+    // The model along a row: a + b·u + c·u².
+    const double v = v_of(y);
+    const double a = coef(0) + coef(2) * v + coef(5) * v * v, b = coef(1) + coef(4) * v,
+                 c = coef(3);
+    const uchar* in = small.ptr<uchar>(y);
+    const uchar* skip = ignore.ptr<uchar>(y);
+    uchar* p = pos.ptr<uchar>(y);
+    uchar* q = neg.ptr<uchar>(y);
     for (int x = 0; x < w; ++x) {
-      if (ignore.at<uchar>(y, x)) continue;
-      const double r = small.at<uchar>(y, x) - coef.dot(terms(x, y));
-      if (r > thr) pos.at<uchar>(y, x) = 255;
-      if (r < -thr) neg.at<uchar>(y, x) = 255;
+      if (skip[x]) continue;
+      const double u = u_of(x);
+      const double r = in[x] - (a + (b + c * u) * u);
+      if (r > thr) p[x] = 255;
+      if (r < -thr) q[x] = 255;
     }
   }
   const int d = std::max(3, 2 * static_cast<int>(std::ceil(min_thickness)) + 1);
@@ -188,8 +187,8 @@ std::vector<Block> FindBlocks(const cv::Mat& small, const cv::Mat& ignore, doubl
   for (int sign : {+1, -1}) {
     cv::Mat m = sign > 0 ? pos : neg;
     cv::morphologyEx(m, m, cv::MORPH_OPEN, disk);
-    cv::Mat labels, stats, centroids;
-    const int count = cv::connectedComponentsWithStats(m, labels, stats, centroids, 8, CV_32S);
+    cv::Mat labels, stats;
+    const int count = extract_internal::ConnectedComponents(m, &labels, &stats);
     for (int l = 1; l < count; ++l) {
       if (stats.at<int>(l, cv::CC_STAT_AREA) < 0.01 * w * h) continue;
       // Fixtures reach into the photo from outside; a region wholly inside it is part of the

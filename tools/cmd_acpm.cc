@@ -15,6 +15,7 @@
 #include "textile/sim/acpm.h"
 #include "textile/sim/error.h"
 #include "textile/sim/material.h"
+#include "textile/sim/mesh_io.h"
 #include "textile/sim/seam.h"
 #include "textile/sim/units.h"
 
@@ -22,7 +23,7 @@ namespace textile::cli {
 namespace {
 
 struct AcpmArgs {
-  std::string material, seam, seam_dir, model = "auto", out, png;
+  std::string material, seam, seam_dir, model = "auto", out, png, obj;
   std::optional<double> seam_at_mm;
   double width_mm = 200, length_mm = 300, margin_mm = 5, barrier_deg = 41.5;
   double speed_cm_per_min = 12, crossing_tol_mm = 0.05;
@@ -159,6 +160,8 @@ void Run(const AcpmArgs& a) {
   AtomicFile result_file(a.out);
   std::optional<AtomicFile> png_file;
   if (!a.png.empty()) png_file.emplace(a.png);
+  std::optional<AtomicFile> obj_file;
+  if (!a.obj.empty()) obj_file.emplace(a.obj);
 
   const auto start = std::chrono::steady_clock::now();
   AcpmResult r;
@@ -175,10 +178,12 @@ void Run(const AcpmArgs& a) {
   j["compute_ms"] = ms;
   WriteFileAtomically(a.out, j.dump(2) + "\n");
   if (png_file) Plot(r, o, m, a.png);
+  if (obj_file) WriteFileAtomically(a.obj, ObjText(r.shape));
 
   if (a.json) {
     j["output"] = a.out;
     if (!a.png.empty()) j["png"] = a.png;
+    if (!a.obj.empty()) j["obj"] = a.obj;
     PrintJson(j);
     return;
   }
@@ -214,7 +219,8 @@ void Run(const AcpmArgs& a) {
             << Num(units::SiRigidityToMicroNm(r.plain_rigidity)) << " µN·m\n"
             << "device time " << Num(r.device_time, 4) << " s; computed in " << Num(ms, 3)
             << " ms (" << r.solves << " solves)\n"
-            << "wrote " << a.out << (a.png.empty() ? "" : " and " + a.png) << "\n";
+            << "wrote " << a.out << (a.png.empty() ? "" : ", " + a.png)
+            << (a.obj.empty() ? "" : ", " + a.obj) << "\n";
 }
 
 }  // namespace
@@ -239,6 +245,9 @@ void RegisterAcpm(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "elastica", "shell"}));
   sub->add_option("-o,--out", a->out, "Result JSON to write (cli.md's ACPM result)")->required();
   sub->add_option("--png", a->png, "Write the front across the width and the side profile to a PNG");
+  sub->add_option("--obj", a->obj,
+                  "Write the sample at the middle ray's crossing as an OBJ mesh [m] (the shell's "
+                  "mesh, or the elastica's profile swept across the width)");
   sub->add_option("--width-mm", a->width_mm, "Sample width [mm], at most 200 (default 200)");
   sub->add_option("--length-mm", a->length_mm, "Sample length, the longest overhang [mm] (default 300)");
   sub->add_option("--rays", a->rays, "Number of rays across the width (default 17)");

@@ -19,6 +19,29 @@
 namespace textile {
 namespace {
 
+// The side profile (x_i, y_i) swept across the width w [m]: a ruled strip mesh with the
+// profile's points along the push and 10 cells across (x along the push, y across, z up).
+TriangleMesh SweptProfile(const std::vector<double>& px, const std::vector<double>& py, double w) {
+  constexpr int kAcross = 10;
+  TriangleMesh mesh;
+  const int n = static_cast<int>(px.size());
+  if (n < 2) return mesh;
+  mesh.vertices.resize(static_cast<long>(n) * (kAcross + 1), 3);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j <= kAcross; ++j)
+      mesh.vertices.row(i * (kAcross + 1) + j) << px[i], w * j / kAcross, py[i];
+  mesh.triangles.resize(2L * (n - 1) * kAcross, 3);
+  int f = 0;
+  for (int i = 0; i + 1 < n; ++i) {
+    for (int j = 0; j < kAcross; ++j) {
+      const int a = i * (kAcross + 1) + j, b = a + kAcross + 1;
+      mesh.triangles.row(f++) << a, b, b + 1;
+      mesh.triangles.row(f++) << a, b + 1, a + 1;
+    }
+  }
+  return mesh;
+}
+
 constexpr double kDegree = std::numbers::pi / 180.0;
 constexpr double kMaxWidth = 0.2;  // the ACPM200 takes samples up to 20 cm wide (section 4.1)
 
@@ -96,6 +119,7 @@ AcpmCrossings ElasticaModel(const Material& material, const AcpmOptions& o,
   if (!p.converged) throw ComputeError("elastica side profile at the crossing: " + p.message);
   out.profile_x = p.x;
   out.profile_y = p.y;
+  out.shape = SweptProfile(p.x, p.y, o.width);
   return out;
 }
 
@@ -324,6 +348,7 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
   result.profile_y = crossings.profile_y;
   result.solves = crossings.solves;
   result.notes = crossings.notes;
+  result.shape = std::move(crossings.shape);
   return result;
 }
 

@@ -36,6 +36,11 @@ const ClothOptions& Checked(const ClothOptions& options) {
 
 bool ClothOptions::Check(std::string* why) const {
   if (!bending.Check(why)) return false;
+  if (discretization != BendingDiscretization::kHinge &&
+      discretization != BendingDiscretization::kTensor) {
+    *why = "bending discretization is neither hinge nor tensor";
+    return false;
+  }
   if (!contact.Check(why)) return false;
   if (!gravity.allFinite()) {
     *why = "gravity must be finite";
@@ -65,7 +70,24 @@ ClothProblem::ClothProblem(const TriangleMesh& rest, const Material& material,
   const double g_scale = g > 0.0 ? g : 9.80665;
   penalty_ = masses_ * (g_scale / options_.contact.sink_under_own_weight);
   tangential_stiffness_ = options_.contact.tangential_ratio * material.stretch_stiffness;
+  if (options_.discretization == BendingDiscretization::kTensor) {
+    tensor_.emplace(rest_, hinges_, material.EffectiveLaw().Scaled(options_.bending_scale),
+                    WeftLaw(material, options_.bending_scale), Multipliers(rest_, hinges_, seams));
+  }
   BuildPattern();
+}
+
+int ClothProblem::num_bending_elements() const {
+  return tensor_ ? tensor_->num_elements() : bending_.num_hinges();
+}
+
+void ClothProblem::BendingTriplets(const Vertices& x, HessianProjection projection, int first,
+                                   int end) {
+  if (tensor_) {
+    tensor_->AddHessianTriplets(x, &triplets_, projection, first, end);
+  } else {
+    bending_.AddHessianTriplets(x, &triplets_, projection, first, end);
+  }
 }
 
 // Elements are assembled in chunks of this many triangles or hinges, so the triplet buffer stays
@@ -85,6 +107,11 @@ void ClothProblem::BuildPattern() {
   for (const Hinge& h : hinges_)
     for (int a = 0; a < 4; ++a)
       for (int b = 0; b < 4; ++b) pairs.emplace_back(h.v[a], h.v[b], 1.0);
+  if (tensor_) {  // a triangle's element couples its three wings too
+    for (int t = 0; t < tensor_->num_triangles(); ++t)
+      for (int a : tensor_->patch(t))
+        for (int b : tensor_->patch(t)) pairs.emplace_back(a, b, 1.0);
+  }
   for (int i = 0; i < nv; ++i) pairs.emplace_back(i, i, 1.0);
   Eigen::SparseMatrix<double> vertex_pattern(nv, nv);
   vertex_pattern.setFromTriplets(pairs.begin(), pairs.end());
@@ -118,10 +145,9 @@ void ClothProblem::BuildPattern() {
     membrane_.AddHessianTriplets(x, &triplets_, false, f, std::min(f + kAssemblyChunk, rest_.num_triangles()));
     for (const auto& t : triplets_) triplet_slot_.push_back(slot(t.row(), t.col()));
   }
-  for (int h = 0; h < bending_.num_hinges(); h += kAssemblyChunk) {
+  for (int h = 0; h < num_bending_elements(); h += kAssemblyChunk) {
     triplets_.clear();
-    bending_.AddHessianTriplets(x, &triplets_, HessianProjection::kNone, h,
-                                std::min(h + kAssemblyChunk, bending_.num_hinges()));
+    BendingTriplets(x, HessianProjection::kNone, h, std::min(h + kAssemblyChunk, num_bending_elements()));
     for (const auto& t : triplets_) triplet_slot_.push_back(slot(t.row(), t.col()));
   }
   triplets_ = {};
@@ -226,7 +252,7 @@ double ClothProblem::ContactEnergyGradient(const Vertices& x, Vertices* grad) co
 }
 
 double ClothProblem::Energy(const Vertices& x) const {
-  double e = membrane_.Energy(x) + bending_.Energy(x);
+  double e = membrane_.Energy(x) + (tensor_ ? tensor_->Energy(x) : bending_.Energy(x));
   for (int i = 0; i < num_vertices(); ++i) e -= masses_(i) * options_.gravity.dot(x.row(i));
   return e + ContactEnergyGradient(x, nullptr);
 }
@@ -234,7 +260,8 @@ double ClothProblem::Energy(const Vertices& x) const {
 double ClothProblem::EnergyGradient(const Vertices& x, Vertices* grad) const {
   grad->setZero(x.rows(), 3);
   membrane_.AddGradient(x, *grad);
-  double e = membrane_.Energy(x) + bending_.EnergyGradient(x, *grad);
+  double e = membrane_.Energy(x) +
+             (tensor_ ? tensor_->EnergyGradient(x, *grad) : bending_.EnergyGradient(x, *grad));
   for (int i = 0; i < num_vertices(); ++i) {
     e -= masses_(i) * options_.gravity.dot(x.row(i));
     grad->row(i) -= masses_(i) * options_.gravity.transpose();
@@ -259,10 +286,9 @@ const Eigen::SparseMatrix<double>& ClothProblem::Hessian(const Vertices& x,
                                  std::min(f + kAssemblyChunk, rest_.num_triangles()));
     scatter();
   }
-  for (int h = 0; h < bending_.num_hinges(); h += kAssemblyChunk) {
+  for (int h = 0; h < num_bending_elements(); h += kAssemblyChunk) {
     triplets_.clear();
-    bending_.AddHessianTriplets(x, &triplets_, projection, h,
-                                std::min(h + kAssemblyChunk, bending_.num_hinges()));
+    BendingTriplets(x, projection, h, std::min(h + kAssemblyChunk, num_bending_elements()));
     scatter();
   }
   assert(next == triplet_slot_.size());

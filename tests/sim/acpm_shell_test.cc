@@ -17,35 +17,66 @@ Material Fabric(double b1, double b2, double c1, double gsm) {
   return m;
 }
 
-TEST(AcpmShell, PlainSampleIsCutEvenlyAndConvergesUnderRefinement) {
-  // The paper's Fig. 8 fabric. Every ray of a plain sample is cut at the same overhang, and the
-  // crossing converges as the elements shrink. It does NOT converge to the exact elastica's:
-  // the hinge energies couple bending with twist on these grids and a free strip is about
-  // twice as soft (docs/statics.md, "Bending-twist coupling"); the factor of a seamed sample is
-  // therefore taken against the shell's own plain crossing at the same resolution.
+TEST(AcpmShell, PlainSampleConvergesToTheElasticaAtFirstOrder) {
+  // The paper's Fig. 8 fabric, one push per resolution (no extrapolation): the crossing error
+  // halves with the element (first order, from the clamped and free ends) and every ray is cut
+  // at nearly the same overhang (the uniform diagonals tilt the front by O(e)).
   const Material m = Fabric(0.1, 0.0892, -0.0092, 200);
+  const BarrierCrossing exact = FindBarrierCrossing(m.EffectiveLaw(), m.areal_density);
+  ASSERT_TRUE(exact.converged);
   AcpmOptions options;
   options.num_rays = 3;
   const std::vector<double> rays = options.RayPositions();
-  std::vector<double> crossing;
+  std::vector<double> error;
   for (double element : {0.004, 0.002, 0.001}) {
     ShellAcpmSettings settings;
     settings.element_length = element;
+    settings.extrapolate = false;
     const AcpmCrossings shell = ShellAcpmCrossings(m, options, rays, settings);
     ASSERT_TRUE(shell.converged) << shell.message;
-    // Alternating diagonals keep the mesh mirror-symmetric: the outer rays agree.
-    EXPECT_NEAR(shell.overhang.front(), shell.overhang.back(), 1e-9);
+    EXPECT_NEAR(shell.overhang.front(), shell.overhang.back(), 4.0 * element * 0.1);
     EXPECT_FALSE(shell.profile_x.empty());
+    EXPECT_GT(shell.shape.num_triangles(), 0);
     EXPECT_GT(shell.solves, 3);
-    crossing.push_back(shell.overhang[1]);
+    error.push_back(shell.overhang[1] / exact.overhang - 1.0);
   }
-  // Differences shrink with each halving (first-order convergence or better).
-  EXPECT_LT(std::abs(crossing[2] - crossing[1]), std::abs(crossing[1] - crossing[0]));
+  // Measured: -8.1 %, -4.4 %, -2.2 %. The ratio of successive errors is that of the elements.
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_LT(error[k], 0.0);
+    EXPECT_NEAR(error[k] / error[k + 1], 2.0, 0.25) << k;
+  }
+}
+
+TEST(AcpmShell, ExtrapolatedPlainSampleAgreesWithTheElastica) {
+  // The default: 2 mm and 1 mm elements, 2 L(1 mm) - L(2 mm). Issue 7's tolerance is 0.5 %;
+  // measured -0.06 % (Fig. 8) — the bound leaves room for the other fabrics' curvature.
+  for (const Material& m : {Fabric(0.1, 0.0892, -0.0092, 200), Fabric(0.5168, 1.8856, 2.2683, 150)}) {
+    const BarrierCrossing exact = FindBarrierCrossing(m.EffectiveLaw(), m.areal_density);
+    ASSERT_TRUE(exact.converged);
+    AcpmOptions options;
+    options.num_rays = 3;
+    const AcpmCrossings shell = ShellAcpmCrossings(m, options, options.RayPositions());
+    ASSERT_TRUE(shell.converged) << shell.message;
+    for (double l : shell.overhang) EXPECT_NEAR(l / exact.overhang, 1.0, 0.005);
+  }
+}
+
+TEST(AcpmShell, HingeBendingIsTooSoftForAFreeStrip) {
+  // The paper's hinge energies couple bend with twist on a triangle grid (docs/statics.md):
+  // the plain strip crosses 20-25 % short of the elastica at any resolution. Kept as a check
+  // that the tensor model is what fixed it.
+  const Material m = Fabric(0.1, 0.0892, -0.0092, 200);
   const BarrierCrossing exact = FindBarrierCrossing(m.EffectiveLaw(), m.areal_density);
-  ASSERT_TRUE(exact.converged);
-  // The documented bias: 20-25 % short. If the elements are ever fixed this fails on purpose.
-  EXPECT_GT(crossing[2] / exact.overhang, 0.7);
-  EXPECT_LT(crossing[2] / exact.overhang, 0.85);
+  AcpmOptions options;
+  options.num_rays = 3;
+  ShellAcpmSettings settings;
+  settings.bending = BendingDiscretization::kHinge;
+  settings.extrapolate = false;
+  const AcpmCrossings shell = ShellAcpmCrossings(m, options, options.RayPositions(), settings);
+  ASSERT_TRUE(shell.converged) << shell.message;
+  EXPECT_NEAR(shell.overhang.front(), shell.overhang.back(), 1e-9);  // alternating diagonals
+  EXPECT_GT(shell.overhang[1] / exact.overhang, 0.7);
+  EXPECT_LT(shell.overhang[1] / exact.overhang, 0.85);
 }
 
 TEST(AcpmShell, SeamAlongThePushStiffensTheRaysNearItSymmetrically) {
@@ -65,8 +96,10 @@ TEST(AcpmShell, SeamAlongThePushStiffensTheRaysNearItSymmetrically) {
   // couples the width: the front is nearly flat over the middle, docs/acpm.md.)
   EXPECT_GT(shell.overhang[2], shell.overhang[0]);
   EXPECT_GT(shell.overhang[1], shell.overhang[0]);
-  EXPECT_NEAR(shell.overhang[0], shell.overhang[4], 2e-4);
-  EXPECT_NEAR(shell.overhang[1], shell.overhang[3], 2e-4);
+  // Mirror rays agree to 0.5 % of L: the uniform diagonals tilt the front at first order in
+  // the element, the extrapolation (4 and 2 mm here) leaves ~0.4 %.
+  EXPECT_NEAR(shell.overhang[0], shell.overhang[4], 0.005 * shell.overhang[0]);
+  EXPECT_NEAR(shell.overhang[1], shell.overhang[3], 0.005 * shell.overhang[0]);
   EXPECT_GT(shell.overhang[2], shell.plain_overhang);
 }
 

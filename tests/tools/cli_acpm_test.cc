@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -64,6 +66,38 @@ TEST(CliAcpm, FittedSeamFileIsAccepted) {
                          (dir / "r.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("seam: B-twill (3 layers) across"), std::string::npos) << r.out;
+}
+
+TEST(CliAcpm, ObjIsTheSampleAtTheCrossing) {
+  // The elastica's profile swept across the 200 mm width: x from the edge to the front, y over
+  // the width, z down to the tip (Fig. 8: L = 33.59 mm).
+  const auto dir = Scratch("CliAcpm.Obj");
+  const auto r = Textile("acpm " + kFig8 + " -o " + (dir / "r.json").string() + " --obj " +
+                         (dir / "sample.obj").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("sample.obj"), std::string::npos) << r.out;
+  std::ifstream obj(dir / "sample.obj");
+  double min_z = 0.0, max_x = 0.0, max_y = 0.0;
+  int vertices = 0, faces = 0;
+  for (std::string line; std::getline(obj, line);) {
+    if (line.rfind("v ", 0) == 0) {
+      double x, y, z;
+      ASSERT_EQ(std::sscanf(line.c_str(), "v %lf %lf %lf", &x, &y, &z), 3) << line;
+      max_x = std::max(max_x, x);
+      max_y = std::max(max_y, y);
+      min_z = std::min(min_z, z);
+      ++vertices;
+    } else if (line.rfind("f ", 0) == 0) {
+      ++faces;
+    }
+  }
+  EXPECT_EQ(vertices, 201 * 11);
+  EXPECT_EQ(faces, 2 * 200 * 10);
+  EXPECT_NEAR(max_y, 0.2, 1e-12);
+  EXPECT_GT(max_x, 0.01);
+  EXPECT_LT(max_x, 0.0336);
+  // The front is on the 41.5° barrier line through the edge: tip depth = tan(41.5°) x_tip.
+  EXPECT_LT(min_z, -0.02);
 }
 
 TEST(CliAcpm, SeamAlongRunsOnTheShellModel) {

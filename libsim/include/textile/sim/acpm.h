@@ -35,6 +35,7 @@
 
 #include "textile/sim/cantilever_outputs.h"
 #include "textile/sim/material.h"
+#include "textile/sim/mesh.h"
 #include "textile/sim/seam.h"
 
 namespace textile {
@@ -78,6 +79,10 @@ struct AcpmCrossings {
   double plain_overhang = std::numeric_limits<double>::quiet_NaN();
   int solves = 0;                 // static solves (elastica solves, or shell push steps)
   std::string notes;              // anything the model wants in the result
+  // The sample's overhanging part at the profile ray's crossing [m] (x along the push from the
+  // edge, y across the width, z up): the shell's solved mesh, or the elastica's profile swept
+  // across the width.
+  TriangleMesh shape;
 };
 
 // The plug-in point of the shell model (issue 6): given the material, the scene (options:
@@ -136,6 +141,7 @@ struct AcpmResult {
   std::vector<double> profile_x, profile_y;  // side profile at that crossing [m]
   int solves = 0;
   std::string notes;
+  TriangleMesh shape;  // the sample at that crossing (AcpmCrossings::shape), for --obj
 
   // One line: model, crossing range, factor range, device time.
   std::string BriefReport() const;

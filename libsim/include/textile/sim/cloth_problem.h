@@ -29,6 +29,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,12 +39,16 @@
 #include "textile/sim/membrane.h"
 #include "textile/sim/mesh.h"
 #include "textile/sim/seam.h"
+#include "textile/sim/tensor_bending.h"
 
 namespace textile {
 
 struct ClothOptions {
   MembraneModel membrane = MembraneModel::kStVK;  // stabilised StVK (Sensitive Couture)
   BendingOptions bending;                         // Pabst's law by default
+  // Hinge energies (bending.model) or Pabst's law on a curvature tensor per triangle
+  // (tensor_bending.h: bend and twist separate, the stiffness of a free strip right).
+  BendingDiscretization discretization = BendingDiscretization::kHinge;
   Eigen::Vector3d gravity{0.0, 0.0, -9.80665};    // [m/s²]
   ContactOptions contact;                         // used when supports are added
   // Multiplies the material's bending law (the 100× plate of the stability benchmark); > 0.
@@ -108,6 +113,8 @@ class ClothProblem {
   const std::vector<char>& is_fixed() const { return is_fixed_; }
   const MembraneElements& membrane() const { return membrane_; }
   const BendingElements& bending() const { return bending_; }
+  // The curvature-tensor bending when options().discretization is kTensor, else null.
+  const TensorBending* tensor_bending() const { return tensor_ ? &*tensor_ : nullptr; }
   const ClothOptions& options() const { return options_; }
   int num_vertices() const { return rest_.num_vertices(); }
   double total_mass() const { return masses_.sum(); }
@@ -128,6 +135,9 @@ class ClothProblem {
   int Touching(const Eigen::Vector3d& p, double limit, double* phi, Eigen::Vector3d* normal) const;
   double ContactEnergyGradient(const Vertices& x, Vertices* grad) const;
   void BuildPattern();
+  // Bending Hessian elements [first, end) of the active discretisation into triplets_.
+  int num_bending_elements() const;
+  void BendingTriplets(const Vertices& x, HessianProjection projection, int first, int end);
 
   TriangleMesh rest_;
   ClothOptions options_;
@@ -135,6 +145,7 @@ class ClothProblem {
   MembraneElements membrane_;
   std::vector<Hinge> hinges_;
   BendingElements bending_;
+  std::optional<TensorBending> tensor_;
   std::vector<Support> supports_;
   std::vector<int> fixed_;
   std::vector<char> is_fixed_;

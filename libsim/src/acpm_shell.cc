@@ -40,13 +40,18 @@ TriangleMesh TensorGrid(const std::vector<double>& xs, const std::vector<double>
   return mesh;
 }
 
+// Cells along the push over the reference overhang (at least 8).
+int CellsAlong(double reference_overhang, double element_length) {
+  return std::max(8, static_cast<int>(std::ceil(reference_overhang / element_length)));
+}
+
 // One push: the sample at a given overhang, its grid and its solver state.
 class PushedSample {
  public:
   PushedSample(const Material& material, const AcpmOptions& options, const AcpmSeam& seam,
                const ShellAcpmSettings& settings, double reference_overhang)
       : material_(material), options_(options), seam_(seam), settings_(settings) {
-    nx_ = std::max(8, static_cast<int>(std::ceil(reference_overhang / settings.element_length)));
+    nx_ = CellsAlong(reference_overhang, settings.element_length);
     platform_ = reference_overhang / nx_;
     // Across the width: uniform, with the seam along the push direction on a grid line.
     const bool along = seam.direction == AcpmSeamDirection::kAlong;
@@ -320,8 +325,10 @@ AcpmCrossings ShellAcpmCrossings(const Material& material, const AcpmOptions& op
   auto run = [&](const AcpmSeam& seam, const std::vector<double>& rays, AcpmCrossings* coarse) {
     *coarse = Push(material, options, seam, rays, settings, reference);
     if (!settings.extrapolate || !coarse->converged) return *coarse;
+    // Exactly twice the cells (the extrapolation assumes the element halved).
     ShellAcpmSettings half = settings;
-    half.element_length = 0.5 * settings.element_length;
+    half.element_length =
+        reference / (2.0 * CellsAlong(reference, settings.element_length)) * (1.0 + 1e-9);
     AcpmCrossings fine = Push(material, options, seam, rays, half, reference);
     if (!fine.converged) return fine;
     for (size_t r = 0; r < rays.size(); ++r)

@@ -27,7 +27,7 @@ namespace textile {
 
 struct ShellAcpmSettings {
   // Element length along the push direction [m]; the grid has ⌈L_ref / this⌉ cells over the
-  // overhang, L_ref the plain elastica's crossing.
+  // overhang (at least 8), L_ref the plain elastica's crossing.
   double element_length = 0.002;
   // Cells across the width: plain samples and seams across (nothing varies across the width
   // but the mesh must still be a shell) and seams along (the seam's stiffness profile S(d)

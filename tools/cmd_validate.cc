@@ -1,11 +1,13 @@
 // textile validate: photos or profiles -> direct fit -> the same cantilevers simulated with the
-// fitted law at the photographed overhangs -> measured vs simulated (cantilever.md, "Closing the
-// loop"): RMS and maximum deviation, tip difference, a verdict against a stated tolerance, a
-// report JSON and a picture with both curves.
+// fitted law at the photographed overhangs, by the elastica and by the shell model -> measured vs
+// simulated (cantilever.md, "Closing the loop"): RMS and maximum deviation, tip difference, a
+// verdict against a stated tolerance, a report JSON and a picture with all curves.
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 
 #include "common/atomic_file.h"
 #include "common/chart.h"
@@ -13,6 +15,7 @@
 #include "common/profile_inputs.h"
 #include "textile/fit/direct_fit.h"
 #include "textile/fit/profile_compare.h"
+#include "textile/sim/acpm_shell.h"
 #include "textile/sim/cantilever_outputs.h"
 #include "textile/sim/error.h"
 #include "textile/sim/material.h"
@@ -26,6 +29,8 @@ struct ValidateArgs {
   double gsm = 0.0;
   std::string out_dir;
   double tolerance_mm = 0.5;
+  double width_mm = 25.0;
+  std::string model = "both";
   bool strict = false, json = false;
   PhotoFlags photo;
 };
@@ -34,43 +39,98 @@ struct ValidateArgs {
 // single point or the tip may stray up to 3× that (a frayed fibre, a speck) before it fails.
 constexpr double kMaxOverRms = 3.0;
 
+// One model's simulation of one profile.
+struct ModelCheck {
+  bool run = false;
+  ProfileComparison c;
+  bool pass = false;
+  std::string why;
+  int solves = 0;
+  std::string notes;
+};
+
 struct Check {
   std::string source;
   bool from_photo = false;
   double data_length = 0.0, overhang = 0.0;  // [m]
-  ProfileComparison c;
+  ModelCheck elastica, shell;
+  double model_gap = std::numeric_limits<double>::quiet_NaN();  // shell vs elastica, max [m]
   bool pass = false;
   std::string why;
 };
 
+// Grades one comparison against the tolerance tol [m]; the failed criteria in k->why.
+void Grade(double tol, double tol_mm, ModelCheck* k) {
+  const ProfileComparison& c = k->c;
+  const double tip = std::hypot(c.tip_dx, c.tip_dy);
+  std::vector<std::string> fails;
+  if (c.rms > tol) fails.push_back("rms " + Num(units::MToMm(c.rms), 3) + " mm > " + Num(tol_mm));
+  if (c.max > kMaxOverRms * tol)
+    fails.push_back("max " + Num(units::MToMm(c.max), 3) + " mm > " + Num(kMaxOverRms * tol_mm));
+  if (tip > kMaxOverRms * tol)
+    fails.push_back("tip " + Num(units::MToMm(tip), 3) + " mm > " + Num(kMaxOverRms * tol_mm));
+  k->pass = fails.empty();
+  k->why.clear();
+  for (size_t f = 0; f < fails.size(); ++f) k->why += (f ? ", " : "") + fails[f];
+}
+
+nlohmann::json ModelJson(const ModelCheck& k) {
+  if (!k.run) return nullptr;
+  const ProfileComparison& c = k.c;
+  return {{"rms_mm", units::MToMm(c.rms)},
+          {"max_mm", units::MToMm(c.max)},
+          {"tip_dx_mm", units::MToMm(c.tip_dx)},
+          {"tip_dy_mm", units::MToMm(c.tip_dy)},
+          {"tip_mm", units::MToMm(std::hypot(c.tip_dx, c.tip_dy))},
+          {"clamp_curvature_per_cm", std::isfinite(c.clamp_curvature)
+                                         ? nlohmann::json(units::SiCurvatureToKes(c.clamp_curvature))
+                                         : nlohmann::json()},
+          {"solves", k.solves},
+          {"pass", k.pass},
+          {"why", k.why}};
+}
+
 void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles,
           const BendingLaw& law, double tol_mm, bool pass, const std::string& path) {
   namespace chart = textile::chart;
-  chart::Panel p{.title = "Measured (dots) and simulated (lines) cantilevers",
-                 .x_label = "x [mm]", .y_label = "y [mm]", .equal_aspect = true};
+  chart::Panel p{.title = "Measured (dots) and simulated cantilevers: elastica (solid), shell (dashed)",
+                 .x_label = "x [mm]", .y_label = "y [mm]", .equal_aspect = true,
+                 .legend_corner = chart::Corner::kTopRight, .notes_corner = chart::Corner::kBottomLeft};
   std::vector<chart::Series> lines;
+  const auto curve = [](const ProfileComparison& c, const std::string& label, bool dashed,
+                        chart::Rgb color) {
+    chart::Series sim{.label = label, .color = color, .line_width = 1.2, .dashed = dashed};
+    for (size_t j = 0; j < c.model_x.size(); ++j) {
+      sim.x.push_back(units::MToMm(c.model_x[j]));
+      sim.y.push_back(units::MToMm(c.model_y[j]));
+    }
+    return sim;
+  };
   for (size_t i = 0; i < checks.size(); ++i) {
-    const auto color = chart::PaletteColor(static_cast<int>(i));
-    chart::Series data{.label = std::filesystem::path(checks[i].source).filename().string(),
-                       .style = chart::Series::Style::kMarkers, .color = color};
+    const Check& k = checks[i];
+    const std::string name = std::filesystem::path(k.source).filename().string();
+    chart::Series data{.label = name, .style = chart::Series::Style::kMarkers,
+                       .color = chart::PaletteColor(static_cast<int>(i))};
     for (size_t j = 0; j < profiles[i].size(); ++j) {
       data.x.push_back(units::MToMm(profiles[i].x[j]));
       data.y.push_back(units::MToMm(profiles[i].y[j]));
     }
-    chart::Series sim{.label = i == 0 ? "simulated (elastica)" : "",
-                      .color = chart::Rgb{0.1, 0.1, 0.1}, .line_width = 1.2};
-    for (size_t j = 0; j < checks[i].c.model_x.size(); ++j) {
-      sim.x.push_back(units::MToMm(checks[i].c.model_x[j]));
-      sim.y.push_back(units::MToMm(checks[i].c.model_y[j]));
-    }
     p.series.push_back(data);
-    lines.push_back(sim);
-    p.notes.push_back(std::filesystem::path(checks[i].source).filename().string() + ": rms " +
-                      Num(units::MToMm(checks[i].c.rms), 3) + ", max " +
-                      Num(units::MToMm(checks[i].c.max), 3) + " mm " +
-                      (checks[i].pass ? "ok" : "FAIL"));
+    // One short line per profile: rms and max of each model run ("elastica / shell").
+    std::string rms, max;
+    for (const ModelCheck* m : {&k.elastica, &k.shell}) {
+      if (!m->run) continue;
+      rms += (rms.empty() ? "" : " / ") + Num(units::MToMm(m->c.rms), 2);
+      max += (max.empty() ? "" : " / ") + Num(units::MToMm(m->c.max), 2);
+    }
+    if (k.elastica.run) lines.push_back(curve(k.elastica.c, i == 0 ? "elastica" : "", false, {0.1, 0.1, 0.1}));
+    if (k.shell.run) lines.push_back(curve(k.shell.c, i == 0 ? "shell" : "", true, {0.85, 0.1, 0.1}));
+    const std::string note = name.substr(0, name.find('.')) + ": rms " + rms + ", max " + max + " mm";
+    p.notes.push_back(note + (k.pass ? " ok" : " FAIL"));
   }
   for (auto& l : lines) p.series.push_back(std::move(l));
+  if (!checks.empty() && checks[0].elastica.run && checks[0].shell.run)
+    p.notes.push_back("(elastica / shell)");
   p.notes.push_back("law b1 = " + Num(law.b1_kes(), 4) + ", b2 = " + Num(law.b2_kes(), 4) +
                     " gf·cm, c1 = " + Num(law.c1_kes(), 4) + " gf·cm²");
   p.notes.push_back(std::string("verdict: ") + (pass ? "PASS" : "FAIL") + " (rms ≤ " +
@@ -84,6 +144,9 @@ void Run(const ValidateArgs& a) {
     throw InputError("--gsm must be an areal density in [1, 10000] g/m², got " + Num(a.gsm));
   if (!std::isfinite(a.tolerance_mm) || a.tolerance_mm <= 0.0 || a.tolerance_mm > 50.0)
     throw InputError("--tolerance-mm must lie in (0, 50] mm, got " + Num(a.tolerance_mm));
+  if (!std::isfinite(a.width_mm) || a.width_mm <= 0.0 || a.width_mm > 200.0)
+    throw InputError("--width-mm must lie in (0, 200] mm, got " + Num(a.width_mm));
+  const bool run_elastica = a.model != "shell", run_shell = a.model != "elastica";
   const double rho = units::GsmToSi(a.gsm);
   const std::vector<LoadedProfile> loaded = LoadProfileInputs(a.inputs, a.photo.Options());
   EnsureDirectory(a.out_dir);
@@ -99,37 +162,67 @@ void Run(const ValidateArgs& a) {
   const BendingLaw& law = *fit.law;
   // Only a law a material file accepts is worth simulating (as textile fit checks): a fit to a
   // straight or vertical strip can run to constants no fabric has.
+  Material fitted;
+  fitted.name = "validated fit";
+  fitted.areal_density = rho;
+  fitted.bending = law;
   try {
-    Material probe;
-    probe.areal_density = rho;
-    probe.bending = law;
-    ParseMaterialJson(MaterialToJson(probe).dump(), "fitted law");
+    ParseMaterialJson(MaterialToJson(fitted).dump(), "fitted law");
   } catch (const InputError& e) {
     throw ComputeError(std::string("fit gave an implausible law: ") + e.what());
   }
 
   // The same cantilevers simulated: the fitted law at each photo's overhang. The overhang is the
   // fitted L_i (the arc length of noisy data is biased long: 0.1 mm noise on 0.6 mm spacing
-  // lengthens it by ~3 %), and the mid-line offset at the edge is the fitted one.
+  // lengthens it by ~3 %), and the mid-line offset at the edge is the fitted one. The shell is
+  // the 3D engine on a strip --width-mm wide (acpm_shell.h, SolveShellCantilever).
   const double tol = units::MmToM(a.tolerance_mm);
   std::vector<Check> checks;
   bool all_pass = true;
+  std::string shell_notes;
   for (size_t i = 0; i < profiles.size(); ++i) {
     Check k;
     k.source = loaded[i].source;
     k.from_photo = loaded[i].from_photo;
     k.data_length = profiles[i].s.back();
     k.overhang = fit.profiles[i].overhang;
-    k.c = CompareWithElastica(law, rho, profiles[i], k.overhang, fit.offset);
-    const double tip = std::hypot(k.c.tip_dx, k.c.tip_dy);
-    std::vector<std::string> fails;
-    if (k.c.rms > tol) fails.push_back("rms " + Num(units::MToMm(k.c.rms), 3) + " mm > " + Num(a.tolerance_mm));
-    if (k.c.max > kMaxOverRms * tol)
-      fails.push_back("max " + Num(units::MToMm(k.c.max), 3) + " mm > " + Num(kMaxOverRms * a.tolerance_mm));
-    if (tip > kMaxOverRms * tol)
-      fails.push_back("tip " + Num(units::MToMm(tip), 3) + " mm > " + Num(kMaxOverRms * a.tolerance_mm));
-    k.pass = fails.empty();
-    for (size_t f = 0; f < fails.size(); ++f) k.why += (f ? ", " : "") + fails[f];
+    if (run_elastica) {
+      k.elastica.run = true;
+      k.elastica.c = CompareWithElastica(law, rho, profiles[i], k.overhang, fit.offset);
+      Grade(tol, a.tolerance_mm, &k.elastica);
+    }
+    if (run_shell) {
+      const ShellCantilever sc = SolveShellCantilever(fitted, k.overhang, units::MmToM(a.width_mm));
+      if (!sc.converged) throw ComputeError(k.source + ": " + sc.message);
+      k.shell.run = true;
+      k.shell.c = CompareWithCurve(profiles[i], sc.x, sc.y, fit.offset);
+      k.shell.solves = sc.solves;
+      k.shell.notes = sc.notes;
+      shell_notes = sc.notes;
+      Grade(tol, a.tolerance_mm, &k.shell);
+      if (run_elastica) {
+        // How far the shell's curve lies from the elastica's (both lifted by the offset).
+        double gap = 0.0;
+        for (size_t j = 0; j < sc.x.size(); ++j) {
+          double best = std::numeric_limits<double>::infinity();
+          const auto& ex = k.elastica.c.model_x;
+          const auto& ey = k.elastica.c.model_y;
+          for (size_t q = 0; q + 1 < ex.size(); ++q) {
+            const double dx = ex[q + 1] - ex[q], dy = ey[q + 1] - ey[q];
+            const double rx = sc.x[j] - ex[q], ry = sc.y[j] + fit.offset - ey[q];
+            const double t = std::clamp((rx * dx + ry * dy) / (dx * dx + dy * dy), 0.0, 1.0);
+            best = std::min(best, std::hypot(rx - t * dx, ry - t * dy));
+          }
+          gap = std::max(gap, best);
+        }
+        k.model_gap = gap;
+      }
+    }
+    std::vector<std::string> why;
+    for (const auto* m : {&k.elastica, &k.shell})
+      if (m->run && !m->pass) why.push_back((m == &k.elastica ? "elastica: " : "shell: ") + m->why);
+    k.pass = why.empty();
+    for (size_t f = 0; f < why.size(); ++f) k.why += (f ? "; " : "") + why[f];
     all_pass = all_pass && k.pass;
     checks.push_back(k);
   }
@@ -140,12 +233,11 @@ void Run(const ValidateArgs& a) {
                    {"from_photo", k.from_photo},
                    {"data_length_mm", units::MToMm(k.data_length)},
                    {"overhang_mm", units::MToMm(k.overhang)},
-                   {"rms_mm", units::MToMm(k.c.rms)},
-                   {"max_mm", units::MToMm(k.c.max)},
-                   {"tip_dx_mm", units::MToMm(k.c.tip_dx)},
-                   {"tip_dy_mm", units::MToMm(k.c.tip_dy)},
-                   {"tip_mm", units::MToMm(std::hypot(k.c.tip_dx, k.c.tip_dy))},
-                   {"clamp_curvature_per_cm", units::SiCurvatureToKes(k.c.clamp_curvature)},
+                   {"elastica", ModelJson(k.elastica)},
+                   {"shell", ModelJson(k.shell)},
+                   {"shell_vs_elastica_max_mm", std::isfinite(k.model_gap)
+                                                    ? nlohmann::json(units::MToMm(k.model_gap))
+                                                    : nlohmann::json()},
                    {"pass", k.pass},
                    {"why", k.why}});
   }
@@ -159,8 +251,10 @@ void Run(const ValidateArgs& a) {
                {"b2_sd_kes", std::isfinite(fit.b2_sd) ? nlohmann::json(units::SiStiffnessToKes(fit.b2_sd)) : nlohmann::json()},
                {"c1_sd_kes", std::isfinite(fit.c1_sd) ? nlohmann::json(units::SiQuadraticToKes(fit.c1_sd)) : nlohmann::json()},
                {"observability", fit.observability}}},
-      {"models", {{"elastica", "simulated"},
-                  {"shell", "not run: the shell model answers the ACPM200 push only so far; on a plain strip it matches the elastica to 0.06 % (docs/statics.md)"}}},
+      {"models", {{"elastica", run_elastica ? "simulated" : "not run (--model shell)"},
+                  {"shell", run_shell ? "simulated: " + shell_notes + ", strip " +
+                                            Num(a.width_mm) + " mm wide"
+                                      : "not run (--model elastica)"}}},
       {"tolerance", {{"rms_mm", a.tolerance_mm},
                      {"max_mm", kMaxOverRms * a.tolerance_mm},
                      {"tip_mm", kMaxOverRms * a.tolerance_mm}}},
@@ -169,12 +263,8 @@ void Run(const ValidateArgs& a) {
       {"png", png_path},
       {"material", material_path}};
   if (all_pass || !a.strict) {
-    Material m;
-    m.name = "validated fit";
-    m.areal_density = rho;
-    m.bending = law;
-    m.fit = {{"method", "direct"}, {"rms_mm", units::MToMm(fit.rms)}, {"validate", report_path}};
-    WriteFileAtomically(material_path, MaterialToJson(m).dump(2) + "\n");
+    fitted.fit = {{"method", "direct"}, {"rms_mm", units::MToMm(fit.rms)}, {"validate", report_path}};
+    WriteFileAtomically(material_path, MaterialToJson(fitted).dump(2) + "\n");
     Plot(checks, profiles, law, a.tolerance_mm, all_pass, png_path);
     WriteFileAtomically(report_path, report.dump(2) + "\n");
   }
@@ -193,14 +283,22 @@ void Run(const ValidateArgs& a) {
             << " gf·cm, c1 = " << Num(law.c1_kes(), 5) << " gf·cm² (fit rms "
             << Num(units::MToMm(fit.rms), 3) << " mm, offset " << Num(units::MToMm(fit.offset), 3)
             << " mm)\n"
-            << "simulated with the elastica at each fitted overhang (shell model: not run here, it "
-               "answers the ACPM200 push only so far; docs/acpm.md)\n";
+            << "simulated at each fitted overhang with " << (run_elastica ? "the elastica" : "")
+            << (run_elastica && run_shell ? " and " : "")
+            << (run_shell ? "the shell (" + shell_notes + ")" : "") << "\n";
+  const auto line = [](const char* name, const ModelCheck& m) {
+    std::cout << "    " << name << ": rms " << Num(units::MToMm(m.c.rms), 3) << " mm, max "
+              << Num(units::MToMm(m.c.max), 3) << " mm, tip (" << Num(units::MToMm(m.c.tip_dx), 3)
+              << ", " << Num(units::MToMm(m.c.tip_dy), 3) << ") mm  "
+              << (m.pass ? "ok" : "FAIL: " + m.why) << "\n";
+  };
   for (const auto& k : checks) {
-    std::cout << "  " << k.source << ": L = " << Num(units::MToMm(k.overhang), 5)
-              << " mm, rms " << Num(units::MToMm(k.c.rms), 3) << " mm, max "
-              << Num(units::MToMm(k.c.max), 3) << " mm, tip (" << Num(units::MToMm(k.c.tip_dx), 3)
-              << ", " << Num(units::MToMm(k.c.tip_dy), 3) << ") mm  "
-              << (k.pass ? "ok" : "FAIL: " + k.why) << "\n";
+    std::cout << "  " << k.source << ": L = " << Num(units::MToMm(k.overhang), 5) << " mm";
+    if (std::isfinite(k.model_gap))
+      std::cout << ", shell within " << Num(units::MToMm(k.model_gap), 3) << " mm of the elastica";
+    std::cout << "\n";
+    if (k.elastica.run) line("elastica", k.elastica);
+    if (k.shell.run) line("shell   ", k.shell);
   }
   std::cout << "verdict: " << (all_pass ? "PASS" : "FAIL") << " (tolerance: rms ≤ "
             << Num(a.tolerance_mm) << " mm, max and tip ≤ " << Num(kMaxOverRms * a.tolerance_mm)
@@ -225,6 +323,12 @@ void RegisterValidate(CLI::App& app) {
       ->required();
   sub->add_option("--tolerance-mm", a->tolerance_mm,
                   "RMS deviation allowed per profile [mm] (max and tip: 3x); default 0.5");
+  sub->add_option("--model", a->model,
+                  "Models to simulate: both (default), elastica (exact, ms) or shell (the 3D engine, "
+                  "~0.5 s per profile)")
+      ->check(CLI::IsMember({"both", "elastica", "shell"}));
+  sub->add_option("--width-mm", a->width_mm,
+                  "Strip width for the shell model [mm], in (0, 200]; default 25");
   sub->add_flag("--strict", a->strict, "A failed validation is an error (exit 3, nothing written)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   AddPhotoFlags(sub, &a->photo);

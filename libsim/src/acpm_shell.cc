@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -43,6 +44,15 @@ TriangleMesh TensorGrid(const std::vector<double>& xs, const std::vector<double>
 // Cells along the push over the reference overhang (at least 8).
 int CellsAlong(double reference_overhang, double element_length) {
   return std::max(8, static_cast<int>(std::ceil(reference_overhang / element_length)));
+}
+
+// The settings with exactly twice the cells along of `settings` over the reference overhang
+// (the Richardson extrapolation assumes the element halved).
+ShellAcpmSettings HalvedSettings(const ShellAcpmSettings& settings, double reference_overhang) {
+  ShellAcpmSettings half = settings;
+  half.element_length = reference_overhang /
+                        (2.0 * CellsAlong(reference_overhang, settings.element_length)) * (1.0 + 1e-9);
+  return half;
 }
 
 // One push: the sample at a given overhang, its grid and its solver state.
@@ -325,10 +335,7 @@ AcpmCrossings ShellAcpmCrossings(const Material& material, const AcpmOptions& op
   auto run = [&](const AcpmSeam& seam, const std::vector<double>& rays, AcpmCrossings* coarse) {
     *coarse = Push(material, options, seam, rays, settings, reference);
     if (!settings.extrapolate || !coarse->converged) return *coarse;
-    // Exactly twice the cells (the extrapolation assumes the element halved).
-    ShellAcpmSettings half = settings;
-    half.element_length =
-        reference / (2.0 * CellsAlong(reference, settings.element_length)) * (1.0 + 1e-9);
+    const ShellAcpmSettings half = HalvedSettings(settings, reference);
     AcpmCrossings fine = Push(material, options, seam, rays, half, reference);
     if (!fine.converged) return fine;
     for (size_t r = 0; r < rays.size(); ++r)
@@ -365,6 +372,75 @@ AcpmCrossings ShellAcpmCrossings(const Material& material, const AcpmOptions& op
   result.plain_overhang = plain.overhang.front();
   result.solves += plain.solves;
   return result;
+}
+
+namespace {
+
+// The centre line of the plain sample at `overhang`, reached by continuation from 0.4 L in
+// steps of 0.15 L, each warm-started from the last converged state; a step that fails is
+// retried at half the length (down to 1 % of L). False with *message when it cannot get there.
+bool CantileverAt(PushedSample* sample, double overhang, double width, std::vector<double>* x,
+                  std::vector<double>* y, std::string* message) {
+  double reached = 0.25 * overhang;  // nominally: the flat start
+  double step = 0.15 * overhang;
+  Vertices good;                     // empty: start flat
+  while (reached < overhang) {
+    const double next = std::min(overhang, reached + step);
+    if (sample->Solve(next, message)) {
+      reached = next;
+      good = sample->state();
+      continue;
+    }
+    step *= 0.5;
+    if (step < 0.01 * overhang) return false;
+    sample->Restore(good, reached);
+  }
+  sample->SideProfile(0.5 * width, x, y);
+  return true;
+}
+
+}  // namespace
+
+ShellCantilever SolveShellCantilever(const Material& material, double overhang, double width,
+                                     const ShellAcpmSettings& settings) {
+  std::string why;
+  if (!settings.Check(&why)) throw InputError(why);
+  if (!(overhang > 0.0 && overhang <= 1.0)) throw InputError("shell cantilever: overhang must lie in (0, 1000] mm");
+  if (!(width > 0.0 && width <= 0.2)) throw InputError("shell cantilever: width must lie in (0, 200] mm");
+  AcpmOptions options;
+  options.width = width;
+  options.length = overhang;
+  ShellCantilever out;
+  PushedSample coarse(material, options, AcpmSeam{}, settings, overhang);
+  if (!CantileverAt(&coarse, overhang, width, &out.x, &out.y, &out.message)) return out;
+  out.solves = coarse.solves();
+  out.vertices = coarse.num_vertices();
+  std::ostringstream notes;
+  notes << std::setprecision(3) << "shell cantilever: element "
+        << units::MToMm(overhang / CellsAlong(overhang, settings.element_length))
+        << " mm along";
+  if (settings.extrapolate) {
+    const ShellAcpmSettings half = HalvedSettings(settings, overhang);
+    PushedSample fine(material, options, AcpmSeam{}, half, overhang);
+    std::vector<double> fx, fy;
+    if (!CantileverAt(&fine, overhang, width, &fx, &fy, &out.message)) return out;
+    // Fine vertex 2k is coarse vertex k's material point: extrapolate each to e -> 0.
+    if (fx.size() != 2 * out.x.size() - 1) {
+      out.message = "shell cantilever: the fine grid does not halve the coarse one";
+      return out;
+    }
+    for (size_t k = 0; k < out.x.size(); ++k) {
+      out.x[k] = 2.0 * fx[2 * k] - out.x[k];
+      out.y[k] = 2.0 * fy[2 * k] - out.y[k];
+    }
+    out.solves += fine.solves();
+    out.vertices = fine.num_vertices();
+    notes << " and half that, extrapolated point by point";
+  }
+  notes << "; " << out.solves << " static solves";
+  out.notes = notes.str();
+  out.converged = true;
+  return out;
 }
 
 }  // namespace textile

@@ -31,6 +31,15 @@ ProfileComparison CompareWithElastica(const BendingLaw& law, double areal_densit
                                       const Profile& measured, double overhang, double offset,
                                       int curve_samples = 201);
 
+// The same comparison against a simulated curve given as points (x_k, y_k) [m] in the
+// profile's frame before the offset, from the edge to the free end (at least 2), e.g. the shell
+// model's centre line: the points are joined by a Catmull-Rom spline (a polyline through
+// 2 mm-spaced points would miss the curve by up to h²/8R, 0.05 mm at R = 10 mm) and the
+// distances are those of CompareWithElastica (normal distance; beyond an end, the distance from
+// the end's tangent line). clamp_curvature is NaN. Throws InputError for bad arguments.
+ProfileComparison CompareWithCurve(const Profile& measured, const std::vector<double>& curve_x,
+                                   const std::vector<double>& curve_y, double offset);
+
 }  // namespace textile
 
 #endif  // TEXTILE_FIT_PROFILE_COMPARE_H_

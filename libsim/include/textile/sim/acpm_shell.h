@@ -18,6 +18,7 @@
 // until every ray is cut, then each ray's crossing is refined (Illinois regula falsi on the
 // solved states) to AcpmOptions::crossing_tolerance. Solved states are shared by all rays.
 
+#include <string>
 #include <vector>
 
 #include "textile/sim/acpm.h"
@@ -58,6 +59,28 @@ struct ShellAcpmSettings {
 AcpmCrossings ShellAcpmCrossings(const Material& material, const AcpmOptions& options,
                                  const std::vector<double>& ray_z,
                                  const ShellAcpmSettings& settings = {});
+
+// A plain cantilever at a fixed overhang on the shell model: the scene of the push above (the
+// sample held flat on the platform, one cell behind the edge) at overhang L, reached by
+// continuation from 0.4 L in warm-started steps (halved where a step fails). The side profile
+// is the centre line's; with settings.extrapolate it is 2 P(e/2) - P(e) point by point (the
+// fine grid's every other vertex is the coarse grid's material point), as the crossings are.
+//
+//   textile::ShellCantilever c = textile::SolveShellCantilever(fabric, 0.08, 0.025);
+//   // c.x, c.y: the centre line from the edge to the free end [m], y < 0 hanging
+struct ShellCantilever {
+  bool converged = false;
+  std::string message;       // why not, when not converged
+  std::vector<double> x, y;  // centre line [m], cantilever.md's frame, from the edge (0, 0)
+  int solves = 0;            // static solves, both resolutions
+  int vertices = 0;          // of the finest grid
+  std::string notes;
+};
+
+// overhang L [m] in (0, 1], width [m] in (0, 0.2]. Throws InputError for arguments outside
+// those ranges or bad settings; a solve that fails is reported in the result.
+ShellCantilever SolveShellCantilever(const Material& material, double overhang, double width,
+                                     const ShellAcpmSettings& settings = {});
 
 }  // namespace textile
 

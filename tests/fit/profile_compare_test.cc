@@ -1,0 +1,98 @@
+#include "textile/fit/profile_compare.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "textile/sim/elastica.h"
+#include "textile/sim/error.h"
+
+namespace textile {
+namespace {
+
+// A quarter circle of radius r [m] hanging from the edge, n points, each moved by normal[k]
+// [m] along its outward normal (away from the centre (0, -r)).
+Profile Arc(double r, int n, const std::vector<double>& normal = {}) {
+  Profile p;
+  p.source = "arc";
+  for (int k = 0; k < n; ++k) {
+    const double phi = 0.5 * std::numbers::pi * k / (n - 1);
+    const double d = normal.empty() ? 0.0 : normal[static_cast<size_t>(k)];
+    p.s.push_back(r * phi);
+    p.x.push_back((r + d) * std::sin(phi));
+    p.y.push_back(-r + (r + d) * std::cos(phi));
+  }
+  return p;
+}
+
+TEST(CompareWithCurve, SplineThroughCoarsePointsFollowsACircle) {
+  // Simulated points every 2 mm on a 10 mm circle: a polyline through them would miss the
+  // circle by up to h²/8R = 0.05 mm; the spline must stay within 5 µm.
+  const Profile coarse = Arc(0.01, 9);  // 2.0 mm apart
+  const Profile measured = Arc(0.01, 157);
+  const ProfileComparison c = CompareWithCurve(measured, coarse.x, coarse.y, 0.0);
+  EXPECT_LT(c.max, 5e-6);
+  EXPECT_NEAR(c.tip_dx, 0.0, 1e-12);
+  EXPECT_NEAR(c.tip_dy, 0.0, 1e-12);
+  EXPECT_TRUE(std::isnan(c.clamp_curvature));
+  EXPECT_EQ(c.model_x.size(), 8u * 8u + 1u);
+}
+
+TEST(CompareWithCurve, DistancesAreNormalAndTheOffsetLiftsTheCurve) {
+  // Measured points 0.2 mm off the curve, alternately outside and inside: every distance is
+  // 0.2 mm. The tip difference is the curve's end minus the last measured point.
+  std::vector<double> normal;
+  for (int k = 0; k < 61; ++k) normal.push_back(k % 2 ? 2e-4 : -2e-4);
+  const Profile measured = Arc(0.03, 61, normal);
+  const Profile curve = Arc(0.03, 25);
+  const ProfileComparison c = CompareWithCurve(measured, curve.x, curve.y, 0.0);
+  EXPECT_NEAR(c.rms, 2e-4, 2e-6);
+  EXPECT_NEAR(c.max, 2e-4, 2e-6);
+  EXPECT_NEAR(c.tip_dx, curve.x.back() - measured.x.back(), 1e-12);
+  EXPECT_NEAR(c.tip_dy, curve.y.back() - measured.y.back(), 1e-12);
+  // Lifted by 1 mm, the simulated curve's first point is at (0, 1 mm).
+  const ProfileComparison lifted = CompareWithCurve(measured, curve.x, curve.y, 1e-3);
+  EXPECT_NEAR(lifted.model_y.front(), 1e-3, 1e-15);
+  EXPECT_GT(lifted.rms, 5e-4);
+}
+
+TEST(CompareWithCurve, AgreesWithTheElasticaComparison) {
+  // The elastica's own curve given as points 2 mm apart grades a noisy profile as the
+  // elastica comparison does (the same law, overhang and offset): the spline through 2 mm
+  // points is within 6 µm of the curve where the curvature changes fastest (at the clamp).
+  const BendingLaw law = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+  const double rho = 0.2, overhang = 0.08;
+  ElasticaOptions eo;
+  eo.num_samples = 41;
+  const ElasticaProfile e = SolveHeavyElastica(law, rho, overhang, eo);
+  ASSERT_TRUE(e.converged) << e.message;
+  ElasticaOptions fine;
+  fine.num_samples = 161;
+  const ElasticaProfile f = SolveHeavyElastica(law, rho, overhang, fine);
+  Profile measured;
+  measured.source = "elastica";
+  for (size_t k = 0; k < f.s.size(); ++k) {
+    const double d = (k % 3 == 0 ? 1.0 : -0.5) * 1e-4;  // ±0.1 mm along the normal
+    measured.s.push_back(f.s[k]);
+    measured.x.push_back(f.x[k] + d * std::sin(f.theta[k]));
+    measured.y.push_back(f.y[k] + d * std::cos(f.theta[k]) + 2e-4);
+  }
+  const ProfileComparison a = CompareWithElastica(law, rho, measured, overhang, 2e-4);
+  const ProfileComparison b = CompareWithCurve(measured, e.x, e.y, 2e-4);
+  EXPECT_NEAR(a.rms, b.rms, 1e-6);
+  EXPECT_NEAR(a.max, b.max, 1e-5);
+  EXPECT_NEAR(a.tip_dx, b.tip_dx, 1e-6);
+  EXPECT_NEAR(a.tip_dy, b.tip_dy, 1e-6);
+}
+
+TEST(CompareWithCurve, RefusesBadCurves) {
+  const Profile measured = Arc(0.03, 30);
+  EXPECT_THROW(CompareWithCurve(measured, {0.0}, {0.0}, 0.0), InputError);
+  EXPECT_THROW(CompareWithCurve(measured, {0.0, 0.01}, {0.0}, 0.0), InputError);
+  EXPECT_THROW(CompareWithCurve(measured, {0.0, std::nan("")}, {0.0, -0.01}, 0.0), InputError);
+  EXPECT_THROW(CompareWithCurve(measured, {0.0, 0.01}, {0.0, -0.01}, INFINITY), InputError);
+}
+
+}  // namespace
+}  // namespace textile

@@ -54,6 +54,6 @@ echo "== 5. The fitted law on the virtual ACPM200 and the Cusick drapemeter (tex
 echo
 echo "== 6. Closing the loop: photos -> fit -> the same cantilevers simulated -> compared (textile validate)"
 "$textile" validate samples/photos/pabst-fig8_L0{40,60,80}mm.jpg --rig "$out/pabst-fig8.rig.json" \
-  --gsm 200 -o "$out/validate" 2>/dev/null | tail -n 5
+  --gsm 200 -o "$out/validate" 2>/dev/null
 echo
 echo "Pictures and outputs: $out"

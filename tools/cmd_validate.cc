@@ -180,6 +180,7 @@ void Run(const ValidateArgs& a) {
   std::vector<Check> checks;
   bool all_pass = true;
   std::string shell_notes;
+  int shell_solves = 0;
   for (size_t i = 0; i < profiles.size(); ++i) {
     Check k;
     k.source = loaded[i].source;
@@ -199,6 +200,7 @@ void Run(const ValidateArgs& a) {
       k.shell.solves = sc.solves;
       k.shell.notes = sc.notes;
       shell_notes = sc.notes;
+      shell_solves += sc.solves;
       Grade(tol, a.tolerance_mm, &k.shell);
       if (run_elastica) {
         // How far the shell's curve lies from the elastica's (both lifted by the offset).
@@ -252,8 +254,8 @@ void Run(const ValidateArgs& a) {
                {"c1_sd_kes", std::isfinite(fit.c1_sd) ? nlohmann::json(units::SiQuadraticToKes(fit.c1_sd)) : nlohmann::json()},
                {"observability", fit.observability}}},
       {"models", {{"elastica", run_elastica ? "simulated" : "not run (--model shell)"},
-                  {"shell", run_shell ? "simulated: " + shell_notes + ", strip " +
-                                            Num(a.width_mm) + " mm wide"
+                  {"shell", run_shell ? "simulated: 3D shell, tensor bending, " + shell_notes +
+                                            ", strip " + Num(a.width_mm) + " mm wide"
                                       : "not run (--model elastica)"}}},
       {"tolerance", {{"rms_mm", a.tolerance_mm},
                      {"max_mm", kMaxOverRms * a.tolerance_mm},
@@ -285,7 +287,10 @@ void Run(const ValidateArgs& a) {
             << " mm)\n"
             << "simulated at each fitted overhang with " << (run_elastica ? "the elastica" : "")
             << (run_elastica && run_shell ? " and " : "")
-            << (run_shell ? "the shell (" + shell_notes + ")" : "") << "\n";
+            << (run_shell ? "the shell (" + shell_notes + "; " + std::to_string(shell_solves) +
+                                " static solves in all)"
+                          : "")
+            << "\n";
   const auto line = [](const char* name, const ModelCheck& m) {
     std::cout << "    " << name << ": rms " << Num(units::MToMm(m.c.rms), 3) << " mm, max "
               << Num(units::MToMm(m.c.max), 3) << " mm, tip (" << Num(units::MToMm(m.c.tip_dx), 3)

@@ -416,7 +416,7 @@ ShellCantilever SolveShellCantilever(const Material& material, double overhang, 
   out.solves = coarse.solves();
   out.vertices = coarse.num_vertices();
   std::ostringstream notes;
-  notes << std::setprecision(3) << "shell cantilever: element "
+  notes << std::setprecision(2) << "elements "
         << units::MToMm(overhang / CellsAlong(overhang, settings.element_length))
         << " mm along";
   if (settings.extrapolate) {
@@ -437,7 +437,6 @@ ShellCantilever SolveShellCantilever(const Material& material, double overhang, 
     out.vertices = fine.num_vertices();
     notes << " and half that, extrapolated point by point";
   }
-  notes << "; " << out.solves << " static solves";
   out.notes = notes.str();
   out.converged = true;
   return out;

@@ -456,32 +456,67 @@ Eigen::SparseMatrix<double> BarycentricProlongation(const TriangleMesh& coarse_r
   return prolongation;
 }
 
-SolveSummary SolveCascadic(ClothProblem* coarse, ClothProblem* fine, Vertices* x_coarse,
-                           Vertices* x_fine, const SolveOptions& options) {
+namespace {
+
+// Levels coarsest first; states[0] is the start, states[i] receives level i's solution.
+SolveSummary Cascade(const std::vector<ClothProblem*>& levels, std::vector<Vertices>* states,
+                     const SolveOptions& options) {
+  if (levels.size() < 2) throw InputError("cascadic: at least two levels (coarse and fine)");
   const auto start = Clock::now();
+  states->resize(levels.size());
   SolveOptions coarse_options = options;
   coarse_options.tolerance = 10.0 * options.tolerance;
-  const SolveSummary c = SolveStatic(coarse, x_coarse, coarse_options);
-  if (!c.converged) {
-    SolveSummary s = c;
+  int coarse_iterations = 0;
+  double coarse_seconds = 0.0;
+  for (size_t level = 0;; ++level) {
+    const bool finest = level + 1 == levels.size();
+    SolveOptions level_options = finest ? options : coarse_options;
+    level_options.max_seconds = std::max(1e-3, options.max_seconds - Since(start));
+    if (level > 0) {
+      const Eigen::SparseMatrix<double> prolongation =
+          BarycentricProlongation(levels[level - 1]->rest(), levels[level]->rest());
+      (*states)[level] = prolongation * (*states)[level - 1];
+    }
+    SolveSummary s = SolveStatic(levels[level], &(*states)[level], level_options);
     s.method = "cascadic";
-    s.message = "coarse level: " + c.message;
-    s.coarse_iterations = c.iterations;
-    s.coarse_seconds = c.seconds;
-    s.iterations = 0;
-    return s;
+    if (!finest && !s.converged) {
+      s.message = (levels.size() == 2 ? std::string("coarse level: ")
+                                      : "level " + std::to_string(level + 1) + " of " +
+                                            std::to_string(levels.size()) + ": ") +
+                  s.message;
+      s.coarse_iterations = coarse_iterations + s.iterations;
+      s.coarse_seconds = coarse_seconds + s.seconds;
+      s.iterations = 0;
+      return s;
+    }
+    if (finest) {
+      s.coarse_iterations = coarse_iterations;
+      s.coarse_seconds = coarse_seconds;
+      s.seconds = Since(start);
+      return s;
+    }
+    coarse_iterations += s.iterations;
+    coarse_seconds += s.seconds;
   }
-  const Eigen::SparseMatrix<double> prolongation =
-      BarycentricProlongation(coarse->rest(), fine->rest());
-  *x_fine = prolongation * (*x_coarse);
-  SolveOptions fine_options = options;
-  fine_options.max_seconds = std::max(1e-3, options.max_seconds - c.seconds);
-  SolveSummary f = SolveStatic(fine, x_fine, fine_options);
-  f.method = "cascadic";
-  f.coarse_iterations = c.iterations;
-  f.coarse_seconds = c.seconds;
-  f.seconds = Since(start);
-  return f;
+}
+
+}  // namespace
+
+SolveSummary SolveCascadic(ClothProblem* coarse, ClothProblem* fine, Vertices* x_coarse,
+                           Vertices* x_fine, const SolveOptions& options) {
+  std::vector<Vertices> states = {*x_coarse};
+  const SolveSummary s = Cascade({coarse, fine}, &states, options);
+  *x_coarse = states[0];
+  if (states[1].rows() > 0) *x_fine = states[1];
+  return s;
+}
+
+SolveSummary SolveCascadic(const std::vector<ClothProblem*>& levels, Vertices* x,
+                           const SolveOptions& options) {
+  std::vector<Vertices> states = {*x};
+  const SolveSummary s = Cascade(levels, &states, options);
+  if (states.back().rows() > 0) *x = states.back();
+  return s;
 }
 
 }  // namespace textile

@@ -318,6 +318,35 @@ TEST(StaticSolver, CascadicCoarseToFineReachesTheFineSolution) {
   EXPECT_LT(s.iterations, d.iterations);
 }
 
+TEST(StaticSolver, CascadicOverThreeLevelsReachesTheFineSolution) {
+  HangingSheet coarsest(3, 2), coarse(6, 4), fine(12, 8);
+  SolveOptions options;
+  options.tolerance = 1e-8;
+  Vertices x = coarsest.mesh.vertices;
+  const SolveSummary s = SolveCascadic(
+      {coarsest.problem.get(), coarse.problem.get(), fine.problem.get()}, &x, options);
+  ASSERT_TRUE(s.converged) << s.BriefReport();
+  ASSERT_EQ(x.rows(), fine.mesh.num_vertices());
+  EXPECT_GT(s.coarse_iterations, 0);
+  Vertices direct = fine.mesh.vertices;
+  const SolveSummary d = SolveStatic(fine.problem.get(), &direct, options);
+  ASSERT_TRUE(d.converged) << d.BriefReport();
+  EXPECT_NEAR(s.energy, d.energy, 1e-6 * std::abs(d.energy));
+  EXPECT_LT((x - direct).cwiseAbs().maxCoeff(), 1e-5);
+  EXPECT_LT(s.iterations, d.iterations);
+  // One level is not a cascade; a level that fails stops it with its number.
+  EXPECT_THROW(SolveCascadic({fine.problem.get()}, &x, options), InputError);
+  Vertices y = coarsest.mesh.vertices;
+  SolveOptions capped = options;
+  capped.max_iterations = 1;
+  const SolveSummary f = SolveCascadic(
+      {coarsest.problem.get(), coarse.problem.get(), fine.problem.get()}, &y, capped);
+  EXPECT_FALSE(f.converged);
+  EXPECT_NE(f.message.find("level 1 of 3"), std::string::npos) << f.message;
+  ASSERT_EQ(y.rows(), coarsest.mesh.num_vertices());  // untouched: nothing converged
+  EXPECT_EQ((y - coarsest.mesh.vertices).cwiseAbs().maxCoeff(), 0.0);
+}
+
 TEST(Prolongation, InterpolatesAffineFieldsExactlyAndRowsSumToOne) {
   const TriangleMesh coarse = CrissCrossGridMesh(0.2, 0.1, 3, 2);
   const TriangleMesh fine = RegularGridMesh(0.2, 0.1, 17, 9);

@@ -30,6 +30,7 @@
 
 #include <Eigen/SparseCore>
 #include <string>
+#include <vector>
 
 #include "textile/sim/cloth_problem.h"
 
@@ -103,6 +104,13 @@ Eigen::SparseMatrix<double> BarycentricProlongation(const TriangleMesh& coarse_r
 // start). The summary is the fine level's, with the coarse figures added.
 SolveSummary SolveCascadic(ClothProblem* coarse, ClothProblem* fine, Vertices* x_coarse,
                            Vertices* x_fine, const SolveOptions& options);
+
+// The same over any number of levels, coarsest first (at least 2): each level starts from the
+// prolonged solution of the one before; all but the finest are solved to 10× the tolerance.
+// *x: the coarsest level's start on entry, the finest level's solution on exit. The summary is
+// the finest level's; coarse_iterations and coarse_seconds add up the coarser levels.
+SolveSummary SolveCascadic(const std::vector<ClothProblem*>& levels, Vertices* x,
+                           const SolveOptions& options);
 
 }  // namespace textile
 

@@ -402,6 +402,29 @@ TEST(ClothProblem, FixedVerticesHaveIdentityRowsAndZeroForce) {
   }
 }
 
+TEST(ClothProblem, BuildsOnlyTheChosenBendingDiscretisation) {
+  // Each discretisation is built alone, and the problem's energy is the membrane's plus that
+  // one's bending energy (the tensor problem carries no hinge elements behind it).
+  const TriangleMesh mesh = CrissCrossGridMesh(0.05, 0.05, 3, 3);
+  Vertices x = mesh.vertices;
+  for (int i = 0; i < x.rows(); ++i) x(i, 2) = 4.0 * x(i, 0) * x(i, 0);  // bent about y
+  for (BendingDiscretization d : {BendingDiscretization::kHinge, BendingDiscretization::kTensor}) {
+    ClothOptions options;
+    options.discretization = d;
+    options.gravity.setZero();
+    const ClothProblem problem(mesh, Cotton(), {}, options);
+    const bool tensor = d == BendingDiscretization::kTensor;
+    ASSERT_EQ(problem.hinge_bending() == nullptr, tensor);
+    ASSERT_EQ(problem.tensor_bending() == nullptr, !tensor);
+    const double bending =
+        tensor ? problem.tensor_bending()->Energy(x) : problem.hinge_bending()->Energy(x);
+    EXPECT_GT(bending, 0.0);
+    // Same terms, summed in another order: a few ulps.
+    EXPECT_NEAR(problem.Energy(x), problem.membrane().Energy(x) + bending,
+                1e-12 * problem.Energy(x));
+  }
+}
+
 TEST(ClothProblem, WeightAndMassDoNotDependOnTheMesh) {
   const double area = 0.2 * 0.12;
   for (int n : {4, 9}) {

@@ -101,7 +101,8 @@ DrapeOptions Options(const DrapeArgs& a) {
     if (!(*a.tolerance > 0.0) || *a.tolerance > 0.1) throw InputError("--tolerance: must be in (0, 0.1]");
     o.solver.tolerance = *a.tolerance;
   }
-  if (!(a.max_seconds > 0.0)) throw InputError("--max-seconds: must be > 0");
+  if (!(std::isfinite(a.max_seconds) && a.max_seconds > 0.0))
+    throw InputError("--max-seconds: must be a finite number > 0");
   o.solver.max_seconds = a.max_seconds;
   if (std::string why; !o.Check(&why)) throw InputError("drape: " + why);
   return o;

@@ -25,7 +25,6 @@ struct ExtractArgs {
   PhotoFlags photo;
   int overlay_px = 2000;
   bool json = false;
-  bool progress = false;  // progress lines on stderr even when it is not a terminal
 };
 
 nlohmann::json Point(const Eigen::Vector2d& p) { return {p.x(), p.y()}; }
@@ -56,7 +55,7 @@ void Run(const ExtractArgs& a) {
   for (const auto& photo : a.photos) {
     const cv::Mat gray = ReadPhotoGray(photo);
     if (a.photos.size() > 1 || gray.total() > 4e6) {
-      Progress("extracting " + photo + " ...", a.progress);
+      Progress("extracting " + photo + " ...", options.progress);
     }
     const ExtractionSummary r = ExtractProfile(gray, rig, o, photo);
     if (!r.success) throw ComputeError(photo + ": " + r.message);
@@ -117,8 +116,6 @@ void RegisterExtract(CLI::App& app) {
   sub->add_option("--overlay-px", a->overlay_px,
                   "Long side of the overlay PNG [px] (default 2000)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
-  sub->add_flag("--progress", a->progress,
-                "Print a progress line per photo on stderr even when it is not a terminal");
   sub->callback([a] { Run(*a); });
 }
 

@@ -8,27 +8,18 @@
 #include <cassert>
 #include <cmath>
 #include <sstream>
-#include <utility>
 #include <thread>
+#include <utility>
 
+#include "hinge_angle.h"
 #include "textile/sim/error.h"
 
 namespace textile {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
-using Mat3 = Eigen::Matrix3d;
 using Mat12 = Eigen::Matrix<double, 12, 12>;
-
-inline Mat3 Skew(const Vec3& v) {
-  Mat3 m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
-}
-
-inline Eigen::Map<const Vec3> Row(const Vertices& x, int i) {
-  return Eigen::Map<const Vec3>(x.data() + 3 * i);
-}
+using hinge_angle::Position;
 
 // The SIMD kernels below are compiled twice on x86-64 Linux with GCC: for AVX2 and for the
 // baseline, picked at load time (function multiversioning); elsewhere once. No FMA in either
@@ -77,78 +68,6 @@ TEXTILE_ALWAYS_INLINE double Atan2(double y, double x) {
   r = ay > ax ? kPi2 - r : r;
   r = x < 0.0 ? kPi - r : r;
   return std::copysign(r, y);
-}
-
-// Geometry of one hinge at positions x: everything the gradient of θ needs (docs/bending.md,
-// "Gradient of the bend angle"). n0 = e × a0 and n1 = a1 × e are the unnormalised normals of
-// (x0, x2, x3) and (x1, x3, x2); |n_k| = |e| h_k.
-struct HingeGeometry {
-  Vec3 e, a0, a1, n0, n1;
-  double l2, l, cos_term, sin_term;  // |n0||n1| cos θ, |n0||n1| sin θ
-  void Compute(const Vertices& x, const std::array<int, 4>& v) {
-    const auto x2 = Row(x, v[2]);
-    e = Row(x, v[3]) - x2;
-    a0 = Row(x, v[0]) - x2;
-    a1 = Row(x, v[1]) - x2;
-    n0 = e.cross(a0);
-    n1 = a1.cross(e);
-    l2 = e.squaredNorm();
-    l = std::sqrt(l2);
-    cos_term = n0.dot(n1);
-    sin_term = l * n1.dot(a0);  // (n1 × n0)·e/|e| = |e| (a1 × e)·a0
-  }
-  double Angle() const { return Atan2(sin_term, cos_term); }
-  // ∂θ/∂x_i for the four vertices: g0 = |e| n0/|n0|², g1 = |e| n1/|n1|², the edge vertices take
-  // the reactions at the wings' feet t0, t1 (Bridson et al. 2003's u_i).
-  void Gradient(std::array<Vec3, 4>* g) const {
-    const double n0sq = n0.squaredNorm(), n1sq = n1.squaredNorm();
-    const double inv = 1.0 / (n0sq * n1sq);
-    const double inv_l2 = 1.0 / l2;
-    (*g)[0] = n0 * (l * n1sq * inv);
-    (*g)[1] = n1 * (l * n0sq * inv);
-    const double t0 = a0.dot(e) * inv_l2, t1 = a1.dot(e) * inv_l2;
-    (*g)[2] = (t0 - 1.0) * (*g)[0] + (t1 - 1.0) * (*g)[1];
-    (*g)[3] = -t0 * (*g)[0] - t1 * (*g)[1];
-  }
-};
-
-// One triangle's part of ∇²θ (docs/bending.md, "Hessian of the bend angle"). The triangle's
-// contribution to ∂θ/∂x_p is φ_p N with φ_p = f_p/(|e| |N|²), N its unnormalised normal and
-// f = {|e|², -(x3 - w)·e, -(w - x2)·e} for p = {wing, x2, x3}; eps[p] is the edge opposite
-// p in the triangle's counter-clockwise order, so that ∂N/∂x_p = [eps_p]×.
-void AddTriangleAngleHessian(const Vec3& w, const Vec3& x2, const Vec3& x3, const Vec3& n,
-                             const std::array<Vec3, 3>& eps, int wing, double scale, Mat12* h) {
-  const Vec3 e = x3 - x2, aw = w - x2, bw = x3 - w;
-  const double l2 = e.squaredNorm(), l = std::sqrt(l2), nsq = n.squaredNorm();
-  const double inv = 1.0 / (l * nsq);
-  const double phi[3] = {l2 * inv, -bw.dot(e) * inv, -aw.dot(e) * inv};
-  // ∇_q f_p, rows p, columns q (both in the order wing, x2, x3).
-  const Vec3 zero = Vec3::Zero();
-  const Vec3 grad_f[3][3] = {{zero, -2.0 * e, 2.0 * e}, {e, bw, -e - bw}, {-e, e + aw, -aw}};
-  const Vec3 grad_log_l[3] = {zero, -e / l2, e / l2};
-  Vec3 two_u[3];  // 2 ∇λ_q = ∇_q log |N|²
-  Mat3 skew[3];
-  for (int q = 0; q < 3; ++q) {
-    two_u[q] = n.cross(eps[q]) * (2.0 / nsq);
-    skew[q] = Skew(eps[q]);
-  }
-  const int index[3] = {wing, 2, 3};
-  for (int p = 0; p < 3; ++p) {
-    for (int q = 0; q < 3; ++q) {
-      const Vec3 d_phi = grad_f[p][q] * inv - phi[p] * (grad_log_l[q] + two_u[q]);
-      h->block<3, 3>(3 * index[p], 3 * index[q]) +=
-          scale * (n * d_phi.transpose() + phi[p] * skew[q]);
-    }
-  }
-}
-
-// ∇²θ of hinge (x0, x1, x2, x3), times scale, added to h.
-void AddAngleHessian(const Vertices& x, const std::array<int, 4>& v, double scale, Mat12* h) {
-  const Vec3 x0 = Row(x, v[0]), x1 = Row(x, v[1]), x2 = Row(x, v[2]), x3 = Row(x, v[3]);
-  const Vec3 e = x3 - x2;
-  // Triangle (x0, x2, x3) and triangle (x1, x3, x2).
-  AddTriangleAngleHessian(x0, x2, x3, e.cross(x0 - x2), {e, x0 - x3, x2 - x0}, 0, scale, h);
-  AddTriangleAngleHessian(x1, x2, x3, (x1 - x2).cross(e), {-e, x3 - x1, x1 - x2}, 1, scale, h);
 }
 
 constexpr int kLanes = 8;  // hinges per SIMD block
@@ -332,39 +251,6 @@ TEXTILE_SIMD_CLONES void DihedralLanes(const DihedralLanesIn& in, const LanePosi
 constexpr int kPackedSize = 78;
 constexpr int Packed(int r, int c) { return r * 12 - r * (r - 1) / 2 + (c - r); }
 
-// One triangle's part of ∇²θ (docs/bending.md, "Hessian"), only the vertex blocks (p, q) with
-// p ≤ q in hinge order and, on the diagonal blocks, entries a ≤ b; added to u (packed). The
-// triangle is (w, x2, x3) with wing `wing` (0 or 1), normal n, eps[p] the edge opposite p.
-TEXTILE_ALWAYS_INLINE void AddTriangleAngleHessianUpper(const Vec3& w, const Vec3& x2,
-                                                        const Vec3& x3, const Vec3& n,
-                                                        const Vec3 (&eps)[3], int wing, double* u) {
-  const Vec3 e = x3 - x2, aw = w - x2, bw = x3 - w;
-  const double l2 = e.squaredNorm(), l = std::sqrt(l2), nsq = n.squaredNorm();
-  const double inv = 1.0 / (l * nsq), inv_l2 = 1.0 / l2, two_inv_nsq = 2.0 / nsq;
-  const double phi[3] = {l2 * inv, -bw.dot(e) * inv, -aw.dot(e) * inv};
-  const Vec3 zero = Vec3::Zero();
-  // ∇_q f_p (rows p, columns q, both in the order wing, x2, x3) and ∇_q log |e| + ∇_q log |N|².
-  const Vec3 grad_f[3][3] = {{zero, -2.0 * e, 2.0 * e}, {e, bw, -e - bw}, {-e, e + aw, -aw}};
-  Vec3 grad_log[3];
-  grad_log[0] = n.cross(eps[0]) * two_inv_nsq;
-  grad_log[1] = n.cross(eps[1]) * two_inv_nsq - e * inv_l2;
-  grad_log[2] = n.cross(eps[2]) * two_inv_nsq + e * inv_l2;
-  const int index[3] = {wing, 2, 3};
-  for (int p = 0; p < 3; ++p) {
-    for (int q = p; q < 3; ++q) {
-      const Vec3 d_phi = grad_f[p][q] * inv - phi[p] * grad_log[q];
-      // n d_phiᵀ + φ_p [eps_q]×.
-      const Vec3& s = eps[q];
-      const double skew[3][3] = {{0.0, -s.z(), s.y()}, {s.z(), 0.0, -s.x()}, {-s.y(), s.x(), 0.0}};
-      for (int a = 0; a < 3; ++a) {
-        for (int b = p == q ? a : 0; b < 3; ++b) {
-          u[Packed(3 * index[p] + a, 3 * index[q] + b)] += n[a] * d_phi[b] + phi[p] * skew[a][b];
-        }
-      }
-    }
-  }
-}
-
 // Packed upper Hessian blocks of a block of hinges, lane-minor: u[k][l] is entry k of hinge l.
 struct LaneHessian {
   alignas(64) double u[kPackedSize][kLanes];
@@ -403,8 +289,8 @@ TEXTILE_ALWAYS_INLINE void Unroll(F&& f) {
   [&]<int... I>(std::integer_sequence<int, I...>) __attribute__((always_inline)) { (f(std::integral_constant<int, I>{}), ...); }(std::make_integer_sequence<int, N>{});
 }
 
-// One triangle's part of ∇²θ in one lane (the formula of AddTriangleAngleHessianUpper, with
-// compile-time indices): vertex blocks (p, q), p ≤ q in hinge order, entries a ≤ b on the
+// One triangle's part of ∇²θ in one lane (the formula of hinge_angle::AddTriangleAngleHessian,
+// with compile-time indices): vertex blocks (p, q), p ≤ q in hinge order, entries a ≤ b on the
 // diagonal. kAdd: the edge blocks add to the other triangle's (written first).
 template <int kWing, bool kAdd>
 TEXTILE_ALWAYS_INLINE void TriangleLane(V3 w, V3 x2, V3 x3, V3 n, V3 eps0, V3 eps1, V3 eps2, int l, LaneHessian* out) {
@@ -742,13 +628,13 @@ double BendingElements::HingeTerms(const Vertices& x, int h, double* d_energy,
   const HingeRest& r = rest_[h];
   if (options_.model == BendingModel::kVolino || options_.model == BendingModel::kIsometric) {
     const auto& al = linear_[h].alpha;
-    const Vec3 rv = al[0] * Row(x, r.v[0]) + al[1] * Row(x, r.v[1]) + al[2] * Row(x, r.v[2]) +
-                    al[3] * Row(x, r.v[3]) - linear_[h].rest_vector;
+    const Vec3 rv = al[0] * Position(x, r.v[0]) + al[1] * Position(x, r.v[1]) +
+                    al[2] * Position(x, r.v[2]) + al[3] * Position(x, r.v[3]) -
+                    linear_[h].rest_vector;
     return 0.5 * r.weight * rv.squaredNorm();
   }
-  HingeGeometry g;
-  g.Compute(x, r.v);
-  return DihedralTerms(g.cos_term, g.sin_term, h, d_energy, d2_energy, true);
+  const hinge_angle::AngleTerms t = hinge_angle::AngleTermsAndGradient(x, r.v, nullptr);
+  return DihedralTerms(t.cos_term, t.sin_term, h, d_energy, d2_energy, true);
 }
 
 // E(θ), E'(θ), E''(θ) of a dihedral model from |n0||n1| (cos θ, sin θ); with want_energy
@@ -784,9 +670,8 @@ double BendingElements::DihedralTerms(double cos_term, double sin_term, int h, d
 }
 
 double BendingElements::BendAngle(const Vertices& x, int h) const {
-  HingeGeometry g;
-  g.Compute(x, rest_[h].v);
-  return g.Angle();
+  const hinge_angle::AngleTerms t = hinge_angle::AngleTermsAndGradient(x, rest_[h].v, nullptr);
+  return Atan2(t.sin_term, t.cos_term);
 }
 
 double BendingElements::HingeCurvature(const Vertices& x, int h) const {
@@ -817,8 +702,9 @@ double BendingElements::Evaluate(const Vertices& x, double* grad) const {
     for (long h = begin; h < end; ++h) {
       const HingeRest& r = rest_[h];
       const auto& al = linear_[h].alpha;
-      const Vec3 rv = al[0] * Row(x, r.v[0]) + al[1] * Row(x, r.v[1]) + al[2] * Row(x, r.v[2]) +
-                      al[3] * Row(x, r.v[3]) - linear_[h].rest_vector;
+      const Vec3 rv = al[0] * Position(x, r.v[0]) + al[1] * Position(x, r.v[1]) +
+                      al[2] * Position(x, r.v[2]) + al[3] * Position(x, r.v[3]) -
+                      linear_[h].rest_vector;
       if constexpr (kWithEnergy) energy += 0.5 * r.weight * rv.squaredNorm();
       if constexpr (!kWithGradient) continue;
       const Vec3 wr = r.weight * rv;
@@ -949,7 +835,6 @@ void BendingElements::AddHessianTriplets(const Vertices& x,
 
   ParallelChunks(nh, threads, [&](long begin, long end, int) {
     Mat12 block;
-    Eigen::SelfAdjointEigenSolver<Mat12> eigen;
     for (long k = begin; k < end; ++k) {
       const long h = first_hinge + k;
       const HingeRest& r = rest_[h];
@@ -970,29 +855,7 @@ void BendingElements::AddHessianTriplets(const Vertices& x,
               emit(3 * r.v[i] + c, 3 * r.v[j] + c, r.weight * al[i] * al[j]);
         continue;
       }
-      double d_energy, d2_energy;
-      HingeGeometry geo;
-      geo.Compute(x, r.v);
-      DihedralTerms(geo.cos_term, geo.sin_term, static_cast<int>(h), &d_energy, &d2_energy, false);
-      std::array<Vec3, 4> g;
-      geo.Gradient(&g);
-      Eigen::Matrix<double, 12, 1> gv;
-      for (int i = 0; i < 4; ++i) gv.segment<3>(3 * i) = g[i];
-      // ∇²E = E''(θ) ∇θ ∇θᵀ + E'(θ) ∇²θ.
-      if (projection == HessianProjection::kGaussNewton) {
-        block.noalias() = std::max(d2_energy, 0.0) * gv * gv.transpose();
-      } else {
-        block.noalias() = d2_energy * gv * gv.transpose();
-        AddAngleHessian(x, r.v, d_energy, &block);
-      }
-      if (projection == HessianProjection::kEigen) {
-        eigen.compute(block);
-        const auto& values = eigen.eigenvalues();
-        if (values.minCoeff() < 0.0) {
-          block.noalias() = eigen.eigenvectors() * values.cwiseMax(0.0).asDiagonal() *
-                            eigen.eigenvectors().transpose();
-        }
-      }
+      DihedralHessianBlock(x, static_cast<int>(h), projection, &block);
       for (int i = 0; i < 4; ++i)
         for (int j = 0; j < 4; ++j)
           for (int a = 0; a < 3; ++a)
@@ -1002,56 +865,48 @@ void BendingElements::AddHessianTriplets(const Vertices& x,
   });
 }
 
+// ∇²E = E''(θ) ∇θ ∇θᵀ + E'(θ) ∇²θ of dihedral hinge h, projected as asked.
+void BendingElements::DihedralHessianBlock(const Vertices& x, int h, HessianProjection projection,
+                                           Mat12* block) const {
+  const HingeRest& r = rest_[h];
+  std::array<Vec3, 4> g;
+  const hinge_angle::AngleTerms t = hinge_angle::AngleTermsAndGradient(x, r.v, &g);
+  double d_energy, d2_energy;
+  DihedralTerms(t.cos_term, t.sin_term, h, &d_energy, &d2_energy, false);
+  Eigen::Matrix<double, 12, 1> gv;
+  for (int i = 0; i < 4; ++i) gv.segment<3>(3 * i) = g[i];
+  if (projection == HessianProjection::kGaussNewton) {
+    block->noalias() = std::max(d2_energy, 0.0) * gv * gv.transpose();
+    return;
+  }
+  block->noalias() = d2_energy * gv * gv.transpose();
+  hinge_angle::AddAngleHessian(x, r.v, d_energy, block);
+  if (projection == HessianProjection::kEigen) {
+    const Eigen::SelfAdjointEigenSolver<Mat12> eigen(*block);
+    const auto& values = eigen.eigenvalues();
+    if (values.minCoeff() < 0.0) {
+      block->noalias() = eigen.eigenvectors() * values.cwiseMax(0.0).asDiagonal() *
+                         eigen.eigenvectors().transpose();
+    }
+  }
+}
+
 void BendingElements::HingeHessianUpper(const Vertices& x, int h, HessianProjection projection,
                                         double* u) const {
   const HingeRest& r = rest_[h];
-  std::fill(u, u + kPackedSize, 0.0);
   if (options_.model == BendingModel::kVolino || options_.model == BendingModel::kIsometric) {
     // Constant Hessian: k α_i α_j I₃ for every vertex pair.
+    std::fill(u, u + kPackedSize, 0.0);
     const auto& al = linear_[h].alpha;
     for (int i = 0; i < 4; ++i)
       for (int j = i; j < 4; ++j)
         for (int c = 0; c < 3; ++c) u[Packed(3 * i + c, 3 * j + c)] = r.weight * al[i] * al[j];
     return;
   }
-  double d_energy, d2_energy;
-  HingeGeometry geo;
-  geo.Compute(x, r.v);
-  DihedralTerms(geo.cos_term, geo.sin_term, h, &d_energy, &d2_energy, false);
-  std::array<Vec3, 4> g;
-  geo.Gradient(&g);
-  double gv[12];
-  for (int i = 0; i < 4; ++i)
-    for (int c = 0; c < 3; ++c) gv[3 * i + c] = g[i][c];
-  if (projection == HessianProjection::kEigen) {
-    // The projected block, as the triplet path makes it, then its upper triangle.
-    Mat12 block;
-    const Eigen::Map<const Eigen::Matrix<double, 12, 1>> gm(gv);
-    block.noalias() = d2_energy * gm * gm.transpose();
-    AddAngleHessian(x, r.v, d_energy, &block);
-    Eigen::SelfAdjointEigenSolver<Mat12> eigen(block);
-    const auto& values = eigen.eigenvalues();
-    if (values.minCoeff() < 0.0) {
-      block.noalias() = eigen.eigenvectors() * values.cwiseMax(0.0).asDiagonal() *
-                        eigen.eigenvectors().transpose();
-    }
-    for (int a = 0; a < 12; ++a)
-      for (int b = a; b < 12; ++b) u[Packed(a, b)] = block(a, b);
-    return;
-  }
-  if (projection == HessianProjection::kNone) {
-    // E'(θ) ∇²θ: both triangles' parts (see AddAngleHessian), upper blocks only.
-    const Vec3 x0 = Row(x, r.v[0]), x1 = Row(x, r.v[1]), x2 = Row(x, r.v[2]), x3 = Row(x, r.v[3]);
-    const Vec3 e = x3 - x2;
-    const Vec3 eps0[3] = {e, x0 - x3, x2 - x0}, eps1[3] = {-e, x3 - x1, x1 - x2};
-    AddTriangleAngleHessianUpper(x0, x2, x3, e.cross(x0 - x2), eps0, 0, u);
-    AddTriangleAngleHessianUpper(x1, x2, x3, (x1 - x2).cross(e), eps1, 1, u);
-    for (int k = 0; k < kPackedSize; ++k) u[k] *= d_energy;
-  } else {
-    d2_energy = std::max(d2_energy, 0.0);  // Gauss-Newton
-  }
+  Mat12 block;
+  DihedralHessianBlock(x, h, projection, &block);
   for (int a = 0; a < 12; ++a)
-    for (int b = a; b < 12; ++b) u[Packed(a, b)] += d2_energy * gv[a] * gv[b];
+    for (int b = a; b < 12; ++b) u[Packed(a, b)] = block(a, b);
 }
 
 void BendingElements::HessianBlocks(const Vertices& x, HessianProjection projection, long first,

@@ -3,6 +3,8 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_roots.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <memory>
 #include <sstream>
@@ -35,7 +37,11 @@ double PeirceFactor(double chord_angle) {
 class ChordExcess {
  public:
   ChordExcess(const BendingLaw& law, double areal_density, const CrossingOptions& options)
-      : law_(law), areal_density_(areal_density), barrier_angle_(options.barrier_angle) {
+      : law_(law),
+        areal_density_(areal_density),
+        barrier_angle_(options.barrier_angle),
+        max_seconds_(options.max_seconds),
+        solve_max_seconds_(options.elastica.max_seconds) {
     elastica_ = options.elastica;
     elastica_.arc_lengths.clear();
     elastica_.num_samples = 2;
@@ -51,6 +57,15 @@ class ChordExcess {
         return true;
       }
     }
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    if (elapsed >= max_seconds_) {
+      failure_ = "time cap of " + Number(max_seconds_) +
+                 " s (CrossingOptions::max_seconds) reached after " + std::to_string(solves_) +
+                 " elastica solves";
+      return false;
+    }
+    elastica_.max_seconds = std::min(solve_max_seconds_, max_seconds_ - elapsed);
     ++solves_;
     // A previous tip angle is a good start unless the strip hung nearly vertically (then the
     // angle alone has lost the information, and the solver's own estimate is better).
@@ -77,6 +92,8 @@ class ChordExcess {
  private:
   const BendingLaw& law_;
   double areal_density_, barrier_angle_;
+  double max_seconds_, solve_max_seconds_;  // the search's cap, each solve's own
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   ElasticaOptions elastica_;
   ElasticaProfile last_;
   double last_tip_angle_ = std::numeric_limits<double>::quiet_NaN();
@@ -119,6 +136,8 @@ bool CrossingOptions::Check(std::string* why) const {
     s << "rel_tol must be in [1e-13, 1e-3], got " << rel_tol;
   } else if (max_iterations < 2) {
     s << "max_iterations must be >= 2, got " << max_iterations;
+  } else if (!(std::isfinite(max_seconds) && max_seconds >= 0.0)) {
+    s << "max_seconds must be a finite number >= 0, got " << max_seconds;
   } else if (ElasticaOptions e = elastica; e.arc_lengths.clear(), !e.Check(&elastica_why)) {
     s << "elastica: " << elastica_why;
   }

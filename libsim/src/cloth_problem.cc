@@ -60,9 +60,6 @@ ClothProblem::ClothProblem(const TriangleMesh& rest, const Material& material,
       masses_(LumpedMasses(rest, material.areal_density, seams)),
       membrane_(rest, material, options.membrane),
       hinges_(BuildHinges(rest)),
-      bending_(rest, hinges_, material.EffectiveLaw().Scaled(options.bending_scale),
-               WeftLaw(material, options.bending_scale), options.bending,
-               Multipliers(rest, hinges_, seams)),
       is_fixed_(rest.num_vertices(), 0),
       anchors_(rest.num_vertices()) {
   const double g = options_.gravity.norm();
@@ -70,15 +67,20 @@ ClothProblem::ClothProblem(const TriangleMesh& rest, const Material& material,
   const double g_scale = g > 0.0 ? g : 9.80665;
   penalty_ = masses_ * (g_scale / options_.contact.sink_under_own_weight);
   tangential_stiffness_ = options_.contact.tangential_ratio * material.stretch_stiffness;
+  // Only the chosen discretisation is built; both take the hinges and their seam multipliers.
+  const BendingLaw warp = material.EffectiveLaw().Scaled(options_.bending_scale);
+  const std::optional<BendingLaw> weft = WeftLaw(material, options_.bending_scale);
+  const std::vector<double> multipliers = Multipliers(rest_, hinges_, seams);
   if (options_.discretization == BendingDiscretization::kTensor) {
-    tensor_.emplace(rest_, hinges_, material.EffectiveLaw().Scaled(options_.bending_scale),
-                    WeftLaw(material, options_.bending_scale), Multipliers(rest_, hinges_, seams));
+    tensor_.emplace(rest_, hinges_, warp, weft, multipliers);
+  } else {
+    bending_.emplace(rest_, hinges_, warp, weft, options_.bending, multipliers);
   }
   BuildPattern();
 }
 
 int ClothProblem::num_bending_elements() const {
-  return tensor_ ? tensor_->num_elements() : bending_.num_hinges();
+  return tensor_ ? tensor_->num_elements() : bending_->num_hinges();
 }
 
 void ClothProblem::BendingTriplets(const Vertices& x, HessianProjection projection, int first,
@@ -86,7 +88,7 @@ void ClothProblem::BendingTriplets(const Vertices& x, HessianProjection projecti
   if (tensor_) {
     tensor_->AddHessianTriplets(x, &triplets_, projection, first, end);
   } else {
-    bending_.AddHessianTriplets(x, &triplets_, projection, first, end);
+    bending_->AddHessianTriplets(x, &triplets_, projection, first, end);
   }
 }
 
@@ -252,7 +254,7 @@ double ClothProblem::ContactEnergyGradient(const Vertices& x, Vertices* grad) co
 }
 
 double ClothProblem::Energy(const Vertices& x) const {
-  double e = membrane_.Energy(x) + (tensor_ ? tensor_->Energy(x) : bending_.Energy(x));
+  double e = membrane_.Energy(x) + (tensor_ ? tensor_->Energy(x) : bending_->Energy(x));
   for (int i = 0; i < num_vertices(); ++i) e -= masses_(i) * options_.gravity.dot(x.row(i));
   return e + ContactEnergyGradient(x, nullptr);
 }
@@ -261,7 +263,7 @@ double ClothProblem::EnergyGradient(const Vertices& x, Vertices* grad) const {
   grad->setZero(x.rows(), 3);
   membrane_.AddGradient(x, *grad);
   double e = membrane_.Energy(x) +
-             (tensor_ ? tensor_->EnergyGradient(x, *grad) : bending_.EnergyGradient(x, *grad));
+             (tensor_ ? tensor_->EnergyGradient(x, *grad) : bending_->EnergyGradient(x, *grad));
   for (int i = 0; i < num_vertices(); ++i) {
     e -= masses_(i) * options_.gravity.dot(x.row(i));
     grad->row(i) -= masses_(i) * options_.gravity.transpose();

@@ -1,10 +1,12 @@
 #ifndef TEXTILE_SIM_SRC_HINGE_ANGLE_H_
 #define TEXTILE_SIM_SRC_HINGE_ANGLE_H_
 
-// The bend angle θ of a hinge with its gradient and Hessian, for the elements that are
-// functions of hinge angles (tensor_bending.cc). Hinge numbering as in mesh.h: wings x0, x1,
-// edge x2 → x3; θ is the signed angle of bending_element.h (HingeBendAngle). The derivation is
-// docs/bending.md, "Gradient of the bend angle" and "Hessian of the bend angle".
+// The bend angle θ of a hinge with its gradient and Hessian, the one scalar implementation for
+// the elements that are functions of hinge angles (bending_element.cc, tensor_bending.cc); the
+// SIMD kernels of bending_element.cc write the same formulas out lane by lane. Hinge numbering
+// as in mesh.h: wings x0, x1, edge x2 → x3; θ is the signed angle of bending_element.h
+// (HingeBendAngle). The derivation is docs/bending.md, "Gradient of the bend angle" and
+// "Hessian of the bend angle".
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -23,26 +25,43 @@ inline Eigen::Map<const Vec3> Position(const Vertices& x, int i) {
   return Eigen::Map<const Vec3>(x.data() + 3 * i);
 }
 
-// θ and ∂θ/∂x_k (k = 0..3) of the hinge with vertex ids v at positions x. The wings' gradients
-// are |e| n_k/|n_k|² (n_k the unnormalised triangle normals); the edge vertices take the
-// reactions at the wings' feet along the edge.
-inline double AngleAndGradient(const Vertices& x, const std::array<int, 4>& v,
-                               std::array<Vec3, 4>* grad) {
+// The bend angle as atan2(sin_term, cos_term): |n0||n1| sin θ and |n0||n1| cos θ, n0 = e × a0
+// and n1 = a1 × e the unnormalised normals of (x0, x2, x3) and (x1, x3, x2), e = x3 - x2,
+// a_k = x_k - x2. The dihedral elements (bending_element.cc) take them as they are: their laws
+// need cos θ and sin θ, or θ from their own vectorisable atan2.
+struct AngleTerms {
+  double sin_term, cos_term;
+};
+
+// The terms of θ and, when grad is given, ∂θ/∂x_k (k = 0..3) of the hinge with vertex ids v at
+// positions x. The wings' gradients are |e| n_k/|n_k|²; the edge vertices take the reactions
+// at the wings' feet along the edge.
+inline AngleTerms AngleTermsAndGradient(const Vertices& x, const std::array<int, 4>& v,
+                                        std::array<Vec3, 4>* grad) {
   const Vec3 x2 = Position(x, v[2]);
   const Vec3 e = Position(x, v[3]) - x2;
   const Vec3 a0 = Position(x, v[0]) - x2, a1 = Position(x, v[1]) - x2;
   const Vec3 n0 = e.cross(a0), n1 = a1.cross(e);
   const double l2 = e.squaredNorm(), l = std::sqrt(l2);
-  const double theta = std::atan2(l * n1.dot(a0), n0.dot(n1));
   if (grad) {
-    const Vec3 g0 = n0 * (l / n0.squaredNorm()), g1 = n1 * (l / n1.squaredNorm());
-    const double t0 = a0.dot(e) / l2, t1 = a1.dot(e) / l2;  // the wings' feet on the edge
+    // As the SIMD kernels of bending_element.cc compute it, so that both give the same bits.
+    const double n0sq = n0.squaredNorm(), n1sq = n1.squaredNorm();
+    const double inv = 1.0 / (n0sq * n1sq), inv_l2 = 1.0 / l2;
+    const Vec3 g0 = n0 * (l * n1sq * inv), g1 = n1 * (l * n0sq * inv);
+    const double t0 = a0.dot(e) * inv_l2, t1 = a1.dot(e) * inv_l2;  // the wings' feet on the edge
     (*grad)[0] = g0;
     (*grad)[1] = g1;
     (*grad)[2] = (t0 - 1.0) * g0 + (t1 - 1.0) * g1;
     (*grad)[3] = -t0 * g0 - t1 * g1;
   }
-  return theta;
+  return {l * n1.dot(a0), n0.dot(n1)};  // (n1 × n0)·e/|e| = |e| (a1 × e)·a0
+}
+
+// θ and ∂θ/∂x_k (k = 0..3), as AngleTermsAndGradient.
+inline double AngleAndGradient(const Vertices& x, const std::array<int, 4>& v,
+                               std::array<Vec3, 4>* grad) {
+  const AngleTerms t = AngleTermsAndGradient(x, v, grad);
+  return std::atan2(t.sin_term, t.cos_term);
 }
 
 // One triangle (wing w, edge x2 → x3, unnormalised normal n) of ∇²θ, times scale, into the

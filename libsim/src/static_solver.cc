@@ -147,7 +147,8 @@ struct Run {
   std::string Stop(double energy, double residual) const {
     if (!std::isfinite(energy) || !std::isfinite(residual) || !x->allFinite())
       return "the state became non-finite (NaN or inf)";
-    if (Since(start) > options.max_seconds)
+    // ≥, so that a cap of 0 stops every run at its first check (the tests' deterministic cap).
+    if (Since(start) >= options.max_seconds)
       return "time cap of " + std::to_string(options.max_seconds) + " s reached";
     if (start_height - CentreHeight(*problem, *x, down) > options.fall_limit * diagonal)
       return "the cloth falls: nothing holds it (it sank " + std::to_string(options.fall_limit) +
@@ -361,7 +362,8 @@ bool SolveOptions::Check(std::string* why) const {
   };
   if (!(tolerance > 0.0) || !std::isfinite(tolerance)) return fail("tolerance must be > 0");
   if (max_iterations < 0) return fail("max_iterations must be >= 0");
-  if (!(max_seconds > 0.0)) return fail("max_seconds must be > 0");
+  if (!(std::isfinite(max_seconds) && max_seconds >= 0.0))
+    return fail("max_seconds must be a finite number >= 0");
   if (!(max_step >= 0.0) || !std::isfinite(max_step)) return fail("max_step must be >= 0");
   if (!(time_step > 0.0) || !std::isfinite(time_step)) return fail("time_step must be > 0");
   if (!(cg_tolerance > 0.0) || cg_tolerance >= 1.0) return fail("cg_tolerance must be in (0, 1)");

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -178,6 +179,36 @@ TEST(BarrierCrossing, WorksAcrossTheParameterRange) {
         EXPECT_LE(c.elastica_solves, 25) << c.BriefReport();
       }
     }
+  }
+}
+
+TEST(BarrierCrossing, CapsEndInFailureWithoutNumbers) {
+  const BendingLaw fig8 = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+  const double rho = units::GsmToSi(200.0);
+  auto expect_failed = [](const BarrierCrossing& c, const std::string& words) {
+    EXPECT_FALSE(c.converged);
+    EXPECT_NE(c.message.find(words), std::string::npos) << c.message;
+    EXPECT_TRUE(std::isnan(c.overhang));
+    EXPECT_TRUE(std::isnan(c.tip_y));
+    EXPECT_NE(c.BriefReport().find("FAILED"), std::string::npos);
+  };
+  // Two iterations cannot bracket and refine the root (the default search takes more).
+  CrossingOptions o;
+  o.max_iterations = 2;
+  const BarrierCrossing few = FindBarrierCrossing(fig8, rho, o);
+  EXPECT_GT(Cross(fig8, rho).elastica_solves, 3);
+  expect_failed(few, few.message.find("bracketing") != std::string::npos ? "bracketing" : "Brent");
+  // A time cap of 0 s has passed before the first solve, on any machine.
+  o = {};
+  o.max_seconds = 0.0;
+  const BarrierCrossing late = FindBarrierCrossing(fig8, rho, o);
+  expect_failed(late, "time cap of 0 s");
+  EXPECT_EQ(late.elastica_solves, 0);
+  for (double bad : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    o.max_seconds = bad;
+    std::string why;
+    EXPECT_FALSE(o.Check(&why)) << bad;
+    EXPECT_NE(why.find("max_seconds"), std::string::npos) << why;
   }
 }
 

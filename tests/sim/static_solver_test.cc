@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "textile/sim/error.h"
@@ -143,6 +144,44 @@ TEST(StaticSolver, CapsStopARunAndSayWhyWithoutClaimingConvergence) {
   EXPECT_NE(s.message.find("iteration cap of 2"), std::string::npos) << s.message;
   EXPECT_NE(s.BriefReport().find("NOT converged"), std::string::npos);
   EXPECT_GT(s.residual, options.tolerance);
+}
+
+TEST(StaticSolver, TimeCapStopsARunWithoutClaimingConvergence) {
+  // A cap of 0 s has passed at the first check, whatever the machine: the failure path is
+  // reached deterministically, with either method.
+  for (SolverMethod method : {SolverMethod::kNewton, SolverMethod::kKineticDamping}) {
+    HangingSheet sheet;
+    Vertices x = sheet.mesh.vertices;
+    SolveOptions options;
+    options.method = method;
+    options.max_seconds = 0.0;
+    const SolveSummary s = SolveStatic(sheet.problem.get(), &x, options);
+    EXPECT_FALSE(s.converged) << SolverMethodName(method);
+    EXPECT_NE(s.message.find("time cap of 0"), std::string::npos) << s.message;
+    EXPECT_NE(s.BriefReport().find("NOT converged"), std::string::npos);
+    EXPECT_EQ(s.iterations, 0);
+  }
+  // The cap must be a usable number.
+  for (double bad : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    SolveOptions options;
+    options.max_seconds = bad;
+    std::string why;
+    EXPECT_FALSE(options.Check(&why)) << bad;
+    EXPECT_NE(why.find("max_seconds"), std::string::npos) << why;
+  }
+}
+
+TEST(StaticSolver, ANonFiniteStateStopsARunWithoutClaimingConvergence) {
+  // Gravity of 1e200 m/s² is finite, but the squared weights of the residual overflow: the
+  // residual is inf/inf = NaN at the first check, which must end the run as a failure.
+  ClothOptions huge;
+  huge.gravity = {0.0, 0.0, -1e200};
+  HangingSheet sheet(10, 6, huge);
+  Vertices x = sheet.mesh.vertices;
+  const SolveSummary s = SolveStatic(sheet.problem.get(), &x, {});
+  EXPECT_FALSE(s.converged);
+  EXPECT_NE(s.message.find("non-finite"), std::string::npos) << s.message;
+  EXPECT_NE(s.BriefReport().find("NOT converged"), std::string::npos);
 }
 
 TEST(StaticSolver, ImpossibleProblemsAreReportedAsSuch) {
@@ -428,6 +467,29 @@ TEST(ClothProblem, FixedVerticesHaveIdentityRowsAndZeroForce) {
       }
       EXPECT_GT(h.coeff(dof, dof), 0.0);
     }
+  }
+}
+
+TEST(ClothProblem, BuildsOnlyTheChosenBendingDiscretisation) {
+  // Each discretisation is built alone, and the problem's energy is the membrane's plus that
+  // one's bending energy (the tensor problem carries no hinge elements behind it).
+  const TriangleMesh mesh = CrissCrossGridMesh(0.05, 0.05, 3, 3);
+  Vertices x = mesh.vertices;
+  for (int i = 0; i < x.rows(); ++i) x(i, 2) = 4.0 * x(i, 0) * x(i, 0);  // bent about y
+  for (BendingDiscretization d : {BendingDiscretization::kHinge, BendingDiscretization::kTensor}) {
+    ClothOptions options;
+    options.discretization = d;
+    options.gravity.setZero();
+    const ClothProblem problem(mesh, Cotton(), {}, options);
+    const bool tensor = d == BendingDiscretization::kTensor;
+    ASSERT_EQ(problem.hinge_bending() == nullptr, tensor);
+    ASSERT_EQ(problem.tensor_bending() == nullptr, !tensor);
+    const double bending =
+        tensor ? problem.tensor_bending()->Energy(x) : problem.hinge_bending()->Energy(x);
+    EXPECT_GT(bending, 0.0);
+    // Same terms, summed in another order: a few ulps.
+    EXPECT_NEAR(problem.Energy(x), problem.membrane().Energy(x) + bending,
+                1e-12 * problem.Energy(x));
   }
 }
 

@@ -443,6 +443,29 @@ TEST(CliFit, PhotoInputsNeedARigAndAreNamedWhenBad) {
   }
 }
 
+TEST(CliFit, LargePhotosAreExtractedQuietlyUnlessProgressIsAsked) {
+  // Photos over 4 MP get an "extracting ..." progress line, on stderr only when it is a terminal
+  // or with --progress (as `textile extract`): a script's stderr of a good run stays empty.
+  const auto dir = Scratch("cli_fit_large_photo");
+  const fs::path photo = dir / "big.jpg", rig = dir / "big.rig-truth.json";
+  const auto render = Textile("render-photo --material " + kFig8 + " --overhang-mm 60 -o " +
+                              Quote(photo) + " --size 2400x1700 --difficulty easy");
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  ASSERT_GT(cv::imread(photo.string(), cv::IMREAD_GRAYSCALE).total(), 4e6);
+  const std::string args = "fit " + Quote(photo) + " --rig " + Quote(rig) + " --gsm 200 -o ";
+  const auto quiet = Textile(args + Quote(dir / "quiet.json"));
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "");
+  const auto verbose = Textile(args + Quote(dir / "verbose.json") + " --progress");
+  ASSERT_EQ(verbose.exit_code, 0) << verbose.err;
+  EXPECT_EQ(verbose.err, "extracting " + photo.string() + " ...\n");
+  // The flag changes nothing but stderr: the same law.
+  const Material a = ReadMaterial((dir / "quiet.json").string());
+  const Material b = ReadMaterial((dir / "verbose.json").string());
+  EXPECT_EQ(a.bending.b1(), b.bending.b1());
+  EXPECT_EQ(a.bending.c1(), b.bending.c1());
+}
+
 TEST(CliFit, ShippedPhotosGiveTheExpectedLawAndTheTruthWithinOnePercent) {
   // samples/photos: rendered photos (medium level) of two of the paper's fabrics, their boards.
   // Calibrate on the board, fit the photos: the shipped expected law is reproduced, and the

@@ -67,7 +67,7 @@ std::vector<LoadedProfile> LoadProfileInputs(const std::vector<std::string>& pat
     }
     if (!rig) rig = RigFromOptions(options, path + " is a photo");
     cv::Mat gray = ReadPhotoGray(path);
-    if (gray.total() > 4e6) Info("extracting " + path + " ...");
+    if (gray.total() > 4e6) Progress("extracting " + path + " ...", options.progress);
     ExtractionSummary r = ExtractProfile(gray, *rig, options.extract, path);
     if (!r.success) throw ComputeError(path + ": " + r.message);
     in.profile = r.profile;
@@ -117,6 +117,7 @@ PhotoInputOptions PhotoFlags::Options() const {
   if (!edge.empty()) e.edge_px = ParseEdgePx(edge);
   if (level_option && level_option->count() > 0) e.level_deg = level_deg;
   e.step_mm = step_mm;
+  o.progress = progress;
   std::string why;
   if (!e.Check(&why)) {
     const std::string flag = why.rfind("step", 0) == 0    ? "--step-mm"
@@ -145,6 +146,9 @@ void AddPhotoFlags(CLI::App* sub, PhotoFlags* f) {
   sub->add_option("--rig-type", f->rig_type, "auto (default), platform (fail if none is found) or clamp")
       ->check(CLI::IsMember({"auto", "platform", "clamp"}));
   sub->add_option("--step-mm", f->step_mm, "Profile spacing along the arc length [mm] (default 0.5)");
+  sub->add_flag("--progress", f->progress,
+                "Print the progress lines of photo extraction on stderr even when it is not a "
+                "terminal");
 }
 
 }  // namespace textile::cli

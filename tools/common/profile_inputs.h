@@ -35,6 +35,7 @@ struct PhotoInputOptions {
   std::optional<double> mm_per_px;      // a plain scale [mm/px]; at most one of the two
   ExtractOptions extract;               // trace, rig type, edge, level, step
   bool keep_photos = false;             // keep the decoded grey photos (for overlays)
+  bool progress = false;  // "extracting ..." lines on stderr even when it is not a terminal
 };
 
 struct LoadedProfile {
@@ -55,6 +56,8 @@ Rig RigFromOptions(const PhotoInputOptions& options, const std::string& what);
 // Loads every path in order: CSVs read and checked, photos extracted. Throws on the first
 // failure (InputError or ComputeError, naming the file). A photo without a rig or scale is an
 // InputError naming it; both --rig and --mm-per-px is one too. The rig file is read once.
+// A photo over 4 MP gets a progress line "extracting <path> ..." on stderr, printed only when
+// stderr is a terminal or options.progress is set (Progress in cli.h).
 std::vector<LoadedProfile> LoadProfileInputs(const std::vector<std::string>& paths,
                                              const PhotoInputOptions& options);
 
@@ -62,14 +65,15 @@ std::vector<LoadedProfile> LoadProfileInputs(const std::vector<std::string>& pat
 struct PhotoFlags {
   std::string rig_file, edge, trace = "mid", rig_type = "auto";
   double mm_per_px = 0.0, level_deg = 0.0, step_mm = 0.5;
+  bool progress = false;
   CLI::Option *rig_option = nullptr, *scale_option = nullptr, *level_option = nullptr;
 
   // The options these flags give; throws InputError naming the flag ("--edge-px: ...").
   PhotoInputOptions Options() const;
 };
 
-// Adds --rig, --mm-per-px, --trace, --rig-type, --edge-px, --level-deg and --step-mm to a
-// subcommand, bound to *flags (which must outlive the parse).
+// Adds --rig, --mm-per-px, --trace, --rig-type, --edge-px, --level-deg, --step-mm and
+// --progress to a subcommand, bound to *flags (which must outlive the parse).
 void AddPhotoFlags(CLI::App* sub, PhotoFlags* flags);
 
 // "X,Y" in pixels (--edge-px); throws InputError.

@@ -203,6 +203,9 @@ class BendingElements {
   static constexpr int kMaxThreads = 64;
   template <bool kWithEnergy, bool kWithGradient>
   double Evaluate(const Vertices& x, double* grad) const;
+  // Dihedral hinge h's 12×12 Hessian block (rows/columns 3k..3k+2: vertex v[k]), projected.
+  void DihedralHessianBlock(const Vertices& x, int h, HessianProjection projection,
+                            Eigen::Matrix<double, 12, 12>* block) const;
   // Hinge h's Hessian block, packed upper triangle of the 12×12 block (78 values) into u.
   void HingeHessianUpper(const Vertices& x, int h, HessianProjection projection, double* u) const;
   // The same for hinges first ≤ h < first + count (count ≤ kSimdLanes), lane-minor:

@@ -38,6 +38,10 @@ struct CrossingOptions {
   double rel_tol = 1e-10;
   // Cap on root-finding iterations (bracketing and Brent together).
   int max_iterations = 100;
+  // Wall-time cap of the whole search [s], finite, ≥ 0 (0: fail before the first solve). Each
+  // elastica solve gets at most the time left (and at most elastica.max_seconds). A crossing
+  // takes milliseconds; without it, 100 iterations of 5 s solves could run for minutes.
+  double max_seconds = 30.0;
   // Options of each elastica solve; the sampling and sensitivities are ignored.
   ElasticaOptions elastica;
 

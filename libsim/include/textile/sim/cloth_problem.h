@@ -112,7 +112,8 @@ class ClothProblem {
   const std::vector<int>& fixed_vertices() const { return fixed_; }
   const std::vector<char>& is_fixed() const { return is_fixed_; }
   const MembraneElements& membrane() const { return membrane_; }
-  const BendingElements& bending() const { return bending_; }
+  // The hinge bending when options().discretization is kHinge, else null (not built).
+  const BendingElements* hinge_bending() const { return bending_ ? &*bending_ : nullptr; }
   // The curvature-tensor bending when options().discretization is kTensor, else null.
   const TensorBending* tensor_bending() const { return tensor_ ? &*tensor_ : nullptr; }
   const ClothOptions& options() const { return options_; }
@@ -144,8 +145,8 @@ class ClothProblem {
   Eigen::VectorXd masses_;
   MembraneElements membrane_;
   std::vector<Hinge> hinges_;
-  BendingElements bending_;
-  std::optional<TensorBending> tensor_;
+  std::optional<BendingElements> bending_;  // kHinge only
+  std::optional<TensorBending> tensor_;     // kTensor only
   std::vector<Support> supports_;
   std::vector<int> fixed_;
   std::vector<char> is_fixed_;

@@ -48,7 +48,7 @@ struct SolveOptions {
   HessianProjection projection = HessianProjection::kGaussNewton;
   double tolerance = 1e-6;       // on the relative residual [-]
   int max_iterations = 1000;     // Newton steps or kinetic-damping time steps
-  double max_seconds = 60.0;     // wall-time cap [s]
+  double max_seconds = 60.0;     // wall-time cap [s], finite, ≥ 0 (0: stop at the first check)
   // Largest vertex displacement of one Newton step [m]; 0: 10 % of the pattern's diagonal.
   double max_step = 0.0;
   // Kinetic damping's time step [s]. The implicit step is stable for any h; larger steps

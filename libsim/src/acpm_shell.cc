@@ -264,7 +264,16 @@ AcpmCrossings Push(const Material& material, const AcpmOptions& options, const A
       return out;
     }
     int side = 0;
-    while (hi - lo > options.crossing_tolerance) {
+    // Illinois converges superlinearly (4-8 solves per ray here); the cap only guards against
+    // a bracket that floating point cannot narrow further.
+    constexpr int kMaxRefinements = 60;
+    for (int refinement = 0; hi - lo > options.crossing_tolerance; ++refinement) {
+      if (refinement == kMaxRefinements) {
+        out.message = "shell model: ray " + std::to_string(r) + "'s crossing did not narrow to " +
+                      std::to_string(units::MToMm(options.crossing_tolerance)) + " mm in " +
+                      std::to_string(kMaxRefinements) + " solves";
+        return out;
+      }
       double mid = hi - f_hi * (hi - lo) / (f_hi - f_lo);
       if (!(mid > lo && mid < hi)) mid = 0.5 * (lo + hi);
       const Solved* s = solve(mid);

@@ -107,6 +107,21 @@ TEST(AcpmShell, SeamAlongThePushStiffensTheRaysNearItSymmetrically) {
   EXPECT_GT(shell.overhang[2], shell.plain_overhang);
 }
 
+TEST(AcpmShell, CrossingRefinementIsCapped) {
+  // A tolerance below the spacing of doubles at L (~3e-18 m at 33 mm) can never be reached:
+  // the refinement stops at its cap and says so instead of looping.
+  const Material m = Fabric(0.1, 0.0892, -0.0092, 200);
+  AcpmOptions options;
+  options.num_rays = 1;
+  options.crossing_tolerance = 1e-18;
+  ShellAcpmSettings settings;
+  settings.element_length = 0.004;
+  settings.extrapolate = false;
+  const AcpmCrossings shell = ShellAcpmCrossings(m, options, options.RayPositions(), settings);
+  EXPECT_FALSE(shell.converged);
+  EXPECT_NE(shell.message.find("did not narrow"), std::string::npos) << shell.message;
+}
+
 TEST(AcpmShell, BadSettingsAreRefused) {
   const Material m = Fabric(0.1, 0.0892, -0.0092, 200);
   AcpmOptions options;

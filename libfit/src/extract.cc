@@ -1238,6 +1238,16 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
     if (options.rig == RigKind::kPlatform && !platform.found) {
       return fail("platform not found: " + platform_why);
     }
+    // The strip lies on a block that could not be measured as a platform. Taken for a clamp
+    // instead, the origin would be put where the strip leaves the image border (extrapolated)
+    // or where its held end lies on the block, either far behind the platform's edge, and the
+    // profile would be wrong with no sign of it: refuse.
+    if (!platform.found && platform.under_strip &&
+        (root_how == "border" || root_how == "block")) {
+      return fail("the strip lies on a block that looks like a platform, but " + platform_why +
+                  "; give the platform's edge with --edge-px X,Y (and --level-deg if the camera "
+                  "is rolled), or --rig-type clamp if the block is a clamp");
+    }
   }
   for (const Block& b : blocks) {
     std::vector<std::vector<cv::Point>> contours;

@@ -54,6 +54,9 @@ struct PlatformFit {
   Vec2 top_far{0, 0};    // far end of the measured top face [px]
   Vec2 front_low{0, 0};  // low end of the measured front face [px]
   double top_angle = 0;  // top face direction, counter-clockwise from the image rows [rad]
+  // The strip lies on the block's top behind its corner (also when not found: a platform
+  // that could not be measured).
+  bool under_strip = false;
 };
 
 // Looks for a platform block under the root of the strip. `block` is on the reduced image

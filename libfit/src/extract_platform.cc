@@ -57,7 +57,13 @@ double FitLineRobust(const std::vector<Vec2>& uv, double* a, double* b, int* kep
 
 // Position of the first clear intensity step along a line of samples, searching from the
 // start (inside the block) outwards: the first local maximum of |derivative| that reaches 30 %
-// of the largest one on the line, refined by a parabola. -1 if there is none. Units: samples.
+// of the largest one on the line and is not noise, refined by a parabola. -1 if there is none.
+// Units: samples. Not noise: the grey level changes across it by 30 % of the largest such
+// change on the line, or its derivative stands 6 σ above the noise's. On a long line (a thick
+// strip at 50 MP searches 50 px into the block) the noise alone has derivative peaks of 30 % of
+// a 30-grey-level face's, but the mean grey 1.5-4 px either side of such a peak hardly differs;
+// the edge between a platform and a strip 3-5 px thick lying on it changes the mean less than
+// that (the strip is narrower than the window) but is far above the noise.
 double FirstStep(const std::vector<double>& v) {
   const int n = static_cast<int>(v.size());
   if (n < 5) return -1.0;
@@ -65,12 +71,38 @@ double FirstStep(const std::vector<double>& v) {
   for (int i = 1; i + 1 < n; ++i) d[i] = std::abs(v[i + 1] - v[i - 1]) / 2.0;
   const double top = *std::max_element(d.begin(), d.end());
   if (top <= 0.0) return -1.0;
+  // The derivative's noise: a few samples are edges, the median is the noise's.
+  const double noise = 1.4826 * Median(std::vector<double>(d.begin() + 1, d.end() - 1));
+  // |mean of samples i+3..i+8 - mean of samples i-8..i-3| (1.5-4 px: past the blur of a face),
+  // clipped to the line.
+  const auto change = [&](int i) {
+    double before = 0.0, after = 0.0;
+    int nb = 0, na = 0;
+    for (int k = 3; k <= 8; ++k) {
+      if (i - k >= 0) {
+        before += v[i - k];
+        ++nb;
+      }
+      if (i + k < n) {
+        after += v[i + k];
+        ++na;
+      }
+    }
+    return nb > 0 && na > 0 ? std::abs(after / na - before / nb) : 0.0;
+  };
+  std::vector<int> peaks;
+  double top_change = 0.0;
   for (int i = 2; i + 2 < n; ++i) {
     if (d[i] >= 0.3 * top && d[i] >= d[i - 1] && d[i] > d[i + 1]) {
-      const double den = d[i - 1] - 2.0 * d[i] + d[i + 1];
-      const double delta = den < 0.0 ? 0.5 * (d[i - 1] - d[i + 1]) / den : 0.0;
-      return i + std::clamp(delta, -0.5, 0.5);
+      peaks.push_back(i);
+      top_change = std::max(top_change, change(i));
     }
+  }
+  for (int i : peaks) {
+    if (change(i) < 0.3 * top_change && d[i] < 6.0 * noise) continue;
+    const double den = d[i - 1] - 2.0 * d[i] + d[i + 1];
+    const double delta = den < 0.0 ? 0.5 * (d[i - 1] - d[i + 1]) / den : 0.0;
+    return i + std::clamp(delta, -0.5, 0.5);
   }
   return -1.0;
 }
@@ -253,6 +285,19 @@ PlatformFit FitPlatform(const cv::Mat& gray, const Block& block, double scale, i
     return fit;
   }
   const Vec2 corner0(front_x, full(top_of[behind]));
+  // Does the strip lie on the block (a platform, whatever the measurement below makes of it)?
+  // It does if its centre line runs just above the block's top for a stretch behind the corner;
+  // a strip leaving a clamp starts at the clamp's face. The top on the reduced image lies below
+  // the strip's zone (a thickness and a reduced pixel or two): a generous tolerance.
+  int on_top = 0;
+  for (const Vec2& p : path) {
+    if ((p.x() - corner0.x()) * direction > -margin) continue;
+    const int x = column(p.x());
+    if (top_of[x] < 0) continue;
+    const double above = full(top_of[x]) - p.y();
+    if (above >= 0.0 && above <= 3.0 * thickness + 3.0 / scale) ++on_top;
+  }
+  fit.under_strip = on_top >= std::max(2.0 * thickness, 20.0);  // path points are 1 px apart
 
   // Top face: vertical scans from inside the block upwards, spread over its far part.
   const double x_far = direction > 0 ? full(box.x) + 3.0 : full(box.x + box.width - 1) - 3.0;

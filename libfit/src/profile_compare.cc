@@ -7,6 +7,7 @@
 #include "cost_functions/profile_model.h"
 #include "law_parameters.h"
 #include "textile/sim/error.h"
+#include "textile/sim/polyline.h"
 
 namespace textile {
 
@@ -90,26 +91,11 @@ ProfileComparison CompareWithCurve(const Profile& measured, const std::vector<do
   ProfileComparison c;
   Densify(curve_x, curve_y, 8, &c.model_x, &c.model_y);
   for (double& y : c.model_y) y += offset;
-  const size_t m = c.model_x.size();
   double s2 = 0.0;
   for (size_t j = 0; j < measured.size(); ++j) {
-    const double px = measured.x[j], py = measured.y[j];
-    double best = std::numeric_limits<double>::infinity(), dist = 0.0;
-    for (size_t k = 0; k + 1 < m; ++k) {
-      const double ex = c.model_x[k + 1] - c.model_x[k], ey = c.model_y[k + 1] - c.model_y[k];
-      const double len2 = ex * ex + ey * ey;
-      if (!(len2 > 0.0)) continue;
-      const double rx = px - c.model_x[k], ry = py - c.model_y[k];
-      const double t = (rx * ex + ry * ey) / len2;
-      const double tc = std::clamp(t, 0.0, 1.0);
-      const double d2 = (rx - tc * ex) * (rx - tc * ex) + (ry - tc * ey) * (ry - tc * ey);
-      if (d2 < best) {
-        best = d2;
-        // Beyond an end of the curve: the distance from that end's tangent line.
-        const bool beyond = (k == 0 && t < 0.0) || (k + 2 == m && t > 1.0);
-        dist = beyond ? std::abs(rx * ey - ry * ex) / std::sqrt(len2) : std::sqrt(d2);
-      }
-    }
+    // Beyond an end of the curve: the distance from that end's tangent line.
+    const double dist = DistanceToPolyline(c.model_x, c.model_y, measured.x[j], measured.y[j],
+                                           /*extend_ends=*/true);
     s2 += dist * dist;
     c.max = std::max(c.max, dist);
   }

@@ -16,6 +16,7 @@
 
 #include "textile/sim/elastica.h"
 #include "textile/sim/error.h"
+#include "textile/sim/polyline.h"
 
 namespace textile {
 namespace {
@@ -395,16 +396,7 @@ bool RenderPhotoOptions::Check(std::string* why) const {
 }
 
 double DistanceToProfile(const Profile& truth, double x, double y) {
-  double best = 1e300;
-  const Eigen::Vector2d q(x, y);
-  for (size_t i = 0; i + 1 < truth.size(); ++i) {
-    const Eigen::Vector2d a(truth.x[i], truth.y[i]), b(truth.x[i + 1], truth.y[i + 1]);
-    const Eigen::Vector2d d = b - a;
-    const double len2 = d.squaredNorm();
-    const double t = len2 > 0 ? std::clamp((q - a).dot(d) / len2, 0.0, 1.0) : 0.0;
-    best = std::min(best, (a + t * d - q).norm());
-  }
-  return best;
+  return DistanceToPolyline(truth.x, truth.y, x, y);
 }
 
 RenderedPhoto RenderPhoto(const BendingLaw& law, double areal_density,

@@ -9,6 +9,7 @@
 #include "textile/sim/cantilever_outputs.h"
 #include "textile/sim/elastica.h"
 #include "textile/sim/error.h"
+#include "textile/sim/polyline.h"
 
 namespace textile {
 namespace {
@@ -142,16 +143,7 @@ Gap GapToElastica(const Material& m, double overhang, const std::vector<double>&
   const ElasticaProfile e = SolveHeavyElastica(m.EffectiveLaw(), m.areal_density, overhang, eo);
   EXPECT_TRUE(e.converged) << e.message;
   Gap g;
-  for (size_t j = 0; j < x.size(); ++j) {
-    double best = std::numeric_limits<double>::infinity();
-    for (size_t q = 0; q + 1 < e.x.size(); ++q) {
-      const double dx = e.x[q + 1] - e.x[q], dy = e.y[q + 1] - e.y[q];
-      const double rx = x[j] - e.x[q], ry = y[j] - e.y[q];
-      const double t = std::clamp((rx * dx + ry * dy) / (dx * dx + dy * dy), 0.0, 1.0);
-      best = std::min(best, std::hypot(rx - t * dx, ry - t * dy));
-    }
-    g.max = std::max(g.max, best);
-  }
+  g.max = MaxDistanceToPolyline(e.x, e.y, x, y);
   g.tip = std::hypot(x.back() - e.x.back(), y.back() - e.y.back());
   return g;
 }

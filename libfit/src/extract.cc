@@ -892,7 +892,7 @@ SectionSet TrackStrip(const cv::Mat& gray, const cv::Mat& mid, int f, const std:
     set = AnalyseSections(gray, line, direction, polarity, half_1, 0.6 * half_1);
   }
   RejectOutliers(&set);
-  for (int pass = 0; pass < 8; ++pass) {
+  for (int pass = 0; pass < 12; ++pass) {
     std::vector<Vec2> guide;
     double w_max;
     if (!NextGuide(set, &guide, &w_max)) {
@@ -911,11 +911,18 @@ SectionSet TrackStrip(const cv::Mat& gray, const cv::Mat& mid, int f, const std:
     set = AnalyseSections(gray, line, direction, polarity, half_2, 0.5 * w_max + 3.0);
     set_f = 1;
     RejectOutliers(&set);
-    // Done unless the strip still shows at the far end of the extension.
+    // Done unless the strip still shows at the far end of the extension, or it was followed
+    // well into the extension: the extension is straight, and a strip that curves leaves it
+    // before its far end although it goes on (the next guide follows it further). A strip
+    // that ends is measured to where the previous guide ended, and no further.
     double unused;
     const std::pair<int, int> now = TrimmedRun(set, TraceLine::kMid, &unused);
     const int far_end = static_cast<int>(set.s.size()) - 1 - static_cast<int>(0.5 * ahead);
-    if (pass > 0 && now.second < far_end) break;
+    if (now.second < now.first) break;
+    const Vec2 tangent =
+        (guide.back() - guide[guide.size() > 10 ? guide.size() - 11 : 0]).normalized();
+    const bool grew = (set.p[now.second] - guide.back()).dot(tangent) > std::max(5.0, width);
+    if (pass > 0 && now.second < far_end && !grew) break;
   }
   return set;
 }
@@ -967,10 +974,16 @@ double FindTip(const cv::Mat& gray, const Vec2& centre, const Vec2& tangent, con
   for (size_t k = 1; k < t_at.size(); ++k) {
     if (t_at[k] < -0.5 * w) continue;
     if (pts[k].x() < half) {
-      const double a0 = pts[k - 1].x(), a1 = pts[k].x();
-      const double f = a0 > a1 ? (a0 - half) / (a0 - a1) : 0.0;
+      // The width may have fallen below half already before -w/2 (the end lies a little
+      // behind `centre`): the crossing is the last one before k, not an extrapolation from
+      // the two samples at k.
+      size_t j = k;
+      while (j > 0 && pts[j - 1].x() < half) --j;
       *status = TipStatus::kFound;  // the strip ends before the image does
-      return t_at[k - 1] + f * (t_at[k] - t_at[k - 1]);
+      if (j == 0) return t_at[0];
+      const double a0 = pts[j - 1].x(), a1 = pts[j].x();
+      const double f = std::clamp((a0 - half) / (a0 - a1), 0.0, 1.0);
+      return t_at[j - 1] + f * (t_at[j] - t_at[j - 1]);
     }
   }
   if (*status == TipStatus::kFound) *status = TipStatus::kNoEnd;
@@ -1234,6 +1247,22 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
       platform =
           extract_internal::FitPlatform(gray, blocks[best_k], scale, direction, coarse, t_full);
       if (!platform.found) platform_why = platform.why_not;
+    } else if (root_how == "border" || root_how == "guess") {
+      // No region stands out under the held end, and the strip comes in from the border (a
+      // clamp out of view?) or from nowhere: a platform whose faces the light makes as light
+      // as the background in places, or whose top merges with the strip, still shows its
+      // front face as a long straight edge.
+      if (auto block = extract_internal::FindBlockByFrontEdge(small, strip_zone, coarse, scale,
+                                                              direction, t_small)) {
+        platform = extract_internal::FitPlatform(gray, *block, scale, direction, coarse, t_full);
+        if (!platform.found) platform_why = platform.why_not;
+        blocks.push_back(std::move(*block));
+        if (platform.found && root_how == "guess") {
+          std::erase_if(r.warnings, [](const std::string& w) {
+            return w.starts_with("no clamp, platform or border holds the strip");
+          });
+        }
+      }
     }
     if (options.rig == RigKind::kPlatform && !platform.found) {
       return fail("platform not found: " + platform_why);

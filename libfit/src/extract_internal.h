@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,16 @@ struct Block {
 // [px] and cover at least 1 % of the image are returned. `ignore` (CV_8U) marks pixels to leave
 // out of the background fit (the strip).
 std::vector<Block> FindBlocks(const cv::Mat& small, const cv::Mat& ignore, double min_thickness);
+
+// A platform that does not stand out from the background as a region (a strong light gradient
+// or shadow makes its faces as light as the background somewhere), found by its front face
+// instead: the straightest long edge of one sign that runs from just below the held, level part
+// of the strip's line (`path`, full px) down to the bottom of the reduced image `small`, within
+// ±12° of the vertical. `ignore` marks the strip. Returns the region behind that edge and below
+// the strip as a block for FitPlatform, or nothing if no edge stands out from the noise.
+std::optional<Block> FindBlockByFrontEdge(const cv::Mat& small, const cv::Mat& ignore,
+                                          const std::vector<Vec2>& path, double scale,
+                                          int direction, double min_thickness);
 
 // A platform found at full resolution: its top face and front face as lines, and their corner.
 struct PlatformFit {

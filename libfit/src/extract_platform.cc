@@ -4,6 +4,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <opencv2/imgproc.hpp>
 
 #include "extract_internal.h"
@@ -107,16 +108,27 @@ double FirstStep(const std::vector<double>& v) {
   return -1.0;
 }
 
-// Samples of the grey image from `from` towards `to`, every 0.5 px, smoothed with σ = 1 px.
-std::vector<double> LineSamples(const cv::Mat& gray, const Vec2& from, const Vec2& to) {
+// Samples of the grey image from `from` towards `to`, every 0.5 px, smoothed with σ = 1 px
+// along the line and averaged over `across` px either side of it (along the face being
+// scanned for: faint faces under heavy noise need the average).
+std::vector<double> LineSamples(const cv::Mat& gray, const Vec2& from, const Vec2& to,
+                                int across) {
   const double len = (to - from).norm();
   const int n = static_cast<int>(len / 0.5) + 1;
+  const Vec2 along = (to - from) / std::max(len, 1e-9);
+  const Vec2 side(-along.y(), along.x());
   std::vector<double> raw;
   for (int i = 0; i < n; ++i) {
-    double v;
-    const Vec2 p = from + (to - from) * (i * 0.5 / std::max(len, 1e-9));
-    if (!SampleGray(gray, p.x(), p.y(), &v)) break;
-    raw.push_back(v);
+    const Vec2 p = from + along * (i * 0.5);
+    double sum = 0.0, v;
+    bool inside = true;
+    for (int k = -across; k <= across && inside; ++k) {
+      const Vec2 q = p + k * side;
+      inside = SampleGray(gray, q.x(), q.y(), &v);
+      sum += v;
+    }
+    if (!inside) break;
+    raw.push_back(sum / (2 * across + 1));
   }
   std::vector<Vec2> as_points;
   for (double v : raw) as_points.emplace_back(v, 0.0);
@@ -241,6 +253,137 @@ std::vector<Block> FindBlocks(const cv::Mat& small, const cv::Mat& ignore, doubl
   return blocks;
 }
 
+std::optional<Block> FindBlockByFrontEdge(const cv::Mat& small, const cv::Mat& ignore,
+                                          const std::vector<Vec2>& path, double scale,
+                                          int direction, double min_thickness) {
+  const int w = small.cols, h = small.rows;
+  // The strip's line on the reduced image, a point per reduced pixel.
+  std::vector<Vec2> line;
+  for (const Vec2& p : path) {
+    const Vec2 q = (p + Vec2(0.5, 0.5)) * scale - Vec2(0.5, 0.5);
+    if (line.empty() || (q - line.back()).norm() >= 1.0) line.push_back(q);
+  }
+  if (line.size() < 20) return std::nullopt;
+  // Candidate corners: points of the held, near-level part of the line (the strip on the top
+  // face), up to where it turns down by 60° (it hangs). If the line comes in from the image
+  // border, its first 5 % are left out: a corner there leaves no top face to measure.
+  std::vector<int> tops;
+  const int reach = 3;
+  const bool from_border = line.front().x() < 2.0 || line.front().x() > w - 3.0;
+  for (int i = reach; i + reach < static_cast<int>(line.size()); ++i) {
+    const Vec2 d = line[i + reach] - line[i - reach];
+    const double angle = std::atan2(std::abs(d.y()), std::abs(d.x()));
+    if (angle > 60 * kDeg) break;
+    if (angle < 30 * kDeg && (!from_border || i >= static_cast<int>(0.05 * line.size())))
+      tops.push_back(i);
+  }
+  if (tops.empty()) return std::nullopt;
+
+  // Horizontal derivative of the lightly smoothed image [grey levels per px], and its noise.
+  cv::Mat smooth, gx;
+  cv::GaussianBlur(small, smooth, cv::Size(0, 0), 1.0);
+  cv::Sobel(smooth, gx, CV_32F, 1, 0, 3, 1.0 / 8.0);
+  std::vector<double> abs_g;
+  for (int y = 2; y < h - 2; y += 3) {
+    for (int x = 2; x < w - 2; x += 3) {
+      if (!ignore.at<uchar>(y, x)) abs_g.push_back(std::abs(gx.at<float>(y, x)));
+    }
+  }
+  if (abs_g.size() < 100) return std::nullopt;
+  const double noise = std::max(0.02, 1.4826 * Median(abs_g));
+
+  // A front face is a straight edge of one sign from just below the strip to the bottom of
+  // the photo (the block stands on the floor of the scene), within ±12° of the vertical. Each
+  // candidate line is scored by the mean of the derivative along it in units of the noise, at
+  // rows clear of the strip; a line counts when it is long and most of its rows agree in sign.
+  const double gap = std::max(3.0, 2.0 * min_thickness);
+  struct Line {
+    double score = 0.0, x0 = 0.0, y0 = 0.0, slope = 0.0;
+    int rows = 0;
+  };
+  const auto score_line = [&](double x0, double y0, double slope) {
+    Line l{0.0, x0, y0, slope, 0};
+    double sum = 0.0;
+    int agree = 0;
+    std::vector<float> values;
+    for (int y = static_cast<int>(std::ceil(y0 + gap)); y < h - 1; ++y) {
+      const int x = static_cast<int>(std::lround(x0 + slope * (y - y0)));
+      if (x < 1 || x >= w - 1) break;
+      if (ignore.at<uchar>(y, x)) continue;
+      // The largest of three neighbours in the sign of the running sum: the edge is a pixel
+      // or two wide on the reduced image and the line is drawn on whole pixels.
+      const float* row = gx.ptr<float>(y);
+      values.push_back(row[x - 1] + row[x] + row[x + 1]);
+      sum += values.back();
+    }
+    l.rows = static_cast<int>(values.size());
+    if (l.rows == 0) return l;
+    const double sign = sum >= 0.0 ? 1.0 : -1.0;
+    for (float v : values) agree += sign * v > 0.0;
+    // Three neighbours: the noise of the sum is about √3 σ (neighbours correlate through the
+    // smoothing, so a little more; the threshold below allows for it).
+    l.score = agree >= 0.8 * l.rows ? std::abs(sum) / l.rows / (std::sqrt(3.0) * noise) : 0.0;
+    return l;
+  };
+  const int min_rows = std::max(30, h / 5);
+  Line best;
+  for (int i : tops) {
+    const double x0 = line[i].x(), y0 = line[i].y() + 0.5 * min_thickness;
+    for (int k = -12; k <= 12; ++k) {
+      const Line l = score_line(x0, y0, std::tan(k * kDeg));
+      if (l.rows >= min_rows && l.score > best.score) best = l;
+    }
+  }
+  // Refine the tilt around the best line.
+  for (int k = -4; k <= 4; ++k) {
+    const double slope = std::tan(std::atan(best.slope) + 0.25 * k * kDeg);
+    const Line l = score_line(best.x0, best.y0, slope);
+    if (l.rows >= min_rows && l.score > best.score) best = l;
+  }
+  // A step of c grey levels blurred over a few pixels gives a derivative of about c / 3 at its
+  // centre: a score of 4 is an edge of a few noise levels' contrast along hundreds of rows,
+  // which noise, the background's gradient or the strip's shadow do not make.
+  if (best.score < 4.0) return std::nullopt;
+
+  // The block: behind the line (away from the overhang), below the strip.
+  Block b;
+  b.mask = cv::Mat::zeros(small.size(), CV_8U);
+  const double front_y0 = best.y0;
+  const auto strip_y_at = [&](int x) {  // the line's lowest point over column x, or -1
+    double y = -1.0;
+    for (const Vec2& p : line)
+      if (std::abs(p.x() - x) <= 0.5) y = std::max(y, p.y());
+    return y;
+  };
+  for (int x = 0; x < w; ++x) {
+    const double y_strip = strip_y_at(x);
+    const double y_top = y_strip >= 0.0 ? y_strip + 0.5 * min_thickness + 0.5 : front_y0;
+    for (int y = std::max(0, static_cast<int>(std::ceil(y_top))); y < h; ++y) {
+      const double xf = best.x0 + best.slope * (y - best.y0);
+      if ((x - xf) * direction <= 0.0 && y >= front_y0) b.mask.at<uchar>(y, x) = 255;
+    }
+  }
+  const cv::Rect box = cv::boundingRect(b.mask);
+  if (box.area() < 0.01 * w * h) return std::nullopt;
+  b.box = box;
+  // Lighter or darker than the background just in front of the face (the sign of the step).
+  {
+    double inside = 0.0, outside = 0.0;
+    int n = 0;
+    for (int y = static_cast<int>(front_y0 + gap); y < h; y += 4) {
+      const double xf = best.x0 + best.slope * (y - best.y0);
+      const int xi = static_cast<int>(std::lround(xf - direction * 4.0));
+      const int xo = static_cast<int>(std::lround(xf + direction * 4.0));
+      if (xi < 0 || xi >= w || xo < 0 || xo >= w) continue;
+      inside += smooth.at<uchar>(y, xi);
+      outside += smooth.at<uchar>(y, xo);
+      ++n;
+    }
+    b.sign = n > 0 && inside > outside ? +1 : -1;
+  }
+  return b;
+}
+
 PlatformFit FitPlatform(const cv::Mat& gray, const Block& block, double scale, int direction,
                         const std::vector<Vec2>& path, double thickness) {
   PlatformFit fit;
@@ -268,6 +411,7 @@ PlatformFit FitPlatform(const cv::Mat& gray, const Block& block, double scale, i
     return fit;
   }
   const double margin = std::max(3.0 * thickness, 12.0);
+  const int across_min = std::clamp(static_cast<int>(std::lround(thickness)), 3, 12);
   const double reach_in = std::max(2.0 * thickness, 8.0),
                reach_out = std::max(3.0 * thickness, 12.0);
   const double front_x = full(Median(fronts));
@@ -299,43 +443,57 @@ PlatformFit FitPlatform(const cv::Mat& gray, const Block& block, double scale, i
   }
   fit.under_strip = on_top >= std::max(2.0 * thickness, 20.0);  // path points are 1 px apart
 
-  // Top face: vertical scans from inside the block upwards, spread over its far part.
-  const double x_far = direction > 0 ? full(box.x) + 3.0 : full(box.x + box.width - 1) - 3.0;
-  const double x_near = corner0.x() - direction * margin;
-  std::vector<Vec2> top_pts;  // (x, y)
-  if ((x_near - x_far) * direction > 10.0) {
-    for (int k = 0; k < 60; ++k) {
-      const double x = x_far + (x_near - x_far) * k / 59.0;
-      const int top = top_of[column(x)];
-      if (top < 0) continue;
-      const Vec2 from(x, full(top) + reach_in), to(x, full(top) - reach_out);
-      const double at = FirstStep(LineSamples(gray, from, to));
-      if (at >= 0) top_pts.emplace_back(x, from.y() - 0.5 * at);
+  // The faces are measured by scans across them, each averaged over `across` px along the
+  // face and kept that far clear of the corner. A faint face under heavy noise (light that
+  // makes the block almost as light as the background) scatters the steps found; the scans are
+  // then repeated with four times the average (a face tilted by 12° shifts by a fifth of that
+  // across the average, symmetrically: a blur, not a bias).
+  std::vector<Vec2> top_pts, front_pts;  // (x, y) and (y, x)
+  double a = 0, b = 0, c = 0, d = 0, rms_top = 1e9, rms_front = 1e9;
+  int kept_top = 0, kept_front = 0;
+  const auto straight = [&] {
+    return rms_top <= 1.5 && rms_front <= 1.5 && kept_top >= 0.6 * top_pts.size() &&
+           kept_front >= 0.6 * front_pts.size();
+  };
+  for (const int across : {across_min, std::min(4 * across_min, 40)}) {
+    // Top face: vertical scans from inside the block upwards, spread over its far part.
+    const double x_far = direction > 0 ? full(box.x) + 3.0 + across : full(box.x + box.width - 1) - 3.0 - across;
+    const double x_near = corner0.x() - direction * (margin + across);
+    top_pts.clear();
+    if ((x_near - x_far) * direction > 10.0) {
+      for (int k = 0; k < 60; ++k) {
+        const double x = x_far + (x_near - x_far) * k / 59.0;
+        const int top = top_of[column(x)];
+        if (top < 0) continue;
+        const Vec2 from(x, full(top) + reach_in), to(x, full(top) - reach_out);
+        const double at = FirstStep(LineSamples(gray, from, to, across));
+        if (at >= 0) top_pts.emplace_back(x, from.y() - 0.5 * at);
+      }
     }
-  }
-  // Front face: horizontal scans from inside the block outwards, below the corner.
-  const double y_low = std::min(full(box.y + box.height - 1), gray.rows - 1.0) - 3.0;
-  const double y_high = corner0.y() + margin;
-  std::vector<Vec2> front_pts;  // (y, x)
-  if (y_low - y_high > 10.0) {
-    for (int k = 0; k < 60; ++k) {
-      const double y = y_high + (y_low - y_high) * k / 59.0;
-      const int front = front_of[row_of(y)];
-      if (front < 0) continue;
-      const Vec2 from(full(front) - direction * reach_in, y),
-          to(full(front) + direction * reach_out, y);
-      const double at = FirstStep(LineSamples(gray, from, to));
-      if (at >= 0) front_pts.emplace_back(y, from.x() + direction * 0.5 * at);
+    // Front face: horizontal scans from inside the block outwards, below the corner.
+    const double y_low = std::min(full(box.y + box.height - 1), gray.rows - 1.0) - 3.0 - across;
+    const double y_high = corner0.y() + margin + across;
+    front_pts.clear();
+    if (y_low - y_high > 10.0) {
+      for (int k = 0; k < 60; ++k) {
+        const double y = y_high + (y_low - y_high) * k / 59.0;
+        const int front = front_of[row_of(y)];
+        if (front < 0) continue;
+        const Vec2 from(full(front) - direction * reach_in, y),
+            to(full(front) + direction * reach_out, y);
+        const double at = FirstStep(LineSamples(gray, from, to, across));
+        if (at >= 0) front_pts.emplace_back(y, from.x() + direction * 0.5 * at);
+      }
     }
+    if (top_pts.size() < 10 || front_pts.size() < 10) break;
+    rms_top = FitLineRobust(top_pts, &a, &b, &kept_top);
+    rms_front = FitLineRobust(front_pts, &c, &d, &kept_front);
+    if (straight()) break;
   }
   if (top_pts.size() < 10 || front_pts.size() < 10) {
     fit.why_not = "the block under the strip is too small to measure its top and front faces";
     return fit;
   }
-  double a, b, c, d;
-  int kept_top = 0, kept_front = 0;
-  const double rms_top = FitLineRobust(top_pts, &a, &b, &kept_top);
-  const double rms_front = FitLineRobust(front_pts, &c, &d, &kept_front);
   // Corner: y = a + b x and x = c + d y.
   const double x = (c + d * a) / (1.0 - d * b);
   fit.corner = Vec2(x, a + b * x);
@@ -352,8 +510,7 @@ PlatformFit FitPlatform(const cv::Mat& gray, const Block& block, double scale, i
                   std::to_string(static_cast<int>(std::lround(std::atan(b) / kDeg))) + "°)";
   } else if (std::abs(std::atan(d)) > 30 * kDeg) {
     fit.why_not = "the block's front face is not vertical";
-  } else if (rms_top > 1.5 || rms_front > 1.5 || kept_top < 0.6 * top_pts.size() ||
-             kept_front < 0.6 * front_pts.size()) {
+  } else if (!straight()) {
     fit.why_not = "the block's faces are not straight";
   } else if (nearest > std::max(2.0 * thickness, 10.0) + 3.0) {
     fit.why_not = "the strip does not pass over the block's corner";

@@ -206,13 +206,15 @@ TEST(RenderPhoto, PlatformsThatTheLightHidesAreFoundByTheirFrontFace) {
   EXPECT_GE(found, 5);
 }
 
-// Hard photos of the extract-accuracy benchmark: 1732 x 1299 px at 0.1 mm/px.
-RenderedPhoto HardBenchmarkPhoto(std::uint64_t seed, const BendingLaw& law, double rho) {
-  RenderPhotoOptions o = RenderPhotoOptions::ForDifficulty(PhotoDifficulty::kHard, 1732000 + seed);
+// A 2 MP photo of the extract-accuracy benchmark (1732 x 1299 px at 0.1 mm/px): level d,
+// benchmark seed `seed`.
+RenderedPhoto BenchmarkPhoto(PhotoDifficulty d, std::uint64_t seed, const BendingLaw& law,
+                             double rho, double overhang) {
+  RenderPhotoOptions o = RenderPhotoOptions::ForDifficulty(d, 1732000 + seed);
   o.width_px = 1732;
   o.height_px = 1299;
   o.mm_per_px = 0.1;
-  o.overhang = 0.06;
+  o.overhang = overhang;
   return RenderPhoto(law, rho, o);
 }
 
@@ -222,7 +224,8 @@ TEST(RenderPhoto, ACurvingStripIsFollowedPastTheStraightExtension) {
   // used to stop there, and the profile ended 15 mm before the tip (no error); it now goes on
   // while each pass gets well past the previous guide. Measured: tip 1.1 mm off (the oblique
   // view's bias), RMS 0.24 mm.
-  const RenderedPhoto r = HardBenchmarkPhoto(2, BendingLaw::FromKes(0.0973, 0.0973, 0.0453), 0.13);
+  const RenderedPhoto r = BenchmarkPhoto(PhotoDifficulty::kHard, 2,
+                                         BendingLaw::FromKes(0.0973, 0.0973, 0.0453), 0.13, 0.06);
   SCOPED_TRACE(r.description);
   const ExtractionSummary x = ExtractProfile(r.photo, r.rig, ExtractOptions{}, "rendered");
   ASSERT_TRUE(x.success) << x.message;
@@ -235,12 +238,8 @@ TEST(RenderPhoto, TipThatEndsJustBehindTheLastSectionIsNotExtrapolatedBackwards)
   // left): the strip's width falls below half just before the tip search's window opens, and
   // the crossing used to be extrapolated from two samples already near zero, putting the tip
   // 87 px (8.7 mm) back along the strip. The profile was 7 mm short with no warning.
-  RenderPhotoOptions o = RenderPhotoOptions::ForDifficulty(PhotoDifficulty::kMedium, 1732003);
-  o.width_px = 1732;
-  o.height_px = 1299;
-  o.mm_per_px = 0.1;
-  o.overhang = 0.1;
-  const RenderedPhoto r = RenderPhoto(BendingLaw::FromKes(0.5168, 1.8856, 2.2683), 0.25, o);
+  const RenderedPhoto r = BenchmarkPhoto(PhotoDifficulty::kMedium, 3,
+                                         BendingLaw::FromKes(0.5168, 1.8856, 2.2683), 0.25, 0.1);
   SCOPED_TRACE(r.description);
   const ExtractionSummary x = ExtractProfile(r.photo, r.rig, ExtractOptions{}, "rendered");
   ASSERT_TRUE(x.success) << x.message;

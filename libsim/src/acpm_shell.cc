@@ -1,6 +1,7 @@
 #include "textile/sim/acpm_shell.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <map>
@@ -55,12 +56,25 @@ ShellAcpmSettings HalvedSettings(const ShellAcpmSettings& settings, double refer
   return half;
 }
 
+using Clock = std::chrono::steady_clock;
+
+// The end of a whole run's time (ShellAcpmSettings::max_seconds from its start).
+Clock::time_point DeadlineAfter(double seconds) {
+  return Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                            std::chrono::duration<double>(std::min(seconds, 1e7)));
+}
+
 // One push: the sample at a given overhang, its grid and its solver state.
 class PushedSample {
  public:
   PushedSample(const Material& material, const AcpmOptions& options, const AcpmSeam& seam,
-               const ShellAcpmSettings& settings, double reference_overhang)
-      : material_(material), options_(options), seam_(seam), settings_(settings) {
+               const ShellAcpmSettings& settings, double reference_overhang,
+               Clock::time_point deadline)
+      : material_(material),
+        options_(options),
+        seam_(seam),
+        settings_(settings),
+        deadline_(deadline) {
     nx_ = CellsAlong(reference_overhang, settings.element_length);
     platform_ = reference_overhang / nx_;
     // Across the width: uniform, with the seam along the push direction on a grid line.
@@ -117,7 +131,17 @@ class PushedSample {
       for (int v = 0; v < state_.rows(); ++v)
         if (mesh.vertices(v, 0) > 0.0) state_.row(v) *= scale;
     }
-    const SolveSummary s = SolveStatic(problem_.get(), &state_, settings_.solve);
+    // Each solve gets at most the run's time left (ShellAcpmSettings::max_seconds).
+    const double left = std::chrono::duration<double>(deadline_ - Clock::now()).count();
+    if (!(left > 0.0)) {
+      *message = "shell model: time cap of " + std::to_string(settings_.max_seconds) +
+                 " s (ShellAcpmSettings::max_seconds) reached after " + std::to_string(solves_) +
+                 " static solves";
+      return false;
+    }
+    SolveOptions solve = settings_.solve;
+    solve.max_seconds = std::min(solve.max_seconds, left);
+    const SolveSummary s = SolveStatic(problem_.get(), &state_, solve);
     ++solves_;
     overhang_ = overhang;
     mesh_ = std::move(mesh);
@@ -197,6 +221,7 @@ class PushedSample {
   double seam_z_ = 0.0;
   std::unique_ptr<ClothProblem> problem_;
   TriangleMesh mesh_;
+  Clock::time_point deadline_;
   Vertices state_;
   double overhang_ = 1.0;
   int solves_ = 0;
@@ -210,9 +235,9 @@ struct Solved {
 // Pushes until every ray is cut, then refines each ray's crossing.
 AcpmCrossings Push(const Material& material, const AcpmOptions& options, const AcpmSeam& seam,
                    const std::vector<double>& ray_z, const ShellAcpmSettings& settings,
-                   double reference) {
+                   double reference, Clock::time_point deadline) {
   AcpmCrossings out;
-  PushedSample sample(material, options, seam, settings, reference);
+  PushedSample sample(material, options, seam, settings, reference, deadline);
   std::map<double, Solved> solved;  // by overhang
   auto solve = [&](double overhang) -> const Solved* {
     // Warm start from the nearest solved overhang.
@@ -320,6 +345,10 @@ bool ShellAcpmSettings::Check(std::string* why) const {
     *why = "shell width cells must be >= 1 (plain) and >= 2 (seam along)";
     return false;
   }
+  if (!(std::isfinite(max_seconds) && max_seconds >= 0.0)) {
+    *why = "shell max_seconds must be finite and >= 0";
+    return false;
+  }
   return solve.Check(why);
 }
 
@@ -329,6 +358,7 @@ AcpmCrossings ShellAcpmCrossings(const Material& material, const AcpmOptions& op
   std::string why;
   if (!settings.Check(&why)) throw InputError(why);
   if (!options.Check(&why)) throw InputError(why);
+  const Clock::time_point deadline = DeadlineAfter(settings.max_seconds);
   // The plain fabric's exact crossing sets the scale of the grid and the push.
   const BarrierCrossing plain_exact = FindBarrierCrossing(material.EffectiveLaw(),
                                                           material.areal_density);
@@ -342,10 +372,10 @@ AcpmCrossings ShellAcpmCrossings(const Material& material, const AcpmOptions& op
   // at first order in e (acpm-accuracy), so this cancels the leading error. *coarse: the push
   // at e alone.
   auto run = [&](const AcpmSeam& seam, const std::vector<double>& rays, AcpmCrossings* coarse) {
-    *coarse = Push(material, options, seam, rays, settings, reference);
+    *coarse = Push(material, options, seam, rays, settings, reference, deadline);
     if (!settings.extrapolate || !coarse->converged) return *coarse;
     const ShellAcpmSettings half = HalvedSettings(settings, reference);
-    AcpmCrossings fine = Push(material, options, seam, rays, half, reference);
+    AcpmCrossings fine = Push(material, options, seam, rays, half, reference, deadline);
     if (!fine.converged) return fine;
     for (size_t r = 0; r < rays.size(); ++r)
       fine.overhang[r] = 2.0 * fine.overhang[r] - coarse->overhang[r];
@@ -362,7 +392,8 @@ AcpmCrossings ShellAcpmCrossings(const Material& material, const AcpmOptions& op
   // across the width) and the plain fabric as above (2 cells across, cheap). The factor is the
   // ratio of the two at the same resolution, where the discretisation error cancels; the seamed
   // crossings get the plain run's extrapolation as a relative correction.
-  AcpmCrossings result = Push(material, options, options.seam, ray_z, settings, reference);
+  AcpmCrossings result =
+      Push(material, options, options.seam, ray_z, settings, reference, deadline);
   if (!result.converged) return result;
   const std::vector<double> centre = {0.5 * options.width};
   const AcpmCrossings plain = run(AcpmSeam{}, centre, &coarse);
@@ -420,7 +451,8 @@ ShellCantilever SolveShellCantilever(const Material& material, double overhang, 
   options.width = width;
   options.length = overhang;
   ShellCantilever out;
-  PushedSample coarse(material, options, AcpmSeam{}, settings, overhang);
+  const Clock::time_point deadline = DeadlineAfter(settings.max_seconds);
+  PushedSample coarse(material, options, AcpmSeam{}, settings, overhang, deadline);
   if (!CantileverAt(&coarse, overhang, width, &out.x, &out.y, &out.message)) return out;
   out.solves = coarse.solves();
   out.vertices = coarse.num_vertices();
@@ -430,7 +462,7 @@ ShellCantilever SolveShellCantilever(const Material& material, double overhang, 
         << " mm along";
   if (settings.extrapolate) {
     const ShellAcpmSettings half = HalvedSettings(settings, overhang);
-    PushedSample fine(material, options, AcpmSeam{}, half, overhang);
+    PushedSample fine(material, options, AcpmSeam{}, half, overhang, deadline);
     std::vector<double> fx, fy;
     if (!CantileverAt(&fine, overhang, width, &fx, &fy, &out.message)) return out;
     // Fine vertex 2k is coarse vertex k's material point: extrapolate each to e -> 0.

@@ -129,6 +129,20 @@ TEST(AcpmShell, BadSettingsAreRefused) {
   ShellAcpmSettings settings;
   settings.element_length = 0.0;
   EXPECT_THROW(ShellAcpmCrossings(m, options, options.RayPositions(), settings), InputError);
+  ShellAcpmSettings cap;
+  cap.max_seconds = std::nan("");
+  EXPECT_THROW(ShellAcpmCrossings(m, options, options.RayPositions(), cap), InputError);
+}
+
+TEST(AcpmShell, TimeCapEndsInFailureWithoutCrossings) {
+  const Material m = Fabric(0.1, 0.0892, -0.0092, 200);
+  AcpmOptions options;
+  ShellAcpmSettings cap;
+  cap.max_seconds = 0.0;
+  const AcpmCrossings c = ShellAcpmCrossings(m, options, options.RayPositions(), cap);
+  EXPECT_FALSE(c.converged);
+  EXPECT_NE(c.message.find("time cap"), std::string::npos) << c.message;
+  EXPECT_TRUE(c.overhang.empty());
 }
 
 // Largest distance of the points (x_k, y_k) from the elastica's curve (a polyline of 401
@@ -182,6 +196,23 @@ TEST(ShellCantilever, RefusesBadArguments) {
   ShellAcpmSettings bad;
   bad.width_cells_plain = 0;
   EXPECT_THROW(SolveShellCantilever(m, 0.05, 0.025, bad), InputError);
+  for (double seconds : {std::nan(""), -1.0, HUGE_VAL}) {
+    ShellAcpmSettings cap;
+    cap.max_seconds = seconds;
+    EXPECT_THROW(SolveShellCantilever(m, 0.05, 0.025, cap), InputError) << seconds;
+  }
+}
+
+TEST(ShellCantilever, TimeCapEndsInFailureWithoutAProfile) {
+  // A cap of 0 s has always passed at the first solve's check: the run fails with the cap's
+  // message and no profile, deterministically.
+  const Material m = Fabric(0.1, 0.0892, -0.0092, 200);
+  ShellAcpmSettings cap;
+  cap.max_seconds = 0.0;
+  const ShellCantilever c = SolveShellCantilever(m, 0.05, 0.025, cap);
+  EXPECT_FALSE(c.converged);
+  EXPECT_NE(c.message.find("time cap"), std::string::npos) << c.message;
+  EXPECT_TRUE(c.x.empty());
 }
 
 }  // namespace

@@ -44,6 +44,10 @@ struct ShellAcpmSettings {
   // tensor model's crossing converges at first order (-4.4 %, -2.2 %, -1.1 % at 2, 1, 0.5 mm on
   // the Fig. 8 fabric), the extrapolation leaves < 0.1 % (docs/acpm.md).
   bool extrapolate = true;
+  // Wall-time cap of a whole run [s] (ShellAcpmCrossings: every push; SolveShellCantilever:
+  // both continuations), finite and >= 0. Each static solve gets at most the time left; past
+  // the cap the run fails with a message (no crossings, no profile). Runs take 0.5-5 s.
+  double max_seconds = 300.0;
   // Static solver settings for every push step.
   SolveOptions solve = [] {
     SolveOptions s;

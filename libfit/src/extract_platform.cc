@@ -310,8 +310,8 @@ std::optional<Block> FindBlockByFrontEdge(const cv::Mat& small, const cv::Mat& i
       const int x = static_cast<int>(std::lround(x0 + slope * (y - y0)));
       if (x < 1 || x >= w - 1) break;
       if (ignore.at<uchar>(y, x)) continue;
-      // The largest of three neighbours in the sign of the running sum: the edge is a pixel
-      // or two wide on the reduced image and the line is drawn on whole pixels.
+      // The sum of three neighbours: the edge is a pixel or two wide on the reduced image and
+      // the line is drawn on whole pixels.
       const float* row = gx.ptr<float>(y);
       values.push_back(row[x - 1] + row[x] + row[x + 1]);
       sum += values.back();
@@ -349,14 +349,14 @@ std::optional<Block> FindBlockByFrontEdge(const cv::Mat& small, const cv::Mat& i
   Block b;
   b.mask = cv::Mat::zeros(small.size(), CV_8U);
   const double front_y0 = best.y0;
-  const auto strip_y_at = [&](int x) {  // the line's lowest point over column x, or -1
-    double y = -1.0;
-    for (const Vec2& p : line)
-      if (std::abs(p.x() - x) <= 0.5) y = std::max(y, p.y());
-    return y;
-  };
+  // The line's lowest point over each column (-1: the line does not cross it).
+  std::vector<double> strip_y(w, -1.0);
+  for (const Vec2& p : line) {
+    const long x = std::lround(p.x());
+    if (x >= 0 && x < w && std::abs(p.x() - x) <= 0.5) strip_y[x] = std::max(strip_y[x], p.y());
+  }
   for (int x = 0; x < w; ++x) {
-    const double y_strip = strip_y_at(x);
+    const double y_strip = strip_y[x];
     const double y_top = y_strip >= 0.0 ? y_strip + 0.5 * min_thickness + 0.5 : front_y0;
     for (int y = std::max(0, static_cast<int>(std::ceil(y_top))); y < h; ++y) {
       const double xf = best.x0 + best.slope * (y - best.y0);
@@ -457,7 +457,8 @@ PlatformFit FitPlatform(const cv::Mat& gray, const Block& block, double scale, i
   };
   for (const int across : {across_min, std::min(4 * across_min, 40)}) {
     // Top face: vertical scans from inside the block upwards, spread over its far part.
-    const double x_far = direction > 0 ? full(box.x) + 3.0 + across : full(box.x + box.width - 1) - 3.0 - across;
+    const double x_far = direction > 0 ? full(box.x) + 3.0 + across
+                                       : full(box.x + box.width - 1) - 3.0 - across;
     const double x_near = corner0.x() - direction * (margin + across);
     top_pts.clear();
     if ((x_near - x_far) * direction > 10.0) {

@@ -21,11 +21,11 @@ using Vec3 = Eigen::Vector3d;
 using Mat12 = Eigen::Matrix<double, 12, 12>;
 using hinge_angle::Position;
 
-// The SIMD kernels below are compiled twice on x86-64 Linux with GCC: for AVX2 and for the
-// baseline, picked at load time (function multiversioning); elsewhere once. No FMA in either
-// clone, so both give the same bits.
+// The SIMD kernels below are compiled three times on x86-64 Linux with GCC: for AVX-512, AVX2
+// and the baseline, picked at load time (function multiversioning); elsewhere once. No FMA in
+// any clone (-ffp-contract=off, libsim/CMakeLists.txt), so all give the same bits.
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define TEXTILE_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
+#define TEXTILE_SIMD_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define TEXTILE_SIMD_CLONES
 #endif
@@ -127,17 +127,35 @@ struct DihedralLanesOut {
 // ∂θ/∂x unscaled and d_energy, d2_energy are filled.
 enum class LaneModel { kPabst, kPabstWarpWeft, kBridson };
 
-template <LaneModel kModel, bool kEnergy, bool kGradient, bool kHessian>
-TEXTILE_ALWAYS_INLINE void DihedralLanesImpl(const DihedralLanesIn& in, const LanePositions& pos,
+// Where the kernel reads coordinate c of corner i of lane l: gathered lanes (LanePositions) or
+// straight from the positions through the corners' offsets (GatherPositions).
+struct GatherPositions {
+  const double* x;          // #V×3 positions, row-major
+  const int* corner[4];     // offsets 3 v[i] of the block's hinges
+  TEXTILE_ALWAYS_INLINE double at(int i, int c, int l) const { return x[corner[i][l] + c]; }
+};
+TEXTILE_ALWAYS_INLINE double PositionAt(const LanePositions& pos, int i, int c, int l) {
+  return pos.p[3 * i + c][l];
+}
+TEXTILE_ALWAYS_INLINE double PositionAt(const GatherPositions& pos, int i, int c, int l) {
+  return pos.at(i, c, l);
+}
+
+template <LaneModel kModel, bool kEnergy, bool kGradient, bool kHessian, class Positions>
+TEXTILE_ALWAYS_INLINE void DihedralLanesImpl(const DihedralLanesIn& in, const Positions& pos,
                                              DihedralLanesOut* out) {
   // Local copies: loads in the arms of a conditional through a pointer would not if-convert.
   const LawCoefficients warp = *in.warp, weft = *in.weft;
 #pragma omp simd
   for (int l = 0; l < kLanes; ++l) {
-    const double x2x = pos.p[6][l], x2y = pos.p[7][l], x2z = pos.p[8][l];
-    const double ex = pos.p[9][l] - x2x, ey = pos.p[10][l] - x2y, ez = pos.p[11][l] - x2z;
-    const double a0x = pos.p[0][l] - x2x, a0y = pos.p[1][l] - x2y, a0z = pos.p[2][l] - x2z;
-    const double a1x = pos.p[3][l] - x2x, a1y = pos.p[4][l] - x2y, a1z = pos.p[5][l] - x2z;
+    const double x2x = PositionAt(pos, 2, 0, l), x2y = PositionAt(pos, 2, 1, l),
+                 x2z = PositionAt(pos, 2, 2, l);
+    const double ex = PositionAt(pos, 3, 0, l) - x2x, ey = PositionAt(pos, 3, 1, l) - x2y,
+                 ez = PositionAt(pos, 3, 2, l) - x2z;
+    const double a0x = PositionAt(pos, 0, 0, l) - x2x, a0y = PositionAt(pos, 0, 1, l) - x2y,
+                 a0z = PositionAt(pos, 0, 2, l) - x2z;
+    const double a1x = PositionAt(pos, 1, 0, l) - x2x, a1y = PositionAt(pos, 1, 1, l) - x2y,
+                 a1z = PositionAt(pos, 1, 2, l) - x2z;
     // n0 = e × a0, n1 = a1 × e.
     const double n0x = ey * a0z - ez * a0y, n0y = ez * a0x - ex * a0z, n0z = ex * a0y - ey * a0x;
     const double n1x = a1y * ez - a1z * ey, n1y = a1z * ex - a1x * ez, n1z = a1x * ey - a1y * ex;
@@ -287,6 +305,86 @@ template <int A, int B> TEXTILE_ALWAYS_INLINE double SkewAt(V3 s) {
 template <int N, class F>
 TEXTILE_ALWAYS_INLINE void Unroll(F&& f) {
   [&]<int... I>(std::integer_sequence<int, I...>) __attribute__((always_inline)) { (f(std::integral_constant<int, I>{}), ...); }(std::make_integer_sequence<int, N>{});
+}
+
+// Energy and/or gradient of the dihedral hinges begin ≤ h < end, whole: the kernel on blocks of
+// kLanes hinges, reading the positions through the corners' offsets (vector gathers where the
+// machine has them), then the gradient scattered in hinge order (the same additions in the same
+// order as a hinge-by-hinge loop). One function, so that all of it gets the SIMD clone's
+// instructions.
+struct DihedralBlocksIn {
+  DihedralLanesIn rest;        // the rest arrays at hinge 0
+  const int* corner[4];        // 3 v[i] of every hinge, padded by kLanes (first hinge's ids)
+  const double* x;             // #V×3 positions, row-major
+};
+
+template <LaneModel kModel, bool kEnergy, bool kGradient>
+TEXTILE_ALWAYS_INLINE double DihedralBlocksImpl(const DihedralBlocksIn& in, long begin, long end,
+                                                double* grad, double* hinge_grad) {
+  DihedralLanesOut out;
+  double energy = 0.0;
+  for (long b = begin; b < end; b += kLanes) {
+    const int n = static_cast<int>(std::min<long>(kLanes, end - b));
+    const GatherPositions pos{in.x,
+                              {in.corner[0] + b, in.corner[1] + b, in.corner[2] + b,
+                               in.corner[3] + b}};
+    const DihedralLanesIn& r = in.rest;
+    const DihedralLanesIn lanes{r.pabst,          r.anisotropic,       r.warp,
+                                r.weft,           r.rest_angle + b,    r.inv_height + b,
+                                r.weight + b,     r.warp_weight + b,   r.sin_half + b,
+                                r.cos_half + b};
+    DihedralLanesImpl<kModel, kEnergy, kGradient, false>(lanes, pos, &out);
+    if constexpr (kEnergy)
+      for (int l = 0; l < n; ++l) energy += out.energy[l];
+    if constexpr (kGradient) {
+      const auto scatter = [&](int l) __attribute__((always_inline)) {
+        Unroll<4>([&](auto ic) __attribute__((always_inline)) {
+          constexpr int I = decltype(ic)::value;
+          double* g = grad ? grad + in.corner[I][b + l] : hinge_grad + 12 * (b + l) + 3 * I;
+          const double gx = out.grad[3 * I][l], gy = out.grad[3 * I + 1][l],
+                       gz = out.grad[3 * I + 2][l];
+          if (grad) {
+            g[0] += gx;
+            g[1] += gy;
+            g[2] += gz;
+          } else {
+            g[0] = gx;
+            g[1] = gy;
+            g[2] = gz;
+          }
+        });
+      };
+      if (n == kLanes) {
+        Unroll<kLanes>([&](auto lc) __attribute__((always_inline)) { scatter(lc.value); });
+      } else {
+        for (int l = 0; l < n; ++l) scatter(l);
+      }
+    }
+  }
+  return energy;
+}
+
+template <LaneModel kModel>
+TEXTILE_ALWAYS_INLINE double DihedralBlocksModel(const DihedralBlocksIn& in, long begin, long end,
+                                                 bool energy, double* grad, double* hinge_grad) {
+  const bool gradient = grad || hinge_grad;
+  if (energy && gradient) return DihedralBlocksImpl<kModel, true, true>(in, begin, end, grad, hinge_grad);
+  if (gradient) return DihedralBlocksImpl<kModel, false, true>(in, begin, end, grad, hinge_grad);
+  return DihedralBlocksImpl<kModel, true, false>(in, begin, end, grad, hinge_grad);
+}
+
+// Energy (returned when asked) and gradient of hinges [begin, end): added into grad (#V×3) when
+// given, else each hinge's 12-vector written to hinge_grad + 12 h when given, else none.
+TEXTILE_SIMD_CLONES double DihedralBlocks(const DihedralBlocksIn& in, long begin, long end,
+                                          bool energy, double* grad, double* hinge_grad) {
+  if (!in.rest.pabst) {
+    return DihedralBlocksModel<LaneModel::kBridson>(in, begin, end, energy, grad, hinge_grad);
+  }
+  if (in.rest.anisotropic) {
+    return DihedralBlocksModel<LaneModel::kPabstWarpWeft>(in, begin, end, energy, grad,
+                                                          hinge_grad);
+  }
+  return DihedralBlocksModel<LaneModel::kPabst>(in, begin, end, energy, grad, hinge_grad);
 }
 
 // One triangle's part of ∇²θ in one lane (the formula of hinge_angle::AddTriangleAngleHessian,
@@ -580,11 +678,13 @@ BendingElements::BendingElements(const TriangleMesh& rest, const std::vector<Hin
     d.warp_weight.assign(padded, 1.0);
     d.sin_half.assign(padded, 0.0);
     d.cos_half.assign(padded, 1.0);
+    for (int i = 0; i < 4; ++i) d.corner[i].assign(padded, nh > 0 ? 3 * rest_[0].v[i] : 0);
     for (int h = 0; h < nh; ++h) {
       d.rest_angle[h] = rest_[h].rest_angle;
       d.inv_height[h] = rest_[h].inv_height;
       d.weight[h] = rest_[h].weight;
       d.warp_weight[h] = rest_[h].warp_weight;
+      for (int i = 0; i < 4; ++i) d.corner[i][h] = 3 * rest_[h].v[i];
       if (options_.model == BendingModel::kBridson) {
         d.sin_half[h] = half_angle_[2 * h];
         d.cos_half[h] = half_angle_[2 * h + 1];
@@ -721,52 +821,23 @@ double BendingElements::Evaluate(const Vertices& x, double* grad) const {
   // Dihedral models: blocks of kLanes hinges, gathered into lanes, evaluated by the SIMD kernel,
   // scattered in hinge order (the same additions in the same order as a hinge-by-hinge loop).
   auto dihedral_run = [&](long begin, long end, int thread) {
-    double energy = 0.0;
-    LanePositions pos;
-    DihedralLanesOut out;
-    const double* xd = x.data();
-    for (long b = begin; b < end; b += kLanes) {
-      const int n = static_cast<int>(std::min<long>(kLanes, end - b));
-      for (int l = 0; l < kLanes; ++l) {
-        const HingeRest& r = rest_[b + (l < n ? l : 0)];  // spare lanes repeat the first hinge
-        for (int i = 0; i < 4; ++i) {
-          const double* p = xd + 3 * r.v[i];
-          pos.p[3 * i][l] = p[0];
-          pos.p[3 * i + 1][l] = p[1];
-          pos.p[3 * i + 2][l] = p[2];
-        }
-      }
-      const DihedralLanesIn in{model == BendingModel::kPabst,
+    const DihedralLanesIn rest{model == BendingModel::kPabst,
                                anisotropic_,
                                &warp,
                                &weft,
-                               dihedral_.rest_angle.data() + b,
-                               dihedral_.inv_height.data() + b,
-                               dihedral_.weight.data() + b,
-                               dihedral_.warp_weight.data() + b,
-                               dihedral_.sin_half.data() + b,
-                               dihedral_.cos_half.data() + b};
-      DihedralLanes(in, pos, kWithEnergy, kWithGradient, &out);
-      if constexpr (kWithEnergy)
-        for (int l = 0; l < n; ++l) energy += out.energy[l];
-      if constexpr (kWithGradient) {
-        for (int l = 0; l < n; ++l) {
-          const HingeRest& r = rest_[b + l];
-          double* dst = direct ? nullptr : hinge_gradient_.data() + 12 * (b + l);
-          for (int i = 0; i < 4; ++i) {
-            double* g = direct ? grad + 3 * r.v[i] : dst + 3 * i;
-            for (int c = 0; c < 3; ++c) {
-              if (direct) {
-                g[c] += out.grad[3 * i + c][l];
-              } else {
-                g[c] = out.grad[3 * i + c][l];
-              }
-            }
-          }
-        }
-      }
-    }
-    partial[thread] = energy;
+                               dihedral_.rest_angle.data(),
+                               dihedral_.inv_height.data(),
+                               dihedral_.weight.data(),
+                               dihedral_.warp_weight.data(),
+                               dihedral_.sin_half.data(),
+                               dihedral_.cos_half.data()};
+    const DihedralBlocksIn in{rest,
+                              {dihedral_.corner[0].data(), dihedral_.corner[1].data(),
+                               dihedral_.corner[2].data(), dihedral_.corner[3].data()},
+                              x.data()};
+    double* hinge_grad = kWithGradient && !direct ? hinge_gradient_.data() : nullptr;
+    partial[thread] = DihedralBlocks(in, begin, end, kWithEnergy,
+                                     kWithGradient && direct ? grad : nullptr, hinge_grad);
   };
   auto run = [&](long begin, long end, int thread) {
     if (linear) {

@@ -198,6 +198,7 @@ class BendingElements {
   // Dihedral models, structure of arrays padded to a multiple of the SIMD block (hot loop).
   struct DihedralRest {
     std::vector<double> rest_angle, inv_height, weight, warp_weight, sin_half, cos_half;
+    std::array<std::vector<int>, 4> corner;  // 3 v[i]: offset of corner i's position in x
   };
 
   static constexpr int kMaxThreads = 64;

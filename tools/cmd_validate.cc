@@ -96,7 +96,7 @@ void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles
   namespace chart = textile::chart;
   chart::Panel p{.title = "Measured (dots) and simulated cantilevers: elastica (solid), shell (dashed)",
                  .x_label = "x [mm]", .y_label = "y [mm]", .equal_aspect = true,
-                 .legend_corner = chart::Corner::kTopRight, .notes_corner = chart::Corner::kBottomLeft};
+                 .legend_corner = chart::Corner::kTopRight};  // the notes: the corner with the least ink
   std::vector<chart::Series> lines;
   const auto curve = [](const ProfileComparison& c, const std::string& label, bool dashed,
                         chart::Rgb color) {
@@ -107,6 +107,23 @@ void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles
     }
     return sim;
   };
+  // The notes name each profile by its file stem without the stems' common prefix (cut at a
+  // '_' or '-'), so that the box stays narrow enough to find a corner free of curves.
+  std::vector<std::string> stems;
+  for (const Check& k : checks) stems.push_back(std::filesystem::path(k.source).stem().string());
+  size_t common = 0;
+  if (stems.size() > 1) {
+    common = stems[0].size();
+    for (const auto& t : stems) {
+      size_t n = 0;
+      while (n < common && n < t.size() && t[n] == stems[0][n]) ++n;
+      common = n;
+    }
+    const size_t cut = stems[0].find_last_of("_-", common == 0 ? 0 : common - 1);
+    common = cut == std::string::npos || common == 0 ? 0 : cut + 1;
+    for (const auto& t : stems)
+      if (t.size() <= common) common = 0;
+  }
   for (size_t i = 0; i < checks.size(); ++i) {
     const Check& k = checks[i];
     const std::string name = std::filesystem::path(k.source).filename().string();
@@ -121,17 +138,17 @@ void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles
     std::string rms, max;
     for (const ModelCheck* m : {&k.elastica, &k.shell}) {
       if (!m->run) continue;
-      rms += (rms.empty() ? "" : " / ") + Num(units::MToMm(m->c.rms), 2);
-      max += (max.empty() ? "" : " / ") + Num(units::MToMm(m->c.max), 2);
+      rms += (rms.empty() ? "" : "/") + Num(units::MToMm(m->c.rms), 2);
+      max += (max.empty() ? "" : "/") + Num(units::MToMm(m->c.max), 2);
     }
     if (k.elastica.run) lines.push_back(curve(k.elastica.c, i == 0 ? "elastica" : "", false, {0.1, 0.1, 0.1}));
     if (k.shell.run) lines.push_back(curve(k.shell.c, i == 0 ? "shell" : "", true, {0.85, 0.1, 0.1}));
-    const std::string note = name.substr(0, name.find('.')) + ": rms " + rms + ", max " + max + " mm";
+    const std::string note = stems[i].substr(common) + ": rms " + rms + ", max " + max + " mm";
     p.notes.push_back(note + (k.pass ? " ok" : " FAIL"));
   }
   for (auto& l : lines) p.series.push_back(std::move(l));
   if (!checks.empty() && checks[0].elastica.run && checks[0].shell.run)
-    p.notes.push_back("(elastica / shell)");
+    p.notes.push_back("(elastica/shell)");
   p.notes.push_back("law b1 = " + Num(law.b1_kes(), 4) + ", b2 = " + Num(law.b2_kes(), 4) +
                     " gf·cm, c1 = " + Num(law.c1_kes(), 4) + " gf·cm²");
   p.notes.push_back(std::string("verdict: ") + (pass ? "PASS" : "FAIL") + " (rms ≤ " +

@@ -65,15 +65,20 @@ std::vector<Vec2> ResampleByArc(const std::vector<Vec2>& p, double step) {
 int ConnectedComponents(const cv::Mat& mask, cv::Mat* labels, cv::Mat* stats) {
   const int n = cv::connectedComponents(mask, *labels, 8, CV_32S);
   std::vector<int> x0(n, INT_MAX), y0(n, INT_MAX), x1(n, -1), y1(n, -1), area(n, 0);
+  // By runs of one label along a row: the box and area once a run, not once a pixel.
+  const int cols = labels->cols;
   for (int y = 0; y < labels->rows; ++y) {
     const int* row = labels->ptr<int>(y);
-    for (int x = 0; x < labels->cols; ++x) {
+    for (int x = 0; x < cols;) {
       const int l = row[x];
+      int end = x + 1;
+      while (end < cols && row[end] == l) ++end;
       x0[l] = std::min(x0[l], x);
-      x1[l] = std::max(x1[l], x);
+      x1[l] = std::max(x1[l], end - 1);
       y0[l] = std::min(y0[l], y);
       y1[l] = std::max(y1[l], y);
-      ++area[l];
+      area[l] += end - x;
+      x = end;
     }
   }
   stats->create(n, 5, CV_32S);

@@ -163,12 +163,26 @@ std::vector<Block> FindBlocks(const cv::Mat& small, const cv::Mat& ignore, doubl
   for (Eigen::Index i = 0; i < count; ++i) rows.row(i) = grid[i];
   const Eigen::Map<const Eigen::VectorXd> values(samples.data(), count);
   // Trimmed least squares from a starting set of inliers: fit, then keep samples within 2.5σ.
+  // The normal equations summed over the inliers (0/1 weights) as one matrix-vector product:
+  // column i of `moments` holds sample i's 21 distinct basis products (the upper triangle of
+  // rowᵀ row) and its 6 basis values times its grey, formed once.
+  constexpr int kProducts = 21, kMoments = kProducts + 6;
+  Eigen::Matrix<double, kMoments, Eigen::Dynamic> moments(kMoments, count);
+  for (Eigen::Index i = 0; i < count; ++i) {
+    int k = 0;
+    for (int a = 0; a < 6; ++a)
+      for (int b = a; b < 6; ++b) moments(k++, i) = rows(i, a) * rows(i, b);
+    for (int a = 0; a < 6; ++a) moments(kProducts + a, i) = rows(i, a) * values(i);
+  }
   const auto robust_fit = [&](Eigen::VectorXd inlier, Eigen::Matrix<double, 6, 1>* coef) {
     double sigma = 0.5;
     std::vector<double> abs_in;
     for (int iter = 0; iter < 8; ++iter) {
-      const Eigen::Matrix<double, 6, 6> n = rows.transpose() * inlier.asDiagonal() * rows;
-      const Eigen::Matrix<double, 6, 1> r = rows.transpose() * inlier.cwiseProduct(values);
+      const Eigen::Matrix<double, kMoments, 1> sum = moments * inlier;
+      Eigen::Matrix<double, 6, 6> n;
+      for (int a = 0, k = 0; a < 6; ++a)
+        for (int b = a; b < 6; ++b, ++k) n(a, b) = n(b, a) = sum(k);
+      const Eigen::Matrix<double, 6, 1> r = sum.tail<6>();
       *coef = n.ldlt().solve(r);
       const Eigen::VectorXd res = (values - rows * *coef).cwiseAbs();
       abs_in.clear();

@@ -1,7 +1,5 @@
 #include "textile/sim/pattern_mesh.h"
 
-#include <gmsh.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -12,6 +10,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "gmsh_api.h"
 #include "textile/sim/error.h"
 
 namespace textile {
@@ -289,34 +288,94 @@ std::mutex& GmshMutex() {
   return m;
 }
 
+// Gmsh's last logged error, or `fallback`.
+std::string GmshError(const gmsh_api::Api& gmsh, const std::string& fallback) {
+  char* last = nullptr;
+  int ierr = 0;
+  gmsh.logger_get_last_error(&last, &ierr);
+  std::string message = ierr == 0 && last && *last ? last : fallback;
+  if (last) gmsh.free(last);
+  return "pattern mesh: Gmsh failed: " + message;
+}
+
+// A C API call's error flag -> ComputeError with Gmsh's message.
+void Check(const gmsh_api::Api& gmsh, int ierr, const char* call) {
+  if (ierr != 0) throw ComputeError(GmshError(gmsh, std::string(call) + " failed"));
+}
+
 class GmshSession {
  public:
-  GmshSession() : lock_(GmshMutex()) {
-    gmsh::initialize(0, nullptr, /*readConfigFiles=*/false);
-    gmsh::option::setNumber("General.Terminal", 0);
-    gmsh::logger::start();
+  explicit GmshSession(const gmsh_api::Api& gmsh) : gmsh_(gmsh), lock_(GmshMutex()) {
+    int ierr = 0;
+    gmsh_.initialize(0, nullptr, /*readConfigFiles=*/0, &ierr);
+    if (ierr != 0) throw ComputeError("pattern mesh: Gmsh failed to initialise");
+    gmsh_.option_set_number("General.Terminal", 0, &ierr);
+    Check(gmsh_, ierr, "option General.Terminal");
+    gmsh_.logger_start(&ierr);
+    Check(gmsh_, ierr, "logger start");
   }
-  ~GmshSession() {
-    try {
-      gmsh::logger::stop();
-      gmsh::finalize();
-    } catch (...) {  // never throw from a destructor; Gmsh is left for the next initialize
-    }
+  ~GmshSession() {  // errors here are ignored: Gmsh is left for the next initialize
+    int ierr = 0;
+    gmsh_.logger_stop(&ierr);
+    gmsh_.finalize(&ierr);
   }
   GmshSession(const GmshSession&) = delete;
   GmshSession& operator=(const GmshSession&) = delete;
 
  private:
+  const gmsh_api::Api& gmsh_;
   std::lock_guard<std::mutex> lock_;
 };
 
-std::string GmshError(const std::string& thrown) {
-  std::string last;
-  try {
-    gmsh::logger::getLastError(last);
-  } catch (...) {
+// An array the C API allocated, freed with gmshFree.
+template <class T>
+struct GmshArray {
+  const gmsh_api::Api& gmsh;
+  T* data = nullptr;
+  std::size_t size = 0;
+  explicit GmshArray(const gmsh_api::Api& g) : gmsh(g) {}
+  ~GmshArray() {
+    if (data) gmsh.free(data);
   }
-  return "pattern mesh: Gmsh failed: " + (last.empty() ? thrown : last);
+  GmshArray(const GmshArray&) = delete;
+  GmshArray& operator=(const GmshArray&) = delete;
+};
+
+// Arrays of arrays (getElements, fragment's map), freed inner first.
+template <class T>
+struct GmshArrays {
+  const gmsh_api::Api& gmsh;
+  T** data = nullptr;
+  std::size_t* sizes = nullptr;
+  std::size_t count = 0;
+  explicit GmshArrays(const gmsh_api::Api& g) : gmsh(g) {}
+  ~GmshArrays() {
+    for (std::size_t i = 0; data && i < count; ++i)
+      if (data[i]) gmsh.free(data[i]);
+    if (data) gmsh.free(data);
+    if (sizes) gmsh.free(sizes);
+  }
+  GmshArrays(const GmshArrays&) = delete;
+  GmshArrays& operator=(const GmshArrays&) = delete;
+};
+
+// The size field behind Gmsh's C callback; an exception must not cross Gmsh's frames, so it is
+// kept and rethrown after generate.
+struct SizeCallbackData {
+  const SizeField* field;
+  double h;
+  std::exception_ptr error;
+};
+
+double SizeCallback(int, int, double x, double y, double, void* data) {
+  auto* d = static_cast<SizeCallbackData*>(data);
+  if (d->error) return d->h;
+  try {
+    return d->field->Size(Vector2d(x, y));
+  } catch (...) {
+    d->error = std::current_exception();
+    return d->h;
+  }
 }
 
 // What Gmsh hands back, before compaction.
@@ -330,96 +389,123 @@ struct RawMesh {
 RawMesh RunGmsh(const Outline& outline, const std::vector<Polyline2>& seams, const SizeField& field,
                 const PatternMeshOptions& options) {
   const double h = options.element_size;
+  const gmsh_api::Api& gmsh = gmsh_api::Load();
   RawMesh raw;
-  GmshSession session;
-  std::exception_ptr callback_error;
-  try {
-    gmsh::model::add("pattern");
-    int surface;
-    if (outline.is_disk) {
-      surface = gmsh::model::occ::addDisk(0, 0, 0, outline.radius, outline.radius);
-    } else {
-      std::vector<int> points, lines;
-      for (int i = 0; i < outline.num_edges(); ++i) {
-        points.push_back(
-            gmsh::model::occ::addPoint(outline.polygon(i, 0), outline.polygon(i, 1), 0));
-      }
-      for (int i = 0; i < outline.num_edges(); ++i) {
-        lines.push_back(gmsh::model::occ::addLine(points[i], points[(i + 1) % points.size()]));
-      }
-      surface = gmsh::model::occ::addPlaneSurface({gmsh::model::occ::addCurveLoop(lines)});
+  GmshSession session(gmsh);
+  int ierr = 0;
+  const auto check = [&](const char* call) { Check(gmsh, ierr, call); };
+  gmsh.model_add("pattern", &ierr);
+  check("model add");
+  int surface;
+  if (outline.is_disk) {
+    surface = gmsh.occ_add_disk(0, 0, 0, outline.radius, outline.radius, -1, &ierr);
+    check("add disk");
+  } else {
+    std::vector<int> points, lines;
+    for (int i = 0; i < outline.num_edges(); ++i) {
+      points.push_back(
+          gmsh.occ_add_point(outline.polygon(i, 0), outline.polygon(i, 1), 0, 0, -1, &ierr));
+      check("add point");
     }
-    // Seam segments as lines; "fragment" embeds them, splits them where they cross each other and
-    // splits the boundary where they end on it.
-    gmsh::vectorpair tools;
-    std::vector<int> seam_of_tool;
-    for (int k = 0; k < static_cast<int>(seams.size()); ++k) {
-      std::vector<int> points;
-      for (int i = 0; i < seams[k].rows(); ++i) {
-        points.push_back(gmsh::model::occ::addPoint(seams[k](i, 0), seams[k](i, 1), 0));
-      }
-      for (int i = 0; i + 1 < static_cast<int>(points.size()); ++i) {
-        tools.push_back({1, gmsh::model::occ::addLine(points[i], points[i + 1])});
-        seam_of_tool.push_back(k);
-      }
+    for (int i = 0; i < outline.num_edges(); ++i) {
+      lines.push_back(gmsh.occ_add_line(points[i], points[(i + 1) % points.size()], -1, &ierr));
+      check("add line");
     }
-    std::vector<std::vector<int>> seam_curves(seams.size());
-    if (!tools.empty()) {
-      gmsh::vectorpair out;
-      std::vector<gmsh::vectorpair> pieces;
-      gmsh::model::occ::fragment({{2, surface}}, tools, out, pieces);
-      for (std::size_t t = 0; t < tools.size(); ++t) {
-        for (const auto& [dim, tag] : pieces.at(t + 1)) {
-          if (dim == 1) seam_curves[seam_of_tool[t]].push_back(tag);
-        }
-      }
-    }
-    gmsh::model::occ::synchronize();
-
-    gmsh::option::setNumber("Mesh.Algorithm", options.gmsh_algorithm);
-    gmsh::option::setNumber("Mesh.MeshSizeFromPoints", 0);
-    gmsh::option::setNumber("Mesh.MeshSizeFromCurvature", 0);
-    gmsh::option::setNumber("Mesh.MeshSizeExtendFromBoundary", 0);
-    gmsh::option::setNumber("Mesh.MeshSizeMax", h);
-    gmsh::model::mesh::setSizeCallback([&](int, int, double x, double y, double) {
-      if (callback_error) return h;
-      try {
-        return field.Size(Vector2d(x, y));
-      } catch (...) {  // exceptions must not cross Gmsh's frames; rethrown after generate
-        callback_error = std::current_exception();
-        return h;
-      }
-    });
-    gmsh::model::mesh::generate(2);
-    if (callback_error) std::rethrow_exception(callback_error);
-
-    std::vector<double> parametric;
-    gmsh::model::mesh::getNodes(raw.node_tags, raw.node_xyz, parametric, -1, -1, false, false);
-    std::vector<int> types;
-    std::vector<std::vector<std::size_t>> element_tags, element_nodes;
-    gmsh::model::mesh::getElements(types, element_tags, element_nodes, 2, -1);
-    for (std::size_t i = 0; i < types.size(); ++i) {
-      if (types[i] != 2) {
-        throw ComputeError("pattern mesh: Gmsh returned surface elements of type " +
-                           std::to_string(types[i]) + ", not 3-node triangles");
-      }
-      raw.triangle_nodes.insert(raw.triangle_nodes.end(), element_nodes[i].begin(),
-                                element_nodes[i].end());
-    }
-    raw.seam_nodes.resize(seams.size());
-    for (std::size_t k = 0; k < seams.size(); ++k) {
-      for (int curve : seam_curves[k]) {
-        std::vector<std::size_t> tags;
-        std::vector<double> xyz;
-        gmsh::model::mesh::getNodes(tags, xyz, parametric, 1, curve, /*includeBoundary=*/true,
-                                    false);
-        raw.seam_nodes[k].insert(raw.seam_nodes[k].end(), tags.begin(), tags.end());
-      }
-    }
-    gmsh::model::mesh::removeSizeCallback();
-  } catch (const std::string& thrown) {  // Gmsh 4.8 throws its error message as a string
-    throw ComputeError(GmshError(thrown));
+    int loop = gmsh.occ_add_curve_loop(lines.data(), lines.size(), -1, &ierr);
+    check("add curve loop");
+    surface = gmsh.occ_add_plane_surface(&loop, 1, -1, &ierr);
+    check("add plane surface");
   }
+  // Seam segments as lines; "fragment" embeds them, splits them where they cross each other and
+  // splits the boundary where they end on it.
+  std::vector<int> tools;  // (dim, tag) pairs
+  std::vector<int> seam_of_tool;
+  for (int k = 0; k < static_cast<int>(seams.size()); ++k) {
+    std::vector<int> points;
+    for (int i = 0; i < seams[k].rows(); ++i) {
+      points.push_back(gmsh.occ_add_point(seams[k](i, 0), seams[k](i, 1), 0, 0, -1, &ierr));
+      check("add point");
+    }
+    for (int i = 0; i + 1 < static_cast<int>(points.size()); ++i) {
+      tools.push_back(1);
+      tools.push_back(gmsh.occ_add_line(points[i], points[i + 1], -1, &ierr));
+      check("add line");
+      seam_of_tool.push_back(k);
+    }
+  }
+  std::vector<std::vector<int>> seam_curves(seams.size());
+  if (!tools.empty()) {
+    int object[2] = {2, surface};
+    GmshArray<int> out(gmsh);
+    GmshArrays<int> pieces(gmsh);  // per input (the object, then each tool): (dim, tag) pairs
+    gmsh.occ_fragment(object, 2, tools.data(), tools.size(), &out.data, &out.size, &pieces.data,
+                      &pieces.sizes, &pieces.count, -1, 1, 1, &ierr);
+    check("fragment");
+    for (std::size_t t = 0; t < seam_of_tool.size(); ++t) {
+      if (t + 1 >= pieces.count) throw ComputeError("pattern mesh: Gmsh's fragment map is short");
+      for (std::size_t j = 0; j + 1 < pieces.sizes[t + 1]; j += 2) {
+        if (pieces.data[t + 1][j] == 1)
+          seam_curves[seam_of_tool[t]].push_back(pieces.data[t + 1][j + 1]);
+      }
+    }
+  }
+  gmsh.occ_synchronize(&ierr);
+  check("synchronize");
+
+  for (const auto& [name, value] :
+       {std::pair<const char*, double>{"Mesh.Algorithm", options.gmsh_algorithm},
+        {"Mesh.MeshSizeFromPoints", 0},
+        {"Mesh.MeshSizeFromCurvature", 0},
+        {"Mesh.MeshSizeExtendFromBoundary", 0},
+        {"Mesh.MeshSizeMax", h}}) {
+    gmsh.option_set_number(name, value, &ierr);
+    check(name);
+  }
+  SizeCallbackData size{&field, h, nullptr};
+  gmsh.mesh_set_size_callback(SizeCallback, &size, &ierr);
+  check("set size callback");
+  gmsh.mesh_generate(2, &ierr);
+  if (size.error) std::rethrow_exception(size.error);
+  check("generate");
+
+  {
+    GmshArray<std::size_t> tags(gmsh);
+    GmshArray<double> xyz(gmsh), parametric(gmsh);
+    gmsh.mesh_get_nodes(&tags.data, &tags.size, &xyz.data, &xyz.size, &parametric.data,
+                        &parametric.size, -1, -1, 0, 0, &ierr);
+    check("get nodes");
+    raw.node_tags.assign(tags.data, tags.data + tags.size);
+    raw.node_xyz.assign(xyz.data, xyz.data + xyz.size);
+  }
+  {
+    GmshArray<int> types(gmsh);
+    GmshArrays<std::size_t> element_tags(gmsh), element_nodes(gmsh);
+    gmsh.mesh_get_elements(&types.data, &types.size, &element_tags.data, &element_tags.sizes,
+                           &element_tags.count, &element_nodes.data, &element_nodes.sizes,
+                           &element_nodes.count, 2, -1, &ierr);
+    check("get elements");
+    for (std::size_t i = 0; i < types.size && i < element_nodes.count; ++i) {
+      if (types.data[i] != 2) {
+        throw ComputeError("pattern mesh: Gmsh returned surface elements of type " +
+                           std::to_string(types.data[i]) + ", not 3-node triangles");
+      }
+      raw.triangle_nodes.insert(raw.triangle_nodes.end(), element_nodes.data[i],
+                                element_nodes.data[i] + element_nodes.sizes[i]);
+    }
+  }
+  raw.seam_nodes.resize(seams.size());
+  for (std::size_t k = 0; k < seams.size(); ++k) {
+    for (int curve : seam_curves[k]) {
+      GmshArray<std::size_t> tags(gmsh);
+      GmshArray<double> xyz(gmsh), parametric(gmsh);
+      gmsh.mesh_get_nodes(&tags.data, &tags.size, &xyz.data, &xyz.size, &parametric.data,
+                          &parametric.size, 1, curve, /*includeBoundary=*/1, 0, &ierr);
+      check("get seam nodes");
+      raw.seam_nodes[k].insert(raw.seam_nodes[k].end(), tags.data, tags.data + tags.size);
+    }
+  }
+  gmsh.mesh_remove_size_callback(&ierr);
+  check("remove size callback");
   return raw;
 }
 

@@ -85,6 +85,22 @@ TEST(CliDrape, NonConvergenceIsExit3WithOneLineAndNoFiles) {
   EXPECT_FALSE(fs::exists(dir / "r.outline.csv"));
 }
 
+// Gmsh is loaded when a mesh is needed, not at start-up (libsim/src/gmsh_api.h): without it a
+// drape fails with one clear line and no files, and a command that meshes nothing still runs.
+TEST(CliDrape, WithoutGmshIsExit3WithOneLineAndNoFiles) {
+  const auto dir = Scratch("CliDrape.NoGmsh");
+  const std::string missing = "TEXTILE_GMSH=/nonexistent/libgmsh.so.4.8";
+  const auto r = Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "r.json").string(), missing);
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
+  EXPECT_EQ(testing::CountLines(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("cannot load Gmsh (tried /nonexistent/libgmsh.so.4.8)"), std::string::npos)
+      << r.err;
+  EXPECT_TRUE(fs::is_empty(dir));
+  const auto law = Textile("law " + kFig8, missing);
+  EXPECT_EQ(law.exit_code, 0) << law.err;
+}
+
 TEST(CliDrape, RefusesBadInput) {
   const auto dir = Scratch("CliDrape.Bad");
   const std::string o = " -o " + (dir / "r.json").string();

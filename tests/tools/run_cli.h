@@ -35,13 +35,15 @@ inline std::filesystem::path Scratch(const std::string& name) {
 }
 
 // args: everything after `textile`, already shell-quoted where needed. Runs from the source
-// root so that sample paths read as in the README.
-inline CliResult RunTextile(const std::string& args, const std::string& tag = "run") {
+// root so that sample paths read as in the README. env: NAME=value settings for the run, or "".
+inline CliResult RunTextile(const std::string& args, const std::string& tag = "run",
+                            const std::string& env = "") {
   const auto d = std::filesystem::path(TEXTILE_BINARY_DIR) / "test_scratch" / "cli_io";
   std::filesystem::create_directories(d);
   const std::string out = (d / (tag + ".out")).string(), err = (d / (tag + ".err")).string();
-  const std::string cmd = std::string("cd '") + TEXTILE_SOURCE_DIR + "' && timeout 120 '" +
-                          TEXTILE_EXE + "' " + args + " > '" + out + "' 2> '" + err + "' < /dev/null";
+  const std::string cmd = std::string("cd '") + TEXTILE_SOURCE_DIR + "' && env " + env +
+                          " timeout 120 '" + TEXTILE_EXE + "' " + args + " > '" + out + "' 2> '" +
+                          err + "' < /dev/null";
   const int status = std::system(cmd.c_str());
   CliResult r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -58,9 +60,9 @@ inline int CountLines(const std::string& s) {
 
 // RunTextile with capture files named after the running test, so that tests run in parallel
 // by ctest never share them.
-inline CliResult Textile(const std::string& args) {
+inline CliResult Textile(const std::string& args, const std::string& env = "") {
   const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-  return RunTextile(args, std::string(test->test_suite_name()) + "." + test->name());
+  return RunTextile(args, std::string(test->test_suite_name()) + "." + test->name(), env);
 }
 
 // Expects a refusal: exit 2, one line "error: ..." containing `fragment`, nothing on stdout.

@@ -130,8 +130,8 @@ enum class LaneModel { kPabst, kPabstWarpWeft, kBridson };
 // Where the kernel reads coordinate c of corner i of lane l: gathered lanes (LanePositions) or
 // straight from the positions through the corners' offsets (GatherPositions).
 struct GatherPositions {
-  const double* x;          // #V×3 positions, row-major
-  const int* corner[4];     // offsets 3 v[i] of the block's hinges
+  const double* x;       // #V×3 positions, row-major
+  const int* corner[4];  // offsets 3 v[i] of the block's hinges
   TEXTILE_ALWAYS_INLINE double at(int i, int c, int l) const { return x[corner[i][l] + c]; }
 };
 TEXTILE_ALWAYS_INLINE double PositionAt(const LanePositions& pos, int i, int c, int l) {
@@ -308,14 +308,14 @@ TEXTILE_ALWAYS_INLINE void Unroll(F&& f) {
 }
 
 // Energy and/or gradient of the dihedral hinges begin ≤ h < end, whole: the kernel on blocks of
-// kLanes hinges, reading the positions through the corners' offsets (vector gathers where the
-// machine has them), then the gradient scattered in hinge order (the same additions in the same
-// order as a hinge-by-hinge loop). One function, so that all of it gets the SIMD clone's
-// instructions.
+// kLanes hinges, reading the positions through the corners' offsets (vector gathers, or the
+// compiler's emulation of them), then the gradient scattered in hinge order (the same additions
+// in the same order as a hinge-by-hinge loop). One function, so that all of it gets the SIMD
+// clone's instructions.
 struct DihedralBlocksIn {
-  DihedralLanesIn rest;        // the rest arrays at hinge 0
-  const int* corner[4];        // 3 v[i] of every hinge, padded by kLanes (first hinge's ids)
-  const double* x;             // #V×3 positions, row-major
+  DihedralLanesIn rest;  // the rest arrays at hinge 0
+  const int* corner[4];  // 3 v[i] of every hinge, padded by kLanes (first hinge's ids)
+  const double* x;       // #V×3 positions, row-major
 };
 
 template <LaneModel kModel, bool kEnergy, bool kGradient>
@@ -368,7 +368,9 @@ template <LaneModel kModel>
 TEXTILE_ALWAYS_INLINE double DihedralBlocksModel(const DihedralBlocksIn& in, long begin, long end,
                                                  bool energy, double* grad, double* hinge_grad) {
   const bool gradient = grad || hinge_grad;
-  if (energy && gradient) return DihedralBlocksImpl<kModel, true, true>(in, begin, end, grad, hinge_grad);
+  if (energy && gradient) {
+    return DihedralBlocksImpl<kModel, true, true>(in, begin, end, grad, hinge_grad);
+  }
   if (gradient) return DihedralBlocksImpl<kModel, false, true>(in, begin, end, grad, hinge_grad);
   return DihedralBlocksImpl<kModel, true, false>(in, begin, end, grad, hinge_grad);
 }

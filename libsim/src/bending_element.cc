@@ -239,29 +239,16 @@ TEXTILE_ALWAYS_INLINE void DihedralLanesImpl(const DihedralLanesIn& in, const Po
   }
 }
 
-template <LaneModel kModel>
-TEXTILE_ALWAYS_INLINE void DihedralLanesModel(const DihedralLanesIn& in, const LanePositions& pos,
-                                              bool energy, bool gradient, DihedralLanesOut* out) {
-  if (energy && gradient) {
-    DihedralLanesImpl<kModel, true, true, false>(in, pos, out);
-  } else if (gradient) {
-    DihedralLanesImpl<kModel, false, true, false>(in, pos, out);
-  } else if (energy) {
-    DihedralLanesImpl<kModel, true, false, false>(in, pos, out);
-  } else {
-    DihedralLanesImpl<kModel, false, false, true>(in, pos, out);
-  }
-}
-
-// energy and/or gradient; neither: the Hessian's inputs (d_energy, d2_energy, ∂θ/∂x).
-TEXTILE_SIMD_CLONES void DihedralLanes(const DihedralLanesIn& in, const LanePositions& pos,
-                                       bool energy, bool gradient, DihedralLanesOut* out) {
+// The Hessian's inputs of a block of gathered hinges: d_energy, d2_energy and ∂θ/∂x (energy
+// and gradient go through DihedralBlocks).
+TEXTILE_SIMD_CLONES void HessianInputLanes(const DihedralLanesIn& in, const LanePositions& pos,
+                                           DihedralLanesOut* out) {
   if (!in.pabst) {
-    DihedralLanesModel<LaneModel::kBridson>(in, pos, energy, gradient, out);
+    DihedralLanesImpl<LaneModel::kBridson, false, false, true>(in, pos, out);
   } else if (in.anisotropic) {
-    DihedralLanesModel<LaneModel::kPabstWarpWeft>(in, pos, energy, gradient, out);
+    DihedralLanesImpl<LaneModel::kPabstWarpWeft, false, false, true>(in, pos, out);
   } else {
-    DihedralLanesModel<LaneModel::kPabst>(in, pos, energy, gradient, out);
+    DihedralLanesImpl<LaneModel::kPabst, false, false, true>(in, pos, out);
   }
 }
 
@@ -1019,7 +1006,7 @@ void BendingElements::HessianBlocks(const Vertices& x, HessianProjection project
                            dihedral_.sin_half.data() + first,
                            dihedral_.cos_half.data() + first};
   DihedralLanesOut out;
-  DihedralLanes(in, pos, false, false, &out);
+  HessianInputLanes(in, pos, &out);
   HessianLanes(pos, out, projection == HessianProjection::kNone, lanes);
 }
 

@@ -20,7 +20,7 @@ namespace {
 struct CalibrateArgs {
   std::vector<std::string> boards;
   std::string board = "", out, overlay;
-  double square_mm = 0.0, max_error_px = 1.0;
+  double square_mm = 0.0, max_error_px = 1.0, max_seconds = 60.0;
   bool no_lens = false, json = false;
 };
 
@@ -59,11 +59,13 @@ void Run(const CalibrateArgs& a) {
   o.square_mm = a.square_mm;
   o.max_error_px = a.max_error_px;
   o.lens = !a.no_lens;
+  o.max_seconds = a.max_seconds;
   std::string why;
   if (!o.Check(&why)) {
-    const std::string flag = why.rfind("square size", 0) == 0 ? "--square-mm"
-                             : why.rfind("maximum", 0) == 0    ? "--max-error-px"
-                                                               : "--board";
+    const std::string flag = why.rfind("square size", 0) == 0   ? "--square-mm"
+                             : why.rfind("maximum", 0) == 0      ? "--max-error-px"
+                             : why.rfind("max_seconds", 0) == 0  ? "--max-seconds"
+                                                                 : "--board";
     throw InputError(flag + ": " + why);
   }
   // Outputs checked before the work.
@@ -111,7 +113,7 @@ void RegisterCalibrate(CLI::App& app) {
   CLI::App* sub = AddSubcommand(
       app, "calibrate",
       "Chessboard photo(s) in the bending plane -> rig file (homography, lens distortion)",
-      "textile calibrate samples/photos/pabst-fig8.board.png --board 9x6 --square-mm 13 -o rig.json");
+      "textile calibrate samples/photos/pabst-fig8.board.jpg --board 9x6 --square-mm 13 -o rig.json");
   sub->add_option("boards", a->boards,
                   "Board photos (PNG, JPEG, TIFF, BMP); the first lies in the bending plane, more "
                   "(other poses) also give the lens distortion")
@@ -122,6 +124,8 @@ void RegisterCalibrate(CLI::App& app) {
   sub->add_option("--overlay", a->overlay, "Write the first board with its corners drawn (PNG)");
   sub->add_option("--max-error-px", a->max_error_px,
                   "Refuse a calibration whose RMS reprojection error is larger (default 1 px)");
+  sub->add_option("--max-seconds", a->max_seconds,
+                  "Wall-time cap [s] (default 60): past it, no rig is written and the exit is 3");
   sub->add_flag("--no-lens", a->no_lens, "Homography only, even with several boards");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   sub->callback([a] { Run(*a); });

@@ -24,6 +24,7 @@ struct ExtractArgs {
   std::string out_dir;
   PhotoFlags photo;
   int overlay_px = 2000;
+  double max_seconds = 30.0;
   bool json = false;
 };
 
@@ -32,9 +33,12 @@ nlohmann::json Point(const Eigen::Vector2d& p) { return {p.x(), p.y()}; }
 void Run(const ExtractArgs& a) {
   const PhotoInputOptions options = a.photo.Options();
   const Rig rig = RigFromOptions(options, "extract");
-  const ExtractOptions& o = options.extract;
+  ExtractOptions o = options.extract;
   if (a.overlay_px < 200 || a.overlay_px > 20000)
     throw InputError("--overlay-px must lie in [200, 20000]");
+  if (!(std::isfinite(a.max_seconds) && a.max_seconds >= 0.0))
+    throw InputError("--max-seconds must be a finite number >= 0 [s]");
+  o.max_seconds = a.max_seconds;
   // Outputs are named after the photos: two photos with one stem would overwrite each other.
   std::map<std::string, std::string> stems;
   for (const auto& photo : a.photos) {
@@ -115,6 +119,9 @@ void RegisterExtract(CLI::App& app) {
   AddPhotoFlags(sub, &a->photo);
   sub->add_option("--overlay-px", a->overlay_px,
                   "Long side of the overlay PNG [px] (default 2000)");
+  sub->add_option("--max-seconds", a->max_seconds,
+                  "Wall-time cap per photo [s] (default 30): past it, nothing is written and the "
+                  "exit is 3");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   sub->callback([a] { Run(*a); });
 }

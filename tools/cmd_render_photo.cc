@@ -89,6 +89,13 @@ void WriteImage(const AtomicFile& f, const cv::Mat& image, const std::vector<uns
   if (!cv::imwrite(f.temp_path(), image, params)) throw InputError(f.path() + ": cannot write the image");
 }
 
+// The suffix of an overhang's photo when several are rendered: "_L040mm".
+std::string LengthTag(double length_mm) {
+  char tag[32];
+  std::snprintf(tag, sizeof tag, "_L%03.0fmm", length_mm);
+  return tag;
+}
+
 void Run(const RenderArgs& a) {
   const Material m = ReadMaterial(a.material);
   const auto [w, h] = ParsePair(a.size, "--size");
@@ -98,6 +105,16 @@ void Run(const RenderArgs& a) {
   for (double L : a.overhangs_mm) {
     if (!(std::isfinite(L) && L >= 1.0 && L <= 2000.0))
       throw InputError("--overhang-mm: " + Num(L) + " mm is outside [1, 2000] mm");
+  }
+  // Several lengths name their photos by the whole millimetre (_L040mm): two that round alike
+  // would write the same files.
+  for (size_t i = 0; i < a.overhangs_mm.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      if (LengthTag(a.overhangs_mm[i]) == LengthTag(a.overhangs_mm[j]))
+        throw InputError("--overhang-mm: " + Num(a.overhangs_mm[j]) + " and " +
+                         Num(a.overhangs_mm[i]) + " mm would name the same photo (" +
+                         LengthTag(a.overhangs_mm[i]) + ")");
+    }
   }
   if (!(std::isfinite(a.thickness_mm) && a.thickness_mm > 0 && a.thickness_mm <= 20))
     throw InputError("--thickness-mm must lie in (0, 20] mm");
@@ -147,9 +164,7 @@ void Run(const RenderArgs& a) {
   for (size_t k = 0; k < order.size(); ++k) {
     const size_t i = order[k];
     o.overhang = lengths[i] * 1e-3;
-    char tag[32];
-    std::snprintf(tag, sizeof tag, "_L%03.0fmm", lengths[i]);
-    const std::string photo_path = several ? WithSuffix(a.out, tag, ext) : a.out;
+    const std::string photo_path = several ? WithSuffix(a.out, LengthTag(lengths[i]), ext) : a.out;
     const std::string truth_path = WithSuffix(photo_path, ".truth", ".csv");
     if (several) Info("rendering " + photo_path + " ...");
     const RenderedPhoto r = RenderPhoto(m.EffectiveLaw(), m.areal_density, o);

@@ -55,6 +55,8 @@ bool CalibrateOptions::Check(std::string* why) const {
     p << "maximum error must lie in (0, 100] px";
   } else if (detect_side_px < 400 || detect_side_px > 20000) {
     p << "detect_side_px must lie in [400, 20000]";
+  } else if (!(std::isfinite(max_seconds) && max_seconds >= 0.0)) {
+    p << "max_seconds must be a finite number >= 0 [s]";
   }
   if (why) *why = p.str();
   return p.str().empty();
@@ -129,7 +131,21 @@ CalibrationSummary CalibrateRig(const std::vector<cv::Mat>& boards,
   }
   CalibrationSummary s;
   s.boards = static_cast<int>(boards.size());
+  // The time cap (CalibrateOptions::max_seconds): each board's corner search and the lens fit
+  // are bounded by OpenCV's own criteria; the cap is read before each of them.
+  const auto past_cap = [&](const std::string& stage) {
+    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (t < o.max_seconds) return false;
+    std::ostringstream m;
+    m.precision(3);
+    m << "calibrate: time cap of " << o.max_seconds << " s reached after " << t
+      << " s, " << stage << "; no rig";
+    s.message = m.str();
+    s.seconds = t;
+    return true;
+  };
   for (size_t i = 0; i < boards.size(); ++i) {
+    if (past_cap("before the corners of " + sources[i] + " were searched")) return s;
     s.detections.push_back(DetectChessboard(boards[i], o.cols, o.rows, sources[i], o.detect_side_px));
     if (!s.detections.back().found) {
       s.message = sources[i] + ": chessboard with " + std::to_string(o.cols) + "x" +
@@ -162,6 +178,7 @@ CalibrationSummary CalibrateRig(const std::vector<cv::Mat>& boards,
     for (const auto& d : s.detections) images.push_back(to_cv(d.corners_px));
     cv::Mat K, dist;
     std::vector<cv::Mat> rvecs, tvecs;
+    if (past_cap("before the lens fit")) return s;
     try {
       s.lens_rms_px = cv::calibrateCamera(objects, images, boards[0].size(), K, dist, rvecs, tvecs);
     } catch (const cv::Exception& e) {
@@ -187,6 +204,7 @@ CalibrationSummary CalibrateRig(const std::vector<cv::Mat>& boards,
     cv::undistortPoints(first, undistorted, K, dist, cv::noArray(), K);
     first = undistorted;
   }
+  if (past_cap("before the homography")) return s;
   // Plane <- image, least squares over all corners (no outliers on a found board).
   const cv::Mat Hcv = cv::findHomography(first, plane, 0);
   if (Hcv.empty()) {

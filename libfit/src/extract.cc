@@ -1021,6 +1021,10 @@ bool ExtractOptions::Check(std::string* why) const {
     *why = "detect_side_px must lie in [200, 8000]";
     return false;
   }
+  if (!(std::isfinite(max_seconds) && max_seconds >= 0.0)) {
+    *why = "max_seconds must be a finite number >= 0 [s]";
+    return false;
+  }
   return true;
 }
 
@@ -1067,8 +1071,22 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     return r;
   };
+  // The time cap (ExtractOptions::max_seconds), read between stages; each stage is a bounded
+  // pass over the photo, so the cap bounds a run to the cap plus one stage.
+  const auto past_cap = [&](const char* stage) {
+    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    if (t < options.max_seconds) return false;
+    r.profile = Profile{};
+    std::ostringstream m;
+    m.precision(3);
+    m << "time cap of " << options.max_seconds << " s reached after " << t << " s, " << stage
+      << "; no profile";
+    fail(m.str());
+    return true;
+  };
 
   // ---- 1. Find the strip on a reduced image.
+  if (past_cap("before the strip was looked for")) return r;
   const double scale = std::min(1.0, options.detect_side_px / double(std::max(W, H)));
   // Large photos get an intermediate level too, reduced by an integer factor to about 2000 px
   // (a box average, the fast case of cv::INTER_AREA; the photo's last f - 1 rows and columns
@@ -1224,6 +1242,7 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   r.direction = direction > 0 ? "right" : "left";
 
   // ---- 4. Platform or clamp?
+  if (past_cap("after the strip's centre line was found")) return r;
   PlatformFit platform;
   std::string platform_why = "no block under the strip's held end";
   if (options.rig != RigKind::kClamp) {
@@ -1308,6 +1327,7 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   r.width_px = set.width;
   int first = run.first, last = run.second;
 
+  if (past_cap("after the cross-sections were measured")) return r;
   // ---- 6. The tip. Sections within ¾ of a width of the end straddle the end face, so the
   // line is continued straight from the stretch before them, to where the contrast along the
   // strip's middle falls to half (a frayed end was already trimmed to where sections collapse
@@ -1539,6 +1559,7 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
     return fail("the extracted profile is not a hanging strip: " +
                 (colon == std::string::npos ? m : m.substr(colon + 2)));
   }
+  if (past_cap("with the profile done")) return r;
   r.success = true;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return r;

@@ -9,6 +9,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 
 #include "textile/fit/extract.h"
@@ -165,6 +166,26 @@ TEST(Calibrate, RefusesMissingBoardsWrongCountsAndBadOptions) {
   const CalibrationSummary s = CalibrateRig({r.board}, {"board"}, strict);
   EXPECT_FALSE(s.success);
   EXPECT_NE(s.message.find("implausible"), std::string::npos) << s.message;
+}
+
+// The time cap: 0 s stops before the first board's corners are searched, with a message that
+// says so and no rig; a cap that is not a finite number >= 0 is refused.
+TEST(Calibrate, TimeCapEndsInFailureWithoutARig) {
+  const RenderedPhoto r = Rendered(PhotoDifficulty::kEasy, 1);
+  CalibrateOptions o = Board(r);
+  o.max_seconds = 0.0;
+  const CalibrationSummary s = CalibrateRig({r.board}, {"board.png"}, o);
+  EXPECT_FALSE(s.success);
+  EXPECT_NE(s.message.find("time cap of 0 s reached"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("before the corners of board.png"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("no rig"), std::string::npos) << s.message;
+  EXPECT_TRUE(s.detections.empty());
+  o.max_seconds = 1e6;
+  EXPECT_TRUE(CalibrateRig({r.board}, {"board.png"}, o).success);
+  for (double bad : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    o.max_seconds = bad;
+    EXPECT_THROW(CalibrateRig({r.board}, {"board.png"}, o), InputError) << bad;
+  }
 }
 
 }  // namespace

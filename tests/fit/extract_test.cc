@@ -12,6 +12,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
@@ -471,6 +472,29 @@ TEST(ExtractFailures, BadInputThrows) {
   ExtractOptions level;
   level.level_deg = 90.0;
   EXPECT_THROW(Extract(gray, level), InputError);
+}
+
+// The time cap: 0 s stops a run at its first check with a message and no profile; a cap the
+// photo fits in changes nothing; a cap that is not a finite number >= 0 is refused.
+TEST(ExtractFailures, TimeCapEndsInFailureWithoutAProfile) {
+  const cv::Mat gray = testing::Render(BorderScene()).gray;
+  ExtractOptions capped;
+  capped.max_seconds = 0.0;
+  const ExtractionSummary r = Extract(gray, capped);
+  EXPECT_FALSE(r.success);
+  EXPECT_NE(r.message.find("time cap of 0 s reached"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("no profile"), std::string::npos) << r.message;
+  EXPECT_TRUE(r.profile.s.empty());
+  ExtractOptions roomy;
+  roomy.max_seconds = 1e6;
+  const ExtractionSummary full = Extract(gray, roomy);
+  ASSERT_TRUE(full.success) << full.message;
+  EXPECT_EQ(full.profile.y, Extract(gray).profile.y);
+  for (double bad : {-1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    ExtractOptions o;
+    o.max_seconds = bad;
+    EXPECT_THROW(Extract(gray, o), InputError) << bad;
+  }
 }
 
 // ------------------------------------------------------------------ reading photos

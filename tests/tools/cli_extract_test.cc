@@ -203,6 +203,8 @@ TEST(CliExtract, BadInputExitsTwoWithOneLineAndNoOutput) {
       {Quote(good) + scale + " --level-deg 60", "--level-deg"},
       {Quote(good) + scale + " --step-mm 0", "--step-mm"},
       {Quote(good) + scale + " --trace middle", "--trace"},
+      {Quote(good) + scale + " --max-seconds -1", "--max-seconds must be a finite number >= 0"},
+      {Quote(good) + scale + " --max-seconds inf", "--max-seconds must be a finite number >= 0"},
       {Quote(good) + " " + Quote(dir / "sub" / "good.png") + scale, "same file name"},
   };
   for (const Case& c : cases) {
@@ -233,6 +235,7 @@ TEST(CliExtract, DetectionFailuresExitThreeAndKeepGoodOutputs) {
       {"cut.png", cut, "", "the free tip is cut off by the image border"},
       {"forced.png", Strip(), " --rig-type platform", "platform not found"},
       {"hook.png", hook, "", "the extracted profile is not a hanging strip"},
+      {"capped.png", Strip(), " --max-seconds 0", "time cap of 0 s reached after"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);

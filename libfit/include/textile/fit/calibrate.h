@@ -34,6 +34,7 @@ struct CalibrateOptions {
   double max_error_px = 1.0;   // refuse a calibration whose RMS reprojection error is larger [px]
   bool lens = true;            // with several boards, also fit lens distortion (k1, k2, p1, p2, k3)
   int detect_side_px = 2000;   // long side of the reduced image the corners are found on [px]
+  double max_seconds = 60.0;   // wall-time cap, read after each board and after the lens fit [s]
 
   // True if every field is usable; otherwise *why says which and why.
   bool Check(std::string* why) const;

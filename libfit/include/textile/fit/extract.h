@@ -65,6 +65,9 @@ struct ExtractOptions {
   double step_mm = 0.5;
   // Long side of the reduced image on which the strip and the rig are detected [px].
   int detect_side_px = 1000;
+  // Wall-time cap [s], checked between the stages: a run past it fails ("time cap ..."), with
+  // no profile. A 12 MP photo takes about 0.1 s; 0 stops every run at the first check.
+  double max_seconds = 30.0;
 
   // True if every field is usable; otherwise *why says which and why.
   bool Check(std::string* why) const;

@@ -7,6 +7,7 @@
 #include <barrier>
 #include <cassert>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 #include <thread>
 #include <utility>
@@ -477,6 +478,71 @@ constexpr std::array<int, 144> MakeFullToPacked() {
   return m;
 }
 constexpr std::array<int, 144> kFullToPacked = MakeFullToPacked();
+
+// The vertex pairs (i, j), i ≤ j, of a hinge, in the order of BendingHessianSlots::block_slot.
+constexpr int kHingePairs = 10;
+constexpr std::array<std::array<int, 2>, kHingePairs> kHingePair = {
+    {{0, 0}, {0, 1}, {0, 2}, {0, 3}, {1, 1}, {1, 2}, {1, 3}, {2, 2}, {2, 3}, {3, 3}}};
+
+// Vertex block (i, j) of a hinge's 12×12 block, 4 i + j, as packed upper-triangle entries:
+// [4 i + j][3 a + b] holds entry (3 i + a, 3 j + b) (the block is symmetric).
+constexpr std::array<std::array<int, 9>, 16> MakeBlockToPacked() {
+  std::array<std::array<int, 9>, 16> m{};
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) m[4 * i + j][3 * a + b] = kFullToPacked[12 * (3 * i + a) + 3 * j + b];
+  return m;
+}
+constexpr std::array<std::array<int, 9>, 16> kBlockToPacked = MakeBlockToPacked();
+
+// Eight doubles as one value (GCC's vector extension): one AVX-512 register, two AVX2 ones, or
+// four SSE2 ones, depending on the clone.
+using Double8 = double __attribute__((vector_size(64)));
+using Long8 = long __attribute__((vector_size(64)));
+
+// Adds the first `count` hinges of a lane block to the 3×3 blocks (block_slot: theirs, 10 a
+// hinge), in hinge order. Per vertex pair the block's first 8 entries are picked from the lanes
+// into one vector (transposed by a shuffle when the pair's vertices are in the other order) and
+// added with one read-modify-write, the 9th alone: 20 stores a hinge instead of 78 scalar
+// read-modify-writes at scattered positions (docs/bending.md, "Where the time goes").
+TEXTILE_SIMD_CLONES void AddLaneBlocks(const LaneHessian& u, int count, const int* block_slot,
+                                       double* block_values) {
+  for (int l = 0; l < count; ++l) {
+    const int* slot = block_slot + kHingePairs * l;
+    const double* lane = &u.u[0][l];
+    Unroll<kHingePairs>([&](auto kc) __attribute__((always_inline)) {
+      constexpr int K = decltype(kc)::value;
+      constexpr std::array<int, 9> kEntry = kBlockToPacked[4 * kHingePair[K][0] + kHingePair[K][1]];
+      double* dst = block_values + 9 * static_cast<long>(slot[K] >> 1);
+      Double8 t = {lane[kLanes * kEntry[0]], lane[kLanes * kEntry[1]], lane[kLanes * kEntry[2]],
+                   lane[kLanes * kEntry[3]], lane[kLanes * kEntry[4]], lane[kLanes * kEntry[5]],
+                   lane[kLanes * kEntry[6]], lane[kLanes * kEntry[7]]};
+      if constexpr (kHingePair[K][0] != kHingePair[K][1]) {
+        // Entry 3 a + b -> 3 b + a; the 9th, (2, 2), stays.
+        if (slot[K] & 1) t = __builtin_shuffle(t, Long8{0, 3, 6, 1, 4, 7, 2, 5});
+      }
+      Double8 d;
+      std::memcpy(&d, dst, sizeof d);
+      d += t;
+      std::memcpy(dst, &d, sizeof d);
+      dst[8] += lane[kLanes * kEntry[8]];
+    });
+  }
+}
+
+// values[position[k]] (+)= block_values[source[k]], k < n; position null: the identity.
+TEXTILE_SIMD_CLONES void BlockEntriesToValues(const double* __restrict block_values,
+                                              const int* source, const int* position, long n,
+                                              bool assign, double* __restrict values) {
+  if (position) {
+    for (long k = 0; k < n; ++k) values[position[k]] += block_values[source[k]];
+  } else if (assign) {
+    for (long k = 0; k < n; ++k) values[k] = block_values[source[k]];
+  } else {
+    for (long k = 0; k < n; ++k) values[k] += block_values[source[k]];
+  }
+}
 
 // Runs f(begin, end) over [0, n) in `threads` contiguous chunks, the first on this thread.
 template <class F>
@@ -1078,40 +1144,104 @@ BendingHessianSlots BendingElements::HessianSlots(const Eigen::SparseMatrix<doub
   slots.sources.resize(slots.slot.size());
   std::vector<int> fill(slots.source_offsets.begin(), slots.source_offsets.end() - 1);
   for (size_t k = 0; k < slots.slot.size(); ++k) slots.sources[fill[slots.slot[k]]++] = source[k];
+
+  // The 3×3 blocks: every vertex pair va ≤ vb of a hinge once, in the matrix's (column) order.
+  std::vector<long> pairs;  // nv vb + va
+  pairs.reserve(static_cast<size_t>(kHingePairs) * nh);
+  const long nv = num_vertices_;
+  for (const HingeRest& r : rest_) {
+    for (const auto& [i, j] : kHingePair) {
+      pairs.push_back(nv * std::max(r.v[i], r.v[j]) + std::min(r.v[i], r.v[j]));
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  if (pairs.size() >= (size_t{1} << 30)) {
+    throw InputError("bending: too many vertex pairs for the Hessian slots");
+  }
+  slots.block_slot.resize(static_cast<size_t>(kHingePairs) * nh);
+  for (int h = 0; h < nh; ++h) {
+    const auto& v = rest_[h].v;
+    for (int k = 0; k < kHingePairs; ++k) {
+      auto [i, j] = kHingePair[k];
+      if (v[i] > v[j]) std::swap(i, j);
+      const long key = nv * v[j] + v[i];
+      const long block = std::lower_bound(pairs.begin(), pairs.end(), key) - pairs.begin();
+      slots.block_slot[static_cast<size_t>(kHingePairs) * h + k] =
+          static_cast<int>(2 * block + (i != kHingePair[k][0]));
+    }
+  }
+  slots.block_values.assign(9 * pairs.size(), 0.0);
+  // Where each block entry goes (found above for every hinge's entries, so none is missing).
+  std::vector<std::pair<int, int>> targets;  // (value position, block entry)
+  targets.reserve((upper ? 6 : 9) * pairs.size() + (upper ? 0 : 9 * pairs.size()));
+  auto position = [&](int row, int col) {
+    const int* begin = inner + outer[col];
+    const int* end = inner + outer[col + 1];
+    return static_cast<int>(std::lower_bound(begin, end, row) - inner);
+  };
+  for (size_t block = 0; block < pairs.size(); ++block) {
+    const int va = static_cast<int>(pairs[block] % nv), vb = static_cast<int>(pairs[block] / nv);
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        const int entry = static_cast<int>(9 * block) + 3 * a + b;
+        if (va != vb || !upper || a <= b) targets.emplace_back(position(3 * va + a, 3 * vb + b), entry);
+        if (va != vb && !upper) targets.emplace_back(position(3 * vb + b, 3 * va + a), entry);
+      }
+  }
+  std::sort(targets.begin(), targets.end());
+  slots.value_position.resize(targets.size());
+  slots.value_source.resize(targets.size());
+  for (size_t k = 0; k < targets.size(); ++k) {
+    slots.value_position[k] = targets[k].first;
+    slots.value_source[k] = targets[k].second;
+  }
+  slots.covers_all = static_cast<long>(targets.size()) == slots.nonzeros;
   return slots;
 }
 
 void BendingElements::AddHessianValues(const Vertices& x, HessianProjection projection,
                                        const BendingHessianSlots& slots, double* values) const {
+  FillHessianValues(x, projection, slots, false, values);
+}
+
+void BendingElements::FillHessianValues(const Vertices& x, HessianProjection projection,
+                                        const BendingHessianSlots& slots, bool overwrite,
+                                        double* values) const {
   assert(x.rows() == num_vertices_);
   const int nh = num_hinges();
   if (slots.slot.size() != static_cast<size_t>(slots.per_hinge) * nh ||
-      slots.source_offsets.size() != static_cast<size_t>(slots.nonzeros) + 1) {
+      slots.source_offsets.size() != static_cast<size_t>(slots.nonzeros) + 1 ||
+      slots.block_slot.size() != static_cast<size_t>(kHingePairs) * nh ||
+      slots.value_source.size() != slots.value_position.size()) {
     throw InputError("bending: Hessian slots were made for other elements (" +
                      std::to_string(slots.slot.size()) + " slots for " + std::to_string(nh) +
                      " hinges)");
   }
+  if (overwrite && !slots.covers_all) {
+    std::fill(values, values + slots.nonzeros, 0.0);
+    overwrite = false;
+  }
   const int threads = NumThreads();
-  const int per_hinge = slots.per_hinge;
   if (threads == 1) {
+    // Hinge blocks into the 3×3 vertex-pair blocks (each entry 0 + its hinges' in hinge order),
+    // then those into the matrix.
+    double* block_values = slots.block_values.data();
+    std::fill(block_values, block_values + slots.block_values.size(), 0.0);
     LaneHessian u;
     for (long b = 0; b < nh; b += kLanes) {
       const int n = static_cast<int>(std::min<long>(kLanes, nh - b));
       HessianBlocks(x, projection, b, n, &u.u[0][0]);
-      for (int l = 0; l < n; ++l) {
-        const int* slot = slots.slot.data() + static_cast<size_t>(per_hinge) * (b + l);
-        if (slots.upper) {
-          for (int k = 0; k < kPackedSize; ++k) values[slot[k]] += u.u[k][l];
-        } else {
-          for (int k = 0; k < 144; ++k) values[slot[k]] += u.u[kFullToPacked[k]][l];
-        }
-      }
+      AddLaneBlocks(u, n, slots.block_slot.data() + kHingePairs * b, block_values);
     }
+    BlockEntriesToValues(block_values, slots.value_source.data(),
+                         slots.covers_all ? nullptr : slots.value_position.data(),
+                         static_cast<long>(slots.value_source.size()), overwrite, values);
     return;
   }
   // Threads: blocks into a per-hinge buffer (blocks of kLanes hinges from the start, as in the
   // serial loop, so that every hinge gets the same bits), then a per-position gather in hinge
-  // order (the serial additions in the serial order).
+  // order from 0, added to the value (the serial additions in the serial order).
   hinge_hessian_.resize(static_cast<size_t>(kPackedSize) * nh);
   const int num_blocks = (nh + kLanes - 1) / kLanes;
   ParallelChunks(num_blocks, threads, [&](long begin, long end, int) {
@@ -1127,10 +1257,15 @@ void BendingElements::AddHessianValues(const Vertices& x, HessianProjection proj
   ParallelChunks(static_cast<int>(slots.nonzeros), threads, [&](long begin, long end, int) {
     const double* u = hinge_hessian_.data();
     for (long p = begin; p < end; ++p) {
-      double v = values[p];
+      if (slots.source_offsets[p] == slots.source_offsets[p + 1]) continue;
+      double v = 0.0;
       for (int k = slots.source_offsets[p]; k < slots.source_offsets[p + 1]; ++k)
         v += u[slots.sources[k]];
-      values[p] = v;
+      if (overwrite) {
+        values[p] = v;
+      } else {
+        values[p] += v;
+      }
     }
   });
 }
@@ -1141,8 +1276,9 @@ void BendingElements::SetHessian(const Vertices& x, HessianProjection projection
   if (hessian->nonZeros() != slots.nonzeros || !hessian->isCompressed()) {
     throw InputError("bending: SetHessian needs the compressed matrix the slots were made for");
   }
-  std::fill(hessian->valuePtr(), hessian->valuePtr() + hessian->nonZeros(), 0.0);
-  AddHessianValues(x, projection, slots, hessian->valuePtr());
+  // 0 + s = s for the sums s (never -0: they start from +0), so the values need no zeroing
+  // when the slots cover them all.
+  FillHessianValues(x, projection, slots, true, hessian->valuePtr());
 }
 
 }  // namespace textile

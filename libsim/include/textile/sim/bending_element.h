@@ -98,6 +98,17 @@ struct BendingHessianSlots {
   // For threaded filling, per value position p: sources[source_offsets[p] .. source_offsets[p+1])
   // are the contributions (78 h + packed entry) in hinge order, the serial order of additions.
   std::vector<int> source_offsets, sources;
+  // Serial filling goes through 3×3 blocks, one per vertex pair va ≤ vb of some hinge (9 values,
+  // row-major: entry (3 va + a, 3 vb + b)), so that a hinge adds 10 short contiguous vectors.
+  // block_slot: #H × 10, hinge-major, for the vertex pairs (i, j), i ≤ j, of the hinge in the
+  // order (0,0) (0,1) (0,2) (0,3) (1,1) (1,2) (1,3) (2,2) (2,3) (3,3): 2 × block + 1 if
+  // v[i] > v[j] (the block is then the transpose of the hinge's (i, j) block).
+  std::vector<int> block_slot;
+  // The block entries then go to the matrix: values[value_position[k]] += block entry
+  // value_source[k] (9 × block + 3 a + b), value_position ascending.
+  std::vector<int> value_position, value_source;
+  bool covers_all = false;  // value_position is 0, 1, ..., nonzeros - 1
+  mutable std::vector<double> block_values;  // scratch, 9 a block: one fill at a time per slots
 };
 
 class BendingElements {
@@ -159,6 +170,8 @@ class BendingElements {
   // slots were made for): the same numbers as AddHessianTriplets to round-off, upper-half
   // entries when slots.upper. Each hinge block is symmetrised (its exact value is symmetric; the
   // triplet path's is to ~1e-12). No allocation unless threaded (a scratch buffer, reused).
+  // Each value gets the sum of its hinges' entries in hinge order, threaded or not (the same
+  // bits); calls with the same slots must not run concurrently (they share a scratch buffer).
   void AddHessianValues(const Vertices& x, HessianProjection projection,
                         const BendingHessianSlots& slots, double* values) const;
   // hessian = ∇²E: zeroes the values of `hessian` (the matrix `slots` was made for), then adds.
@@ -214,6 +227,9 @@ class BendingElements {
   static constexpr int kSimdLanes = 8;
   void HessianBlocks(const Vertices& x, HessianProjection projection, long first, int count,
                      double* u) const;
+  // AddHessianValues; overwrite: values = ∇²E instead (SetHessian).
+  void FillHessianValues(const Vertices& x, HessianProjection projection,
+                         const BendingHessianSlots& slots, bool overwrite, double* values) const;
   double HingeTerms(const Vertices& x, int h, double* d_energy, double* d2_energy) const;
   double DihedralTerms(double cos_term, double sin_term, int h, double* d_energy, double* d2_energy,
                        bool want_energy) const;

@@ -8,6 +8,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <sstream>
 #include <thread>
 #include <utility>
@@ -502,19 +503,21 @@ using Double8 = double __attribute__((vector_size(64)));
 using Long8 = long __attribute__((vector_size(64)));
 
 // Adds the first `count` hinges of a lane block to the 3×3 blocks (block_slot: theirs, 10 a
-// hinge), in hinge order. Per vertex pair the block's first 8 entries are picked from the lanes
+// hinge), in hinge order: entries 0-7 (3 a + b) of block k at head + 8 k (64-byte aligned: one
+// cache line), entry 8 at ninth + k. Per vertex pair the block's first 8 entries are picked from the lanes
 // into one vector (transposed by a shuffle when the pair's vertices are in the other order) and
 // added with one read-modify-write, the 9th alone: 20 stores a hinge instead of 78 scalar
 // read-modify-writes at scattered positions (docs/bending.md, "Where the time goes").
 TEXTILE_SIMD_CLONES void AddLaneBlocks(const LaneHessian& u, int count, const int* block_slot,
-                                       double* block_values) {
+                                       double* head, double* ninth) {
   for (int l = 0; l < count; ++l) {
     const int* slot = block_slot + kHingePairs * l;
     const double* lane = &u.u[0][l];
     Unroll<kHingePairs>([&](auto kc) __attribute__((always_inline)) {
       constexpr int K = decltype(kc)::value;
       constexpr std::array<int, 9> kEntry = kBlockToPacked[4 * kHingePair[K][0] + kHingePair[K][1]];
-      double* dst = block_values + 9 * static_cast<long>(slot[K] >> 1);
+      const long block = slot[K] >> 1;
+      double* dst = static_cast<double*>(__builtin_assume_aligned(head + 8 * block, 64));
       Double8 t = {lane[kLanes * kEntry[0]], lane[kLanes * kEntry[1]], lane[kLanes * kEntry[2]],
                    lane[kLanes * kEntry[3]], lane[kLanes * kEntry[4]], lane[kLanes * kEntry[5]],
                    lane[kLanes * kEntry[6]], lane[kLanes * kEntry[7]]};
@@ -526,7 +529,7 @@ TEXTILE_SIMD_CLONES void AddLaneBlocks(const LaneHessian& u, int count, const in
       std::memcpy(&d, dst, sizeof d);
       d += t;
       std::memcpy(dst, &d, sizeof d);
-      dst[8] += lane[kLanes * kEntry[8]];
+      ninth[block] += lane[kLanes * kEntry[8]];
     });
   }
 }
@@ -538,8 +541,10 @@ TEXTILE_SIMD_CLONES void BlockEntriesToValues(const double* __restrict block_val
   if (position) {
     for (long k = 0; k < n; ++k) values[position[k]] += block_values[source[k]];
   } else if (assign) {
+#pragma omp simd
     for (long k = 0; k < n; ++k) values[k] = block_values[source[k]];
   } else {
+#pragma omp simd
     for (long k = 0; k < n; ++k) values[k] += block_values[source[k]];
   }
 }
@@ -1171,7 +1176,8 @@ BendingHessianSlots BendingElements::HessianSlots(const Eigen::SparseMatrix<doub
           static_cast<int>(2 * block + (i != kHingePair[k][0]));
     }
   }
-  slots.block_values.assign(9 * pairs.size(), 0.0);
+  const long nb = static_cast<long>(pairs.size());
+  slots.block_values.assign(9 * nb + 8, 0.0);  // 8 spare for the alignment (FillHessianValues)
   // Where each block entry goes (found above for every hinge's entries, so none is missing).
   std::vector<std::pair<int, int>> targets;  // (value position, block entry)
   targets.reserve((upper ? 6 : 9) * pairs.size() + (upper ? 0 : 9 * pairs.size()));
@@ -1184,7 +1190,8 @@ BendingHessianSlots BendingElements::HessianSlots(const Eigen::SparseMatrix<doub
     const int va = static_cast<int>(pairs[block] % nv), vb = static_cast<int>(pairs[block] / nv);
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) {
-        const int entry = static_cast<int>(9 * block) + 3 * a + b;
+        const long e = 3 * a + b;
+        const int entry = static_cast<int>(e < 8 ? 8 * block + e : 8 * nb + block);
         if (va != vb || !upper || a <= b) targets.emplace_back(position(3 * va + a, 3 * vb + b), entry);
         if (va != vb && !upper) targets.emplace_back(position(3 * vb + b, 3 * va + a), entry);
       }
@@ -1213,7 +1220,8 @@ void BendingElements::FillHessianValues(const Vertices& x, HessianProjection pro
   if (slots.slot.size() != static_cast<size_t>(slots.per_hinge) * nh ||
       slots.source_offsets.size() != static_cast<size_t>(slots.nonzeros) + 1 ||
       slots.block_slot.size() != static_cast<size_t>(kHingePairs) * nh ||
-      slots.value_source.size() != slots.value_position.size()) {
+      slots.value_source.size() != slots.value_position.size() ||
+      slots.block_values.size() % 9 != 8) {
     throw InputError("bending: Hessian slots were made for other elements (" +
                      std::to_string(slots.slot.size()) + " slots for " + std::to_string(nh) +
                      " hinges)");
@@ -1226,13 +1234,17 @@ void BendingElements::FillHessianValues(const Vertices& x, HessianProjection pro
   if (threads == 1) {
     // Hinge blocks into the 3×3 vertex-pair blocks (each entry 0 + its hinges' in hinge order),
     // then those into the matrix.
-    double* block_values = slots.block_values.data();
-    std::fill(block_values, block_values + slots.block_values.size(), 0.0);
+    const long nb = static_cast<long>(slots.block_values.size() - 8) / 9;
+    void* raw = slots.block_values.data();
+    size_t space = slots.block_values.size() * sizeof(double);
+    double* block_values = static_cast<double*>(std::align(64, 9 * nb * sizeof(double), raw, space));
+    std::fill(block_values, block_values + 9 * nb, 0.0);
     LaneHessian u;
     for (long b = 0; b < nh; b += kLanes) {
       const int n = static_cast<int>(std::min<long>(kLanes, nh - b));
       HessianBlocks(x, projection, b, n, &u.u[0][0]);
-      AddLaneBlocks(u, n, slots.block_slot.data() + kHingePairs * b, block_values);
+      AddLaneBlocks(u, n, slots.block_slot.data() + kHingePairs * b, block_values,
+                    block_values + 8 * nb);
     }
     BlockEntriesToValues(block_values, slots.value_source.data(),
                          slots.covers_all ? nullptr : slots.value_position.data(),

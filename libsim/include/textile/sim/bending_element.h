@@ -98,17 +98,20 @@ struct BendingHessianSlots {
   // For threaded filling, per value position p: sources[source_offsets[p] .. source_offsets[p+1])
   // are the contributions (78 h + packed entry) in hinge order, the serial order of additions.
   std::vector<int> source_offsets, sources;
-  // Serial filling goes through 3×3 blocks, one per vertex pair va ≤ vb of some hinge (9 values,
-  // row-major: entry (3 va + a, 3 vb + b)), so that a hinge adds 10 short contiguous vectors.
+  // Serial filling goes through 3×3 blocks, one per vertex pair va ≤ vb of some hinge (entry
+  // (3 va + a, 3 vb + b) is number 3 a + b: 0-7 at 8 k in one cache line, 8 in a second array),
+  // so that a hinge adds 10 short contiguous vectors and 10 scalars.
   // block_slot: #H × 10, hinge-major, for the vertex pairs (i, j), i ≤ j, of the hinge in the
   // order (0,0) (0,1) (0,2) (0,3) (1,1) (1,2) (1,3) (2,2) (2,3) (3,3): 2 × block + 1 if
   // v[i] > v[j] (the block is then the transpose of the hinge's (i, j) block).
   std::vector<int> block_slot;
   // The block entries then go to the matrix: values[value_position[k]] += block entry
-  // value_source[k] (9 × block + 3 a + b), value_position ascending.
+  // value_source[k] (8 × block + 3 a + b, or 8 × #blocks + block for entry 8), value_position
+  // ascending.
   std::vector<int> value_position, value_source;
   bool covers_all = false;  // value_position is 0, 1, ..., nonzeros - 1
-  mutable std::vector<double> block_values;  // scratch, 9 a block: one fill at a time per slots
+  // Scratch (9 a block and 8 to align them): one fill at a time per slots.
+  mutable std::vector<double> block_values;
 };
 
 class BendingElements {

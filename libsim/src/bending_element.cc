@@ -492,7 +492,8 @@ constexpr std::array<std::array<int, 9>, 16> MakeBlockToPacked() {
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j)
       for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) m[4 * i + j][3 * a + b] = kFullToPacked[12 * (3 * i + a) + 3 * j + b];
+        for (int b = 0; b < 3; ++b)
+          m[4 * i + j][3 * a + b] = kFullToPacked[12 * (3 * i + a) + 3 * j + b];
   return m;
 }
 constexpr std::array<std::array<int, 9>, 16> kBlockToPacked = MakeBlockToPacked();
@@ -504,10 +505,11 @@ using Long8 = long __attribute__((vector_size(64)));
 
 // Adds the first `count` hinges of a lane block to the 3×3 blocks (block_slot: theirs, 10 a
 // hinge), in hinge order: entries 0-7 (3 a + b) of block k at head + 8 k (64-byte aligned: one
-// cache line), entry 8 at ninth + k. Per vertex pair the block's first 8 entries are picked from the lanes
-// into one vector (transposed by a shuffle when the pair's vertices are in the other order) and
-// added with one read-modify-write, the 9th alone: 20 stores a hinge instead of 78 scalar
-// read-modify-writes at scattered positions (docs/bending.md, "Where the time goes").
+// cache line), entry 8 at ninth + k. Per vertex pair the block's first 8 entries are picked
+// from the lanes into one vector (transposed by a shuffle when the pair's vertices are in the
+// other order) and added with one read-modify-write, the 9th alone: 20 stores a hinge instead
+// of 78 scalar read-modify-writes at scattered positions (docs/bending.md, "Where the time
+// goes").
 TEXTILE_SIMD_CLONES void AddLaneBlocks(const LaneHessian& u, int count, const int* block_slot,
                                        double* head, double* ninth) {
   for (int l = 0; l < count; ++l) {
@@ -1192,7 +1194,9 @@ BendingHessianSlots BendingElements::HessianSlots(const Eigen::SparseMatrix<doub
       for (int b = 0; b < 3; ++b) {
         const long e = 3 * a + b;
         const int entry = static_cast<int>(e < 8 ? 8 * block + e : 8 * nb + block);
-        if (va != vb || !upper || a <= b) targets.emplace_back(position(3 * va + a, 3 * vb + b), entry);
+        if (va != vb || !upper || a <= b) {
+          targets.emplace_back(position(3 * va + a, 3 * vb + b), entry);
+        }
         if (va != vb && !upper) targets.emplace_back(position(3 * vb + b, 3 * va + a), entry);
       }
   }
@@ -1237,7 +1241,8 @@ void BendingElements::FillHessianValues(const Vertices& x, HessianProjection pro
     const long nb = static_cast<long>(slots.block_values.size() - 8) / 9;
     void* raw = slots.block_values.data();
     size_t space = slots.block_values.size() * sizeof(double);
-    double* block_values = static_cast<double*>(std::align(64, 9 * nb * sizeof(double), raw, space));
+    double* block_values =
+        static_cast<double*>(std::align(64, 9 * nb * sizeof(double), raw, space));
     std::fill(block_values, block_values + 9 * nb, 0.0);
     LaneHessian u;
     for (long b = 0; b < nh; b += kLanes) {

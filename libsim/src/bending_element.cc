@@ -8,6 +8,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <thread>
@@ -1163,7 +1164,7 @@ BendingHessianSlots BendingElements::HessianSlots(const Eigen::SparseMatrix<doub
   }
   std::sort(pairs.begin(), pairs.end());
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  if (pairs.size() >= (size_t{1} << 30)) {
+  if (pairs.size() > static_cast<size_t>(std::numeric_limits<int>::max() / 9)) {  // int entries
     throw InputError("bending: too many vertex pairs for the Hessian slots");
   }
   slots.block_slot.resize(static_cast<size_t>(kHingePairs) * nh);

@@ -177,20 +177,53 @@ void ClothProblem::FixVertices(const std::vector<int>& vertices, const Vertices&
   fixed_ = vertices;
   is_fixed_ = seen;
   fixed_positions_ = positions;
-  // Slots of the fixed dofs' rows and columns, for the identity rows of Hessian().
-  fixed_slots_.clear();
+  DropFixedFromPattern();
+}
+
+// A fixed dof's row and column hold nothing but the diagonal that Hessian() sets, so their
+// off-diagonal entries leave the pattern: CHOLMOD then neither orders nor fills them (a clamped
+// drape fixes a third of its vertices; the factorisation is most of a Newton step). Element
+// entries that fall there are added to a fixed diagonal instead, which Hessian() overwrites.
+void ClothProblem::DropFixedFromPattern() {
+  if (pattern_reduced_) BuildPattern();  // fixed again: start from the full pattern
+  pattern_reduced_ = false;
   fixed_diagonal_slots_.clear();
+  if (fixed_.empty()) return;
+  const int n = static_cast<int>(hessian_.cols());
   const int* outer = hessian_.outerIndexPtr();
   const int* inner = hessian_.innerIndexPtr();
-  for (int col = 0; col < hessian_.cols(); ++col) {
-    for (int k = outer[col]; k < outer[col + 1]; ++k) {
-      const int row = inner[k];
-      if (is_fixed_[col / 3] || is_fixed_[row / 3]) {
-        fixed_slots_.push_back(k);
-        if (row == col) fixed_diagonal_slots_.push_back(k);
-      }
-    }
+  const auto keep = [&](int row, int col) {
+    return row == col || (!is_fixed_[row / 3] && !is_fixed_[col / 3]);
+  };
+  Eigen::VectorXi column_sizes = Eigen::VectorXi::Zero(n);
+  for (int col = 0; col < n; ++col)
+    for (int k = outer[col]; k < outer[col + 1]; ++k) column_sizes[col] += keep(inner[k], col);
+  Eigen::SparseMatrix<double> reduced(n, n);
+  reduced.reserve(column_sizes);
+  for (int col = 0; col < n; ++col)
+    for (int k = outer[col]; k < outer[col + 1]; ++k)
+      if (keep(inner[k], col)) reduced.insert(inner[k], col) = 0.0;
+  reduced.makeCompressed();
+  // Old slot -> new slot, in the same order within each column; dropped entries -> the diagonal
+  // of the first fixed dof.
+  std::vector<int> new_slot(hessian_.nonZeros(), -1);
+  const int* new_outer = reduced.outerIndexPtr();
+  for (int col = 0; col < n; ++col) {
+    int next = new_outer[col];
+    for (int k = outer[col]; k < outer[col + 1]; ++k)
+      if (keep(inner[k], col)) new_slot[k] = next++;
   }
+  const int first = 3 * fixed_.front();
+  const int* new_inner = reduced.innerIndexPtr();
+  const int trash = static_cast<int>(
+      std::lower_bound(new_inner + new_outer[first], new_inner + new_outer[first + 1], first) -
+      new_inner);
+  for (int& slot : triplet_slot_) slot = new_slot[slot] >= 0 ? new_slot[slot] : trash;
+  for (int& slot : diagonal_block_slot_) slot = new_slot[slot] >= 0 ? new_slot[slot] : trash;
+  hessian_ = std::move(reduced);
+  for (int v : fixed_)
+    for (int a = 0; a < 3; ++a) fixed_diagonal_slots_.push_back(diagonal_block_slot_[9 * v + 4 * a]);
+  pattern_reduced_ = true;
 }
 
 void ClothProblem::SetFixedPositions(const Vertices& positions) {
@@ -313,11 +346,16 @@ const Eigen::SparseMatrix<double>& ClothProblem::Hessian(const Vertices& x,
     }
   }
   if (!fixed_.empty()) {
+    // The fixed dofs' identity rows, scaled to the free dofs' mean diagonal (the fixed
+    // diagonals also hold the element entries dropped from the pattern: DropFixedFromPattern).
     double diag_sum = 0.0;
-    for (int i = 0; i < num_vertices(); ++i)
+    int free_dofs = 0;
+    for (int i = 0; i < num_vertices(); ++i) {
+      if (is_fixed_[i]) continue;
       for (int a = 0; a < 3; ++a) diag_sum += values[diagonal_block_slot_[9 * i + 4 * a]];
-    const double scale = diag_sum > 0.0 ? diag_sum / hessian_.cols() : 1.0;
-    for (int k : fixed_slots_) values[k] = 0.0;
+      free_dofs += 3;
+    }
+    const double scale = diag_sum > 0.0 ? diag_sum / free_dofs : 1.0;
     for (int k : fixed_diagonal_slots_) values[k] = scale;
   }
   return hessian_;

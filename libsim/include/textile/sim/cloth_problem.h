@@ -82,7 +82,8 @@ class ClothProblem {
   // Fills grad (#V×3, resized) with ∇E [N], zero on fixed vertices; returns E [J].
   double EnergyGradient(const Vertices& x, Vertices* grad) const;
   // ∇²E [N/m] (3V×3V, fixed sparsity, full symmetric storage) with fixed vertices' rows and
-  // columns replaced by identity rows scaled to the matrix's mean diagonal. The reference stays
+  // columns replaced by identity rows scaled to the free dofs' mean diagonal; their off-diagonal
+  // entries are not even stored (FixVertices drops them from the pattern). The reference stays
   // valid until the next call.
   const Eigen::SparseMatrix<double>& Hessian(const Vertices& x, HessianProjection projection);
 
@@ -136,6 +137,7 @@ class ClothProblem {
   int Touching(const Eigen::Vector3d& p, double limit, double* phi, Eigen::Vector3d* normal) const;
   double ContactEnergyGradient(const Vertices& x, Vertices* grad) const;
   void BuildPattern();
+  void DropFixedFromPattern();
   // Bending Hessian elements [first, end) of the active discretisation into triplets_.
   int num_bending_elements() const;
   void BendingTriplets(const Vertices& x, HessianProjection projection, int first, int end);
@@ -161,8 +163,8 @@ class ClothProblem {
   std::vector<Eigen::Triplet<double>> triplets_;
   std::vector<int> triplet_slot_;
   std::vector<int> diagonal_block_slot_;  // #V×9: slot of (3i+a, 3i+b)
-  std::vector<int> fixed_slots_;          // entries in a fixed dof's row or column
-  std::vector<int> fixed_diagonal_slots_;
+  std::vector<int> fixed_diagonal_slots_;  // the fixed dofs' diagonals
+  bool pattern_reduced_ = false;           // fixed dofs' off-diagonal entries dropped
 };
 
 }  // namespace textile

@@ -1074,7 +1074,8 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   // The time cap (ExtractOptions::max_seconds), read between stages; each stage is a bounded
   // pass over the photo, so the cap bounds a run to the cap plus one stage.
   const auto past_cap = [&](const char* stage) {
-    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    const double t =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     if (t < options.max_seconds) return false;
     r.profile = Profile{};
     std::ostringstream m;

@@ -222,7 +222,8 @@ void ClothProblem::DropFixedFromPattern() {
   for (int& slot : diagonal_block_slot_) slot = new_slot[slot] >= 0 ? new_slot[slot] : trash;
   hessian_ = std::move(reduced);
   for (int v : fixed_)
-    for (int a = 0; a < 3; ++a) fixed_diagonal_slots_.push_back(diagonal_block_slot_[9 * v + 4 * a]);
+    for (int a = 0; a < 3; ++a)
+      fixed_diagonal_slots_.push_back(diagonal_block_slot_[9 * v + 4 * a]);
   pattern_reduced_ = true;
 }
 

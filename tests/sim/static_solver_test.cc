@@ -469,6 +469,52 @@ TEST(ClothProblem, FixedVerticesHaveIdentityRowsAndZeroForce) {
   }
 }
 
+// Fixed dofs' rows and columns are not stored beyond their diagonal (so CHOLMOD does no work
+// on them), the free block is the Hessian of the same problem with nothing fixed, the fixed
+// diagonal is the free dofs' mean diagonal, and fixing another set later starts from the full
+// pattern again.
+TEST(ClothProblem, FixedDofsLeaveThePatternAndTheFreeBlockIsUnchanged) {
+  const TriangleMesh mesh = CrissCrossGridMesh(0.2, 0.12, 10, 6);
+  ClothProblem loose(mesh, Cotton(), {}, {});
+  HangingSheet sheet;
+  Vertices x = mesh.vertices;
+  for (int i = 0; i < x.rows(); ++i) x(i, 2) = 0.02 * std::sin(20.0 * x(i, 0)) - 0.1 * x(i, 0);
+  sheet.problem->ApplyFixed(&x);
+  const Eigen::MatrixXd full = Eigen::MatrixXd(loose.Hessian(x, HessianProjection::kNone));
+  const Eigen::SparseMatrix<double>& h = sheet.problem->Hessian(x, HessianProjection::kNone);
+  EXPECT_LT(h.nonZeros(), loose.Hessian(x, HessianProjection::kNone).nonZeros());
+  const auto& fixed = sheet.problem->is_fixed();
+  double free_diagonal = 0.0;
+  int free_dofs = 0;
+  for (int col = 0; col < h.cols(); ++col) {
+    if (!fixed[col / 3]) {
+      free_diagonal += full(col, col);
+      ++free_dofs;
+    }
+    for (Eigen::SparseMatrix<double>::InnerIterator it(h, col); it; ++it) {
+      const int row = static_cast<int>(it.row());
+      if (fixed[row / 3] || fixed[col / 3]) {
+        EXPECT_EQ(row, col) << "stored off-diagonal entry of a fixed dof";
+      } else {
+        EXPECT_NEAR(it.value(), full(row, col), 1e-9 * std::abs(full(col, col)))
+            << row << ", " << col;
+      }
+    }
+  }
+  const int v = sheet.problem->fixed_vertices().front();
+  EXPECT_NEAR(h.coeff(3 * v, 3 * v), free_diagonal / free_dofs, 1e-12 * free_diagonal / free_dofs);
+  // Fix another set: the old fixed dofs get their entries back, the new ones lose theirs.
+  const auto far_edge = VerticesWhere(mesh, [](double px, double) { return px > 0.2 - 1e-12; });
+  sheet.problem->FixVertices(far_edge, Rows(x, far_edge));
+  const Eigen::SparseMatrix<double>& h2 = sheet.problem->Hessian(x, HessianProjection::kNone);
+  const int w = far_edge.front();
+  for (Eigen::SparseMatrix<double>::InnerIterator it(h2, 3 * w); it; ++it)
+    EXPECT_EQ(it.row(), 3 * w);
+  EXPECT_NEAR(h2.coeff(3 * v + 1, 3 * v), full(3 * v + 1, 3 * v),
+              1e-9 * std::abs(full(3 * v, 3 * v)));
+  EXPECT_GT(std::abs(full(3 * v + 1, 3 * v)), 0.0);
+}
+
 TEST(ClothProblem, BuildsOnlyTheChosenBendingDiscretisation) {
   // Each discretisation is built alone, and the problem's energy is the membrane's plus that
   // one's bending energy (the tensor problem carries no hinge elements behind it).

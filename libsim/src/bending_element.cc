@@ -504,6 +504,16 @@ constexpr std::array<std::array<int, 9>, 16> kBlockToPacked = MakeBlockToPacked(
 using Double8 = double __attribute__((vector_size(64)));
 using Long8 = long __attribute__((vector_size(64)));
 
+// Entries 3 a + b -> 3 b + a of a 3×3 block's first 8 entries (the 9th, (2, 2), is its own
+// transpose). GCC and Clang name the shuffle differently (the fuzz build uses Clang).
+TEXTILE_ALWAYS_INLINE void Transpose3x3(Double8* t) {  // by pointer: no vector ABI involved
+#if defined(__clang__)
+  *t = __builtin_shufflevector(*t, *t, 0, 3, 6, 1, 4, 7, 2, 5);
+#else
+  *t = __builtin_shuffle(*t, Long8{0, 3, 6, 1, 4, 7, 2, 5});
+#endif
+}
+
 // Adds the first `count` hinges of a lane block to the 3×3 blocks (block_slot: theirs, 10 a
 // hinge), in hinge order: entries 0-7 (3 a + b) of block k at head + 8 k (64-byte aligned: one
 // cache line), entry 8 at ninth + k. Per vertex pair the block's first 8 entries are picked
@@ -526,7 +536,7 @@ TEXTILE_SIMD_CLONES void AddLaneBlocks(const LaneHessian& u, int count, const in
                    lane[kLanes * kEntry[6]], lane[kLanes * kEntry[7]]};
       if constexpr (kHingePair[K][0] != kHingePair[K][1]) {
         // Entry 3 a + b -> 3 b + a; the 9th, (2, 2), stays.
-        if (slot[K] & 1) t = __builtin_shuffle(t, Long8{0, 3, 6, 1, 4, 7, 2, 5});
+        if (slot[K] & 1) Transpose3x3(&t);
       }
       Double8 d;
       std::memcpy(&d, dst, sizeof d);

@@ -1,16 +1,17 @@
 #!/usr/bin/env bash
 # Short fuzz run of every target: bash tests/fuzz/run.sh [SECONDS_EACH=60] [TARGET...]
 # Builds with clang + libFuzzer + ASan/UBSan in build-fuzz/, runs each target on a copy of its
-# seed corpus (tests/fuzz/corpus/<target>/). Targets: material, profile_csv, seam, rig, photo,
-# cli (default: all). A finding leaves crash-*/leak-*/timeout-* files in build-fuzz/findings:
-# commit it under tests/fuzz/crashes/<target>/ and turn it into a regression test (a file in
-# tests/data/... or tests/bad_inputs/ and an EXPECT in the parser's test).
+# seed corpus (tests/fuzz/corpus/<target>/). Targets: material, profile_csv, seam, seam_samples,
+# rig, photo, cli (default: all). A finding leaves crash-*/leak-*/timeout-* files in
+# build-fuzz/findings: commit it under tests/fuzz/crashes/<target>/ and turn it into a
+# regression test (a file in tests/data/... or tests/bad_inputs/ and an EXPECT in the parser's
+# test).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 seconds="${1:-60}"
 shift || true
 targets=("$@")
-((${#targets[@]})) || targets=(material profile_csv seam rig photo cli)
+((${#targets[@]})) || targets=(material profile_csv seam seam_samples rig photo cli)
 cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
   -DTEXTILE_FUZZ=ON -DTEXTILE_BUILD_TESTS=OFF "-DTEXTILE_SANITIZE=address;undefined" >/dev/null
 cmake --build build-fuzz -j "$(nproc)" --target "${targets[@]/#/fuzz_}"

@@ -4,12 +4,12 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "deadline.h"
 #include "textile/sim/error.h"
 
 namespace textile {
@@ -117,7 +117,7 @@ BoardDetection DetectChessboard(const cv::Mat& gray, int cols, int rows, const s
 CalibrationSummary CalibrateRig(const std::vector<cv::Mat>& boards,
                                 const std::vector<std::string>& sources,
                                 const CalibrateOptions& o) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const fit_internal::Deadline deadline(o.max_seconds);
   if (std::string why; !o.Check(&why)) throw InputError("calibrate: " + why);
   if (boards.empty()) throw InputError("calibrate: no board photo given");
   if (sources.size() != boards.size()) throw InputError("calibrate: one source name per photo");
@@ -134,14 +134,10 @@ CalibrationSummary CalibrateRig(const std::vector<cv::Mat>& boards,
   // The time cap (CalibrateOptions::max_seconds): each board's corner search and the lens fit
   // are bounded by OpenCV's own criteria; the cap is read before each of them.
   const auto past_cap = [&](const std::string& stage) {
-    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (t < o.max_seconds) return false;
-    std::ostringstream m;
-    m.precision(3);
-    m << "calibrate: time cap of " << o.max_seconds << " s reached after " << t
-      << " s, " << stage << "; no rig";
-    s.message = m.str();
-    s.seconds = t;
+    const std::optional<std::string> why = deadline.Reached(stage);
+    if (!why) return false;
+    s.message = "calibrate: " + *why + "; no rig";
+    s.seconds = deadline.Elapsed();
     return true;
   };
   for (size_t i = 0; i < boards.size(); ++i) {
@@ -238,7 +234,7 @@ CalibrationSummary CalibrateRig(const std::vector<cv::Mat>& boards,
   Rig probe = rig;
   probe.lens.reset();  // the scale of the undistorted homography at the centre
   s.mm_per_px = probe.MmPerPxAt(centre);
-  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s.seconds = deadline.Elapsed();
   if (!(s.rms_error_px <= o.max_error_px)) {
     std::ostringstream m;
     m.precision(3);

@@ -5,7 +5,6 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -13,6 +12,7 @@
 #include <sstream>
 
 #include "cost_functions/clapp_law_cost.h"
+#include "deadline.h"
 #include "law_parameters.h"
 #include "textile/sim/error.h"
 #include "textile/sim/units.h"
@@ -240,11 +240,8 @@ ClappProfileFit FitClappProfile(const Profile& profile, double areal_density,
 
 ClappResult FitClapp(const std::vector<Profile>& profiles, double areal_density,
                      const ClappOptions& options) {
-  const auto start_time = std::chrono::steady_clock::now();
-  const auto seconds_left = [&] {
-    return options.max_seconds -
-           std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
-  };
+  const fit_internal::Deadline deadline(options.max_seconds);
+  const auto seconds_left = [&] { return deadline.Remaining(); };
   CheckOptions(options);
   CheckDensity(areal_density);
   if (profiles.empty()) throw InputError("Clapp fit: no profiles given");

@@ -5,7 +5,6 @@
 #include "textile/fit/extract.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -13,6 +12,7 @@
 #include <queue>
 #include <sstream>
 
+#include "deadline.h"
 #include "extract_internal.h"
 #include "textile/sim/error.h"
 
@@ -1045,7 +1045,7 @@ std::string ExtractionSummary::BriefReport() const {
 
 ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const ExtractOptions& options,
                                  const std::string& source) {
-  const auto started = std::chrono::steady_clock::now();
+  const fit_internal::Deadline deadline(options.max_seconds);  // checked below: options.Check
   if (gray.empty() || gray.type() != CV_8UC1) {
     throw InputError(source + ": expected an 8-bit grey image");
   }
@@ -1068,21 +1068,16 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   const auto fail = [&](const std::string& message) {
     r.success = false;
     r.message = message;
-    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    r.seconds = deadline.Elapsed();
     return r;
   };
   // The time cap (ExtractOptions::max_seconds), read between stages; each stage is a bounded
   // pass over the photo, so the cap bounds a run to the cap plus one stage.
   const auto past_cap = [&](const char* stage) {
-    const double t =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    if (t < options.max_seconds) return false;
+    const std::optional<std::string> why = deadline.Reached(stage);
+    if (!why) return false;
     r.profile = Profile{};
-    std::ostringstream m;
-    m.precision(3);
-    m << "time cap of " << options.max_seconds << " s reached after " << t << " s, " << stage
-      << "; no profile";
-    fail(m.str());
+    fail(*why + "; no profile");
     return true;
   };
 
@@ -1562,7 +1557,7 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   }
   if (past_cap("with the profile done")) return r;
   r.success = true;
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  r.seconds = deadline.Elapsed();
   return r;
 }
 

@@ -39,7 +39,7 @@ double CentreHeight(const ClothProblem& p, const Vertices& x, const Eigen::Vecto
 // gradients. The sparsity of A is the same on every call, so CHOLMOD analyses it once.
 class LinearSolver {
  public:
-  explicit LinearSolver(const SolveOptions& options) : options_(options) {
+  explicit LinearSolver(const SolveOptions& options) {
     if (options.linear == LinearSolverKind::kCholmod) {
       cholmod_ = std::make_unique<Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower>>();
       cholmod_->cholmod().print = 0;  // failures are handled here, not printed by CHOLMOD
@@ -98,7 +98,6 @@ class LinearSolver {
     return d->allFinite();
   }
 
-  const SolveOptions& options_;
   std::unique_ptr<Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower>> cholmod_;
   std::unique_ptr<Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper,
                                            Eigen::IncompleteCholesky<double>>>

@@ -30,6 +30,7 @@ struct DrapeArgs {
   int seeds = 1;
   unsigned first_seed = 1;
   std::optional<double> resolution_mm;
+  double rim_mm = 0.0, rim_band_mm = 20.0;
   double specimen_mm = 150.0, support_mm = 90.0, shift_mm = 50.0, perturbation_mm = 2.0;
   double frame_deg = 0.0;
   std::optional<double> tolerance;
@@ -95,6 +96,18 @@ DrapeOptions Options(const DrapeArgs& a) {
     o.element_size = units::MmToM(h);
   }
   o.element_size = std::min(o.element_size, 0.25 * (o.specimen_radius - o.support_radius));
+  const double rim = finite(a.rim_mm, "--rim-mm");
+  if (rim != 0.0 && !(rim >= 0.5 && units::MmToM(rim) <= o.element_size)) {
+    throw InputError("--rim-mm: must be 0 (off) or between 0.5 mm and the element size (" +
+                     Num(units::MToMm(o.element_size)) + " mm)");
+  }
+  o.rim_element_size = units::MmToM(rim);
+  const double band = finite(a.rim_band_mm, "--rim-band-mm");
+  if (!(band >= 0.0 && band <= a.specimen_mm - a.support_mm)) {
+    throw InputError("--rim-band-mm: must be between 0 and the overhang (" +
+                     Num(a.specimen_mm - a.support_mm) + " mm)");
+  }
+  o.rim_band = units::MmToM(band);
   if (a.coarse && a.no_coarse) throw InputError("--coarse-to-fine and --no-coarse-to-fine: give one");
   o.coarse_to_fine = a.coarse;
   if (a.tolerance) {
@@ -229,6 +242,8 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
                 {"perturbation_mm", units::MToMm(o.perturbation)},
                 {"frame_deg", o.frame_angle / kDegree},
                 {"resolution_mm", units::MToMm(o.element_size)},
+                {"rim_mm", units::MToMm(o.rim_element_size)},
+                {"rim_band_mm", units::MToMm(o.rim_band)},
                 {"coarse_to_fine", o.coarse_to_fine},
                 {"tolerance", o.solver.tolerance},
                 {"raster_cell_mm", units::MToMm(o.raster_cell)},
@@ -294,7 +309,12 @@ void Run(const DrapeArgs& a) {
             << "scene: specimen " << Num(a.specimen_mm) << " mm on a " << Num(a.support_mm) << " mm support, "
             << DrapeMountName(o.mount) << ", seams " << DrapeSeamsName(o.seams)
             << (o.seams != DrapeSeams::kNone ? " (" + o.seam_profile.type + ")" : "") << ", "
-            << r.mesh.num_vertices() << " vertices (h = " << Num(units::MToMm(o.element_size)) << " mm)\n";
+            << r.mesh.num_vertices() << " vertices (h = " << Num(units::MToMm(o.element_size)) << " mm"
+            << (o.rim_element_size > 0.0
+                    ? ", " + Num(units::MToMm(o.rim_element_size)) + " mm to " +
+                          Num(units::MToMm(o.rim_band)) + " mm past the rim"
+                    : std::string())
+            << ")\n";
   for (const DrapeSeedResult& s : r.per_seed) {
     std::cout << "  seed " << s.seed << ": DC " << Num(s.drape_coefficient, 4) << ", " << s.nodes.angles.size()
               << " nodes, r " << Num(units::MToMm(s.min_radius), 4) << ".." << Num(units::MToMm(s.max_radius), 4)
@@ -328,6 +348,10 @@ void RegisterDrape(CLI::App& app) {
   sub->add_option("--seeds", a->seeds, "Number of perturbations (repeated tests; default 1)");
   sub->add_option("--first-seed", a->first_seed, "First seed (default 1)");
   sub->add_option("--resolution-mm", a->resolution_mm, "Element size away from seams [mm] (default 12)");
+  sub->add_option("--rim-mm", a->rim_mm,
+                  "Element size along the support's rim [mm] (0: off, the default; docs/drapemeter.md)");
+  sub->add_option("--rim-band-mm", a->rim_band_mm,
+                  "Width of that finer band beyond the rim [mm] (default 20)");
   sub->add_option("--specimen-mm", a->specimen_mm, "Specimen radius [mm] (default 150)");
   sub->add_option("--support-mm", a->support_mm, "Support radius [mm] (default 90)");
   sub->add_option("--shift-mm", a->shift_mm, "Offset of the shifted seam from the centre [mm] (default 50)");

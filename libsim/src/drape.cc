@@ -63,12 +63,25 @@ struct Pattern {
   std::vector<int> clamp;  // vertices held by the clamp (r ≤ R_s)
 };
 
-Pattern MeshPattern(const DrapeOptions& o, const std::vector<Seam>& seams, double element_size) {
+// The mesh at `scale` × the options' sizes (1: the fine mesh; coarse_factor: the coarse one).
+Pattern MeshPattern(const DrapeOptions& o, const std::vector<Seam>& seams, double scale) {
+  const double element_size = scale * o.element_size;
+  const double rim = scale * o.rim_element_size;  // 0: no rim band
   std::vector<Polyline2> lines;
   for (const Seam& s : seams) lines.push_back(Polyline2(s.line));
-  lines.push_back(SupportCircle(o.support_radius, CircleSegments(o, element_size), o.frame_angle));
+  lines.push_back(SupportCircle(o.support_radius,
+                                CircleSegments(o, rim > 0.0 ? rim : element_size), o.frame_angle));
   PatternMeshOptions mo;
   mo.element_size = element_size;
+  if (rim > 0.0) {
+    // At most `rim` from one rim element inside the support out to rim_band beyond it, then
+    // growing by half the distance (a grading the mesher follows without slivers).
+    const double inner = o.support_radius - rim, outer = o.support_radius + o.rim_band;
+    mo.max_size = [rim, inner, outer](double x, double y) {
+      const double r = std::hypot(x, y);
+      return rim + 0.5 * std::max({0.0, inner - r, r - outer});
+    };
+  }
   if (!seams.empty() && o.seam_refinement_range > 0.0) {
     std::vector<SeamProfile> profiles;
     for (const Seam& s : seams) profiles.push_back(s.profile);
@@ -213,6 +226,12 @@ bool DrapeOptions::Check(std::string* why) const {
       element_size > 0.5 * (specimen_radius - support_radius))
     return Fail(why, "element_size: must be in (0, half the overhang]");
   if (element_size < 1e-4) return Fail(why, "element_size: below 0.1 mm is not a drape mesh");
+  if (!Finite(rim_element_size) || rim_element_size < 0.0 || rim_element_size > element_size)
+    return Fail(why, "rim_element_size: must be 0 (off) or in [0.1 mm, element_size]");
+  if (rim_element_size > 0.0 && rim_element_size < 1e-4)
+    return Fail(why, "rim_element_size: below 0.1 mm is not a drape mesh");
+  if (!Finite(rim_band) || rim_band < 0.0 || rim_band > specimen_radius - support_radius)
+    return Fail(why, "rim_band: must be in [0, the overhang]");
   if (!Finite(coarse_factor) || coarse_factor < 1.0 || coarse_factor > 8.0)
     return Fail(why, "coarse_factor: must be in [1, 8]");
   if (coarse_to_fine && coarse_factor * element_size > 0.5 * (specimen_radius - support_radius))
@@ -425,10 +444,10 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
   auto say = [&o](const std::string& line) {
     if (o.progress) o.progress(line);
   };
-  const Pattern fine = MeshPattern(o, seams, o.element_size);
+  const Pattern fine = MeshPattern(o, seams, 1.0);
   std::unique_ptr<Pattern> coarse;
   if (o.coarse_to_fine) {
-    coarse = std::make_unique<Pattern>(MeshPattern(o, seams, o.coarse_factor * o.element_size));
+    coarse = std::make_unique<Pattern>(MeshPattern(o, seams, o.coarse_factor));
     result.coarse_vertices = coarse->pm.mesh.num_vertices();
   }
   result.mesh = fine.pm.mesh;

@@ -223,7 +223,7 @@ std::vector<Polyline2> CheckedSeams(const std::vector<Polyline2>& seams, const O
   return out;
 }
 
-// Edge length h / sqrt(⌈area_factor(d)⌉) at distance d from the nearest seam.
+// Edge length h / sqrt(⌈area_factor(d)⌉) at distance d from the nearest seam, at most max_size.
 class SizeField {
  public:
   SizeField(const std::vector<Polyline2>& seams, const PatternMeshOptions& options)
@@ -250,7 +250,17 @@ class SizeField {
     }
     return std::max(1.0, std::ceil(f));
   }
-  double Size(const Vector2d& p) const { return options_.element_size / std::sqrt(AreaFactor(p)); }
+  // The seams' size, capped by options.max_size; throws InputError when the cap is not a length.
+  double Size(const Vector2d& p) const {
+    const double size = options_.element_size / std::sqrt(AreaFactor(p));
+    if (!options_.max_size) return size;
+    const double cap = options_.max_size(p.x(), p.y());
+    if (!(std::isfinite(cap) && cap > 0.0)) {
+      throw InputError("pattern mesh: max_size(" + Num(p.x()) + ", " + Num(p.y()) +
+                       " m) returned " + Num(cap) + "; it must be a finite length > 0");
+    }
+    return std::min(size, cap);
+  }
 
  private:
   const PatternMeshOptions& options_;
@@ -275,7 +285,8 @@ double EstimateTriangleCount(const Outline& outline, const SizeField& field, dou
       const Vector2d p = lo + Vector2d((i + 0.5) * step.x(), (j + 0.5) * step.y());
       if (!outline.Contains(p)) continue;
       inside_cells += 1;
-      weighted += field.AreaFactor(p);
+      const double ratio = h / field.Size(p);  // = sqrt(AreaFactor) without max_size
+      weighted += ratio * ratio;
     }
   }
   const double mean_factor = inside_cells > 0 ? weighted / inside_cells : 1.0;

@@ -204,6 +204,45 @@ TEST(PatternMesh, RefinesNearSeamsByTheAreaFactor) {
   EXPECT_LT(none.mesh.num_triangles(), 0.6 * all.mesh.num_triangles());
 }
 
+TEST(PatternMesh, MaxSizeRefinesWhereItIsSmallerOnly) {
+  // 12 mm disk mesh with edges of at most 4 mm in the ring 90 mm < r < 110 mm: triangles in the
+  // ring have about a ninth of the area of those near the centre, which keep theirs.
+  PatternMeshOptions o = Options(0.012);
+  const PatternMesh plain = MeshDisk(0.15, {}, o);
+  o.max_size = [](double x, double y) {
+    const double r = std::hypot(x, y);
+    return r > 0.09 && r < 0.11 ? 0.004 : 1.0;  // 1 m: above element_size, no effect
+  };
+  const PatternMesh ring = MeshDisk(0.15, {}, o);
+  ExpectFlatCcw(ring.mesh);
+  const auto mean_area = [](const TriangleMesh& m, double r_lo, double r_hi) {
+    const Eigen::VectorXd areas = TriangleAreas(m);
+    double sum = 0.0;
+    int n = 0;
+    for (int f = 0; f < m.num_triangles(); ++f) {
+      Eigen::Vector2d c = Eigen::Vector2d::Zero();
+      for (int k = 0; k < 3; ++k) c += m.vertices.row(m.triangles(f, k)).head<2>().transpose() / 3;
+      if (c.norm() > r_lo && c.norm() < r_hi) sum += areas(f), ++n;
+    }
+    return sum / n;
+  };
+  const double ratio = mean_area(ring.mesh, 0.0, 0.05) / mean_area(ring.mesh, 0.094, 0.106);
+  EXPECT_GT(ratio, 6.0);
+  EXPECT_LT(ratio, 12.0);
+  EXPECT_NEAR(mean_area(ring.mesh, 0.0, 0.05) / mean_area(plain.mesh, 0.0, 0.05), 1.0, 0.25);
+  // The cap also feeds the triangle estimate that guards the mesher.
+  o.max_triangles = plain.mesh.num_triangles() * 3 / 2;
+  EXPECT_LT(plain.mesh.num_triangles() * 3 / 2, ring.mesh.num_triangles());
+  EXPECT_NE(MeshError([&] { MeshDisk(0.15, {}, o); }).find("would exceed the limit"),
+            std::string::npos);
+  // A cap that is not a length is refused, naming the point.
+  o = Options(0.012);
+  o.max_size = [](double x, double) { return x > 0.1 ? std::nan("") : 0.012; };
+  const std::string bad = MeshError([&] { MeshDisk(0.15, {}, o); });
+  EXPECT_NE(bad.find("pattern mesh: max_size("), std::string::npos) << bad;
+  EXPECT_NE(bad.find("returned nan; it must be a finite length > 0"), std::string::npos) << bad;
+}
+
 TEST(PatternMesh, IsThreadSafeAndQuiet) {
   testing::internal::CaptureStdout();
   std::vector<PatternMesh> out(4);

@@ -95,6 +95,13 @@ struct DrapeOptions {
   // plain drape near 2 CPU s (the budget is 5 s); 8 mm costs 13 CPU s and moves DC by
   // less than the seed-to-seed spread (docs/drapemeter.md).
   double element_size = 0.012;
+  // The support's rim, where the overhang turns down over about a bending length
+  // ((B/ρg)^(1/3): 8 mm for the Fig. 8 fabric). A mesh of element_size there folds along one
+  // row of edges, too cheaply, and the drape comes out too low (docs/drapemeter.md). Edges are
+  // at most rim_element_size [m] from one such element inside the support to rim_band [m]
+  // beyond its edge, growing by half the distance past that; 0: no band.
+  double rim_element_size = 0.0;
+  double rim_band = 0.02;
   // Coarse → fine: solve on a mesh coarse_factor × element_size first and prolong (cascadic).
   // Off by default: the folds of the coarse solution are not the fine mesh's, and the fine level
   // spent more Newton steps re-folding than a cold start needs (8 mm: 236 steps and 13 CPU s

@@ -41,6 +41,10 @@ struct PatternMeshOptions {
   std::function<double(double d_m)> area_factor;
   // area_factor is consulted only for d < refinement_range [m]; elsewhere the factor is 1.
   double refinement_range = std::numeric_limits<double>::infinity();
+  // An upper bound on the edge length at the pattern point (x, y) [m], on top of the seams' field
+  // (e.g. the drapemeter's finer band along the support's rim); empty: none. It must return a
+  // finite length > 0 wherever it is asked; values above element_size change nothing.
+  std::function<double(double x, double y)> max_size;
   // Refuse (InputError) patterns whose estimated or actual triangle count exceeds this.
   long max_triangles = 2'000'000;
   // Gmsh's 2D algorithm (option Mesh.Algorithm): 6 Frontal-Delaunay (best-shaped triangles),

@@ -30,7 +30,8 @@ struct DrapeArgs {
   int seeds = 1;
   unsigned first_seed = 1;
   std::optional<double> resolution_mm;
-  double rim_mm = 0.0, rim_band_mm = 20.0;
+  std::string rim_mm = "0";  // a length [mm], 0 (off) or "auto"
+  double rim_band_mm = 20.0;
   double specimen_mm = 150.0, support_mm = 90.0, shift_mm = 50.0, perturbation_mm = 2.0;
   double frame_deg = 0.0;
   std::optional<double> tolerance;
@@ -96,12 +97,17 @@ DrapeOptions Options(const DrapeArgs& a) {
     o.element_size = units::MmToM(h);
   }
   o.element_size = std::min(o.element_size, 0.25 * (o.specimen_radius - o.support_radius));
-  const double rim = finite(a.rim_mm, "--rim-mm");
-  if (rim != 0.0 && !(rim >= 0.5 && units::MmToM(rim) <= o.element_size)) {
-    throw InputError("--rim-mm: must be 0 (off) or between 0.5 mm and the element size (" +
-                     Num(units::MToMm(o.element_size)) + " mm)");
+  if (a.rim_mm != "auto") {  // "auto" needs the material: Run
+    char* end = nullptr;
+    const double rim = std::strtod(a.rim_mm.c_str(), &end);
+    if (a.rim_mm.empty() || *end != '\0' || !std::isfinite(rim))
+      throw InputError("--rim-mm: '" + a.rim_mm + "' is not a length in mm or auto");
+    if (rim != 0.0 && !(rim >= 0.5 && units::MmToM(rim) <= o.element_size)) {
+      throw InputError("--rim-mm: must be 0 (off), auto or between 0.5 mm and the element size (" +
+                       Num(units::MToMm(o.element_size)) + " mm)");
+    }
+    o.rim_element_size = units::MmToM(rim);
   }
-  o.rim_element_size = units::MmToM(rim);
   const double band = finite(a.rim_band_mm, "--rim-band-mm");
   if (!(band >= 0.0 && band <= a.specimen_mm - a.support_mm)) {
     throw InputError("--rim-band-mm: must be between 0 and the overhang (" +
@@ -244,6 +250,7 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
                 {"resolution_mm", units::MToMm(o.element_size)},
                 {"rim_mm", units::MToMm(o.rim_element_size)},
                 {"rim_band_mm", units::MToMm(o.rim_band)},
+                {"rim_turn_down_mm", units::MToMm(RimTurnDownLength(m, o))},
                 {"coarse_to_fine", o.coarse_to_fine},
                 {"tolerance", o.solver.tolerance},
                 {"raster_cell_mm", units::MToMm(o.raster_cell)},
@@ -266,6 +273,19 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
 void Run(const DrapeArgs& a) {
   DrapeOptions o = Options(a);
   const Material m = ReadMaterial(a.material);
+  // The fabric's turn-down length ℓ at the rim. DC converges at first order in the rim's element
+  // size e, from below, by about 0.06 e/ℓ (the Fig. 8 fabric's study, docs/drapemeter.md,
+  // "Resolution"): `--rim-mm auto` meshes the rim with ℓ/3, and a larger expected shortfall than
+  // 0.02 gets a note.
+  const double turn_down = RimTurnDownLength(m, o);
+  if (a.rim_mm == "auto") o.rim_element_size = std::clamp(turn_down / 3.0, 0.0005, o.element_size);
+  const double rim_size = o.rim_element_size > 0.0 ? o.rim_element_size : o.element_size;
+  std::string note;  // reported with the result (a refused run prints its one error line only)
+  if (const double shortfall = 0.06 * rim_size / turn_down; shortfall > 0.02) {
+    note = "DC is likely low by about " + Num(shortfall, 1) + ": the rim's elements (" +
+           Num(units::MToMm(rim_size), 3) + " mm) are coarse against this fabric's turn-down length there (" +
+           Num(units::MToMm(turn_down), 2) + " mm); --rim-mm auto meshes it finer (slower; docs/drapemeter.md)";
+  }
   // Check the outputs' folders before computing.
   AtomicFile result_file(a.out);
   AtomicFile outline_file(OutlinePath(a.out));
@@ -284,6 +304,7 @@ void Run(const DrapeArgs& a) {
 
   const DrapeSeedResult& first = r.per_seed.front();
   nlohmann::json j = ResultJson(r, o, m, a);
+  j["note"] = note.empty() ? nlohmann::json() : nlohmann::json(note);
   j["outline_csv"] = outline_file.path();
   WriteText(outline_file, OutlineCsv(first));
   if (png_file) {
@@ -324,6 +345,7 @@ void Run(const DrapeArgs& a) {
   if (r.per_seed.size() > 1) std::cout << " ± " << Num(r.drape_coefficient_sd, 3);
   std::cout << "\nnodes: " << Num(r.nodes, 4);
   if (r.per_seed.size() > 1) std::cout << " ± " << Num(r.nodes_sd, 3);
+  if (!note.empty()) std::cout << "\nnote: " << note;
   std::cout << "\ntime: " << Num(r.seconds, 3) << " s\nresult: " << a.out << "\noutline: " << outline_file.path()
             << "\n";
   if (!a.png.empty()) std::cout << "shadow: " << a.png << "\n";
@@ -349,7 +371,8 @@ void RegisterDrape(CLI::App& app) {
   sub->add_option("--first-seed", a->first_seed, "First seed (default 1)");
   sub->add_option("--resolution-mm", a->resolution_mm, "Element size away from seams [mm] (default 12)");
   sub->add_option("--rim-mm", a->rim_mm,
-                  "Element size along the support's rim [mm] (0: off, the default; docs/drapemeter.md)");
+                  "Element size along the support's rim [mm], or auto: a third of the fabric's "
+                  "turn-down length (0: off, the default; docs/drapemeter.md)");
   sub->add_option("--rim-band-mm", a->rim_band_mm,
                   "Width of that finer band beyond the rim [mm] (default 20)");
   sub->add_option("--specimen-mm", a->specimen_mm, "Specimen radius [mm] (default 150)");

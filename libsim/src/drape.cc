@@ -432,6 +432,18 @@ std::vector<SeamLine> DrapeSeamLines(const DrapeOptions& o) {
   return {};
 }
 
+double RimTurnDownLength(const Material& material, const DrapeOptions& o) {
+  const double overhang = o.specimen_radius - o.support_radius;
+  if (!(material.areal_density > 0.0) || !Finite(material.areal_density))
+    throw InputError("rim turn-down length: the material needs an areal density > 0");
+  if (!(overhang > 0.0) || !Finite(overhang))
+    throw InputError("rim turn-down length: the specimen must be larger than the support");
+  const BendingLaw warp = material.EffectiveLaw(), weft = material.EffectiveWeftLaw();
+  const double b = std::min({warp.b1(), warp.b2(), weft.b1(), weft.b2()});
+  const double g = ClothOptions{}.gravity.norm();  // [m/s²]
+  return std::sqrt(b / (material.areal_density * g * overhang));
+}
+
 DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   std::string why;

@@ -186,6 +186,22 @@ TEST(Drape, RimBandOptionsAreCheckedByName) {
   EXPECT_THROW(SimulateDrape(Fig8(), o), InputError);
 }
 
+TEST(Drape, RimTurnDownLengthIsTheClampedStripsBoundaryLayer) {
+  // ℓ = sqrt(B / (ρ g (R − R_s))) with B the smaller stiffness, here b2 = 0.0892 gf·cm:
+  // sqrt(8.7475e-6 N·m / (0.2 kg/m² · 9.80665 m/s² · 0.06 m)) = 8.62 mm.
+  const DrapeOptions o;
+  EXPECT_NEAR(RimTurnDownLength(Fig8(), o), 8.622e-3, 1e-6);
+  Material heavy = Fig8();
+  heavy.areal_density = 0.8;  // four times the weight: half the length
+  EXPECT_NEAR(RimTurnDownLength(heavy, o) / RimTurnDownLength(Fig8(), o), 0.5, 1e-12);
+  Material weft = Fig8();
+  weft.bending_weft = BendingLaw::FromKes(0.0223, 0.0223, 0.0);  // a quarter of b2 across
+  EXPECT_NEAR(RimTurnDownLength(weft, o) / RimTurnDownLength(Fig8(), o), 0.5, 1e-3);
+  Material none = Fig8();
+  none.areal_density = 0.0;
+  EXPECT_THROW(RimTurnDownLength(none, o), InputError);
+}
+
 // The overhang turns down at the rim over a few millimetres; a mesh too coarse there lets it
 // fold along one row of edges and the drape comes out low (docs/drapemeter.md, "Resolution").
 TEST(Drape, RimBandRefinesTheRimAndRaisesTheDrape) {

@@ -83,9 +83,35 @@ TEST(CliDrape, RimBandIsMeshedReportedAndRecorded) {
   const auto j = nlohmann::json::parse(ReadAll(dir / "rim.json"));
   EXPECT_EQ(j["scene"]["rim_mm"].get<double>(), 5.0);
   EXPECT_EQ(j["scene"]["rim_band_mm"].get<double>(), 20.0);
+  EXPECT_NEAR(j["scene"]["rim_turn_down_mm"].get<double>(), 8.622, 1e-3);
+  // 5 mm against ℓ = 8.6 mm: still a note, with a smaller shortfall.
+  EXPECT_NE(r.out.find("note: DC is likely low by about 0.03"), std::string::npos) << r.out;
   // The plain 15 mm disk has 442 vertices; the band triples that (1445 measured).
   EXPECT_GT(j["scene"]["vertices"].get<int>(), 1000);
   EXPECT_TRUE(j["converged"].get<bool>());
+}
+
+TEST(CliDrape, CoarseRimGetsANoteAndAutoMeshesItFiner) {
+  const auto dir = Scratch("CliDrape.RimNote");
+  const auto plain = Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "plain.json").string());
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  const std::string note =
+      "note: DC is likely low by about 0.1: the rim's elements (15 mm) are coarse against this "
+      "fabric's turn-down length there (8.6 mm)";
+  EXPECT_NE(plain.out.find(note), std::string::npos) << plain.out;
+  const auto j = nlohmann::json::parse(ReadAll(dir / "plain.json"));
+  EXPECT_EQ(j["note"].get<std::string>().rfind(note.substr(6), 0), 0u) << j["note"];
+  // `--rim-mm auto`: ℓ/3 = 2.9 mm along the rim, several times the plain 15 mm disk's 442
+  // vertices (a capped run: the mesh is reported before the solve).
+  const auto autorim = Textile("drape " + kFig8 + kCoarse + " --rim-mm auto --max-seconds 0.001 -o " +
+                               (dir / "auto.json").string());
+  EXPECT_EQ(autorim.exit_code, 3) << autorim.err;
+  const auto vertices = [](const std::string& err) {
+    const auto at = err.find("drape: mesh: ");
+    return at == std::string::npos ? 0 : std::stoi(err.substr(at + 13));
+  };
+  EXPECT_GT(vertices(autorim.err), 4 * 442) << autorim.err;
+  EXPECT_FALSE(fs::exists(dir / "auto.json"));
 }
 
 TEST(CliDrape, NonConvergenceIsExit3WithOneLineAndNoFiles) {

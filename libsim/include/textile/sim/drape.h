@@ -202,6 +202,14 @@ struct DrapeResult {
 // The seam lines of a configuration [m] (frame_angle applied).
 std::vector<SeamLine> DrapeSeamLines(const DrapeOptions& options);
 
+// ℓ = sqrt(B / (ρ g (R − R_s))) [m]: the length over which the overhang turns down at the rim,
+// the boundary layer of a strip of stiffness B [N·m] clamped flat and pulled down by the weight
+// of the hanging overhang (ρ g (R − R_s) [N/m]); B is the smallest initial or ultimate stiffness
+// of the warp and weft laws (β applied). The rim's edges must be about this short for a
+// converged DC (docs/drapemeter.md, "Resolution"); `--rim-mm auto` uses it. Throws InputError
+// for a material without a density or a specimen not larger than the support.
+double RimTurnDownLength(const Material& material, const DrapeOptions& options);
+
 // Runs the drapemeter. Throws InputError for bad options or material (a specimen not larger
 // than the support, ...) and ComputeError when meshing fails; a solve that does not converge is
 // reported in the result (converged = false), never as a DC.

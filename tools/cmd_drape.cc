@@ -273,16 +273,16 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
 void Run(const DrapeArgs& a) {
   DrapeOptions o = Options(a);
   const Material m = ReadMaterial(a.material);
-  // The fabric's turn-down length ℓ at the rim. DC converges at first order in the rim's element
-  // size e, from below, by about 0.06 e/ℓ (the Fig. 8 fabric's study, docs/drapemeter.md,
-  // "Resolution"): `--rim-mm auto` meshes the rim with ℓ/3, and a larger expected shortfall than
-  // 0.02 gets a note.
+  // The fabric's turn-down length ℓ at the rim. DC converges at first order in the rim's
+  // element size e, from below, by about 0.06 e/ℓ (the Fig. 8 fabric's study,
+  // docs/drapemeter.md, "Resolution at the rim"): `--rim-mm auto` meshes the rim with ℓ/3, and
+  // an expected shortfall over 0.02 gets a note (an estimate: smaller with seams, near DC = 1).
   const double turn_down = RimTurnDownLength(m, o);
   if (a.rim_mm == "auto") o.rim_element_size = std::clamp(turn_down / 3.0, 0.0005, o.element_size);
   const double rim_size = o.rim_element_size > 0.0 ? o.rim_element_size : o.element_size;
   std::string note;  // reported with the result (a refused run prints its one error line only)
   if (const double shortfall = 0.06 * rim_size / turn_down; shortfall > 0.02) {
-    note = "DC is likely low by about " + Num(shortfall, 1) + ": the rim's elements (" +
+    note = "DC may be low by up to about " + Num(shortfall, 1) + ": the rim's elements (" +
            Num(units::MToMm(rim_size), 3) + " mm) are coarse against this fabric's turn-down length there (" +
            Num(units::MToMm(turn_down), 2) + " mm); --rim-mm auto meshes it finer (slower; docs/drapemeter.md)";
   }
@@ -332,7 +332,7 @@ void Run(const DrapeArgs& a) {
             << (o.seams != DrapeSeams::kNone ? " (" + o.seam_profile.type + ")" : "") << ", "
             << r.mesh.num_vertices() << " vertices (h = " << Num(units::MToMm(o.element_size)) << " mm"
             << (o.rim_element_size > 0.0
-                    ? ", " + Num(units::MToMm(o.rim_element_size)) + " mm to " +
+                    ? ", " + Num(units::MToMm(o.rim_element_size), 3) + " mm to " +
                           Num(units::MToMm(o.rim_band)) + " mm past the rim"
                     : std::string())
             << ")\n";

@@ -11,6 +11,8 @@
 #include "textile/sim/error.h"
 #include "textile/sim/mesh.h"
 
+#include "ring_area.h"
+
 namespace textile {
 namespace {
 
@@ -215,17 +217,7 @@ TEST(PatternMesh, MaxSizeRefinesWhereItIsSmallerOnly) {
   };
   const PatternMesh ring = MeshDisk(0.15, {}, o);
   ExpectFlatCcw(ring.mesh);
-  const auto mean_area = [](const TriangleMesh& m, double r_lo, double r_hi) {
-    const Eigen::VectorXd areas = TriangleAreas(m);
-    double sum = 0.0;
-    int n = 0;
-    for (int f = 0; f < m.num_triangles(); ++f) {
-      Eigen::Vector2d c = Eigen::Vector2d::Zero();
-      for (int k = 0; k < 3; ++k) c += m.vertices.row(m.triangles(f, k)).head<2>().transpose() / 3;
-      if (c.norm() > r_lo && c.norm() < r_hi) sum += areas(f), ++n;
-    }
-    return sum / n;
-  };
+  const auto mean_area = MeanTriangleAreaInRing;
   const double ratio = mean_area(ring.mesh, 0.0, 0.05) / mean_area(ring.mesh, 0.094, 0.106);
   EXPECT_GT(ratio, 6.0);
   EXPECT_LT(ratio, 12.0);

@@ -18,7 +18,6 @@ class Deadline {
   explicit Deadline(double max_seconds)
       : max_seconds_(max_seconds), start_(std::chrono::steady_clock::now()) {}
 
-  double max_seconds() const { return max_seconds_; }
   double Elapsed() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   }

@@ -95,11 +95,12 @@ struct DrapeOptions {
   // plain drape near 2 CPU s (the budget is 5 s); 8 mm costs 13 CPU s and moves DC by
   // less than the seed-to-seed spread (docs/drapemeter.md).
   double element_size = 0.012;
-  // The support's rim, where the overhang turns down over about a bending length
-  // ((B/ρg)^(1/3): 8 mm for the Fig. 8 fabric). A mesh of element_size there folds along one
-  // row of edges, too cheaply, and the drape comes out too low (docs/drapemeter.md). Edges are
-  // at most rim_element_size [m] from one such element inside the support to rim_band [m]
-  // beyond its edge, growing by half the distance past that; 0: no band.
+  // The support's rim, where the overhang turns down over the length RimTurnDownLength (8.6 mm
+  // for the Fig. 8 fabric). A mesh of element_size there folds along the clamp's edges too
+  // cheaply, and the DC comes out low, by about 0.06 × element / turn-down length at least
+  // (docs/drapemeter.md, "Resolution at the rim"). Edges are at most rim_element_size [m] from
+  // one such element inside the support to rim_band [m] beyond its edge, growing by half the
+  // distance past that; 0: no band (the default, for run time).
   double rim_element_size = 0.0;
   double rim_band = 0.02;
   // Coarse → fine: solve on a mesh coarse_factor × element_size first and prolong (cascadic).
@@ -205,9 +206,10 @@ std::vector<SeamLine> DrapeSeamLines(const DrapeOptions& options);
 // ℓ = sqrt(B / (ρ g (R − R_s))) [m]: the length over which the overhang turns down at the rim,
 // the boundary layer of a strip of stiffness B [N·m] clamped flat and pulled down by the weight
 // of the hanging overhang (ρ g (R − R_s) [N/m]); B is the smallest initial or ultimate stiffness
-// of the warp and weft laws (β applied). The rim's edges must be about this short for a
-// converged DC (docs/drapemeter.md, "Resolution"); `--rim-mm auto` uses it. Throws InputError
-// for a material without a density or a specimen not larger than the support.
+// of the warp and weft laws (β applied). The DC's shortfall scales with the rim's element size
+// over ℓ (docs/drapemeter.md, "Resolution at the rim"); `--rim-mm auto` meshes the rim with
+// ℓ/3. Throws InputError for a material without a density or a specimen not larger than the
+// support.
 double RimTurnDownLength(const Material& material, const DrapeOptions& options);
 
 // Runs the drapemeter. Throws InputError for bad options or material (a specimen not larger

@@ -211,7 +211,7 @@ nlohmann::json SummaryJson(const SolveSummary& s) {
 nlohmann::json NumberOrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
 
 nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Material& m,
-                          const DrapeArgs& a) {
+                          const DrapeArgs& a, double turn_down) {
   nlohmann::json j;
   j["converged"] = r.converged;
   j["message"] = r.message;
@@ -250,7 +250,7 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
                 {"resolution_mm", units::MToMm(o.element_size)},
                 {"rim_mm", units::MToMm(o.rim_element_size)},
                 {"rim_band_mm", units::MToMm(o.rim_band)},
-                {"rim_turn_down_mm", units::MToMm(RimTurnDownLength(m, o))},
+                {"rim_turn_down_mm", units::MToMm(turn_down)},
                 {"coarse_to_fine", o.coarse_to_fine},
                 {"tolerance", o.solver.tolerance},
                 {"raster_cell_mm", units::MToMm(o.raster_cell)},
@@ -303,7 +303,7 @@ void Run(const DrapeArgs& a) {
   if (!r.converged) throw ComputeError("drape: not converged (" + r.message + "); no drape coefficient");
 
   const DrapeSeedResult& first = r.per_seed.front();
-  nlohmann::json j = ResultJson(r, o, m, a);
+  nlohmann::json j = ResultJson(r, o, m, a, turn_down);
   j["note"] = note.empty() ? nlohmann::json() : nlohmann::json(note);
   j["outline_csv"] = outline_file.path();
   WriteText(outline_file, OutlineCsv(first));

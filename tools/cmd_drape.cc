@@ -203,6 +203,7 @@ nlohmann::json SummaryJson(const SolveSummary& s) {
   return {{"converged", s.converged},   {"method", s.method},
           {"message", s.message},       {"iterations", s.iterations},
           {"coarse_iterations", s.coarse_iterations},
+          {"factorizations", s.factorizations}, {"exact_hessian_steps", s.exact_steps},
           {"residual", s.residual},     {"energy_J", s.energy},
           {"seconds", s.seconds},       {"coarse_seconds", s.coarse_seconds},
           {"contacts", s.contacts},     {"anchors", s.anchors}};

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <dlfcn.h>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -35,6 +36,45 @@ double CentreHeight(const ClothProblem& p, const Vertices& x, const Eigen::Vecto
   return -(p.masses().transpose() * (x * down)).value() / p.total_mass();
 }
 
+// While alive, OpenMP regions started on this thread run on it alone (max-active-levels 0,
+// a per-thread setting in libgomp); the setting before is restored at the end.
+// Why: CHOLMOD 3 (SuiteSparse 5) opens an OpenMP region of a fixed 4 threads
+// (CHOLMOD_OMP_NUM_THREADS, compiled in) for each large supernode of every factorisation, and
+// on a 2-core machine the wake-ups cost more than the work they share: a 2100-vertex drape
+// (96 Newton steps) took 6.2 s wall, 1.7 s of it in the kernel (1.1 million futex calls);
+// serial, 3.1 s and 0.2 s (docs/drapemeter.md, "Solver"). The functions are looked up in the
+// process, i.e. in the OpenMP runtime CHOLMOD brought in; without one there is nothing to do,
+// and libsim needs no OpenMP of its own.
+class SerialOpenMp {
+ public:
+  SerialOpenMp() {
+    static const Api api = Lookup();
+    if (api.set == nullptr || api.get == nullptr) return;
+    set_ = api.set;
+    before_ = api.get();
+    set_(0);
+  }
+  ~SerialOpenMp() {
+    if (set_ != nullptr) set_(before_);
+  }
+  SerialOpenMp(const SerialOpenMp&) = delete;
+  SerialOpenMp& operator=(const SerialOpenMp&) = delete;
+
+ private:
+  struct Api {
+    void (*set)(int) = nullptr;
+    int (*get)() = nullptr;
+  };
+  static Api Lookup() {
+    Api api;
+    api.set = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
+    api.get = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_max_active_levels"));
+    return api;
+  }
+  void (*set_)(int) = nullptr;
+  int before_ = 0;
+};
+
 // Solves A d = b with CHOLMOD (shifting the diagonal when A is singular) or with conjugate
 // gradients. The sparsity of A is the same on every call, so CHOLMOD analyses it once.
 class LinearSolver {
@@ -50,6 +90,16 @@ class LinearSolver {
       cg_->setTolerance(options.cg_tolerance);
       cg_->setMaxIterations(options.cg_max_iterations);
     }
+  }
+
+  // One factorisation of `a` as it is (no shift): false when it is not positive definite.
+  bool SolveUnshifted(const SparseMatrix& a, const Eigen::VectorXd& b, Eigen::VectorXd* d,
+                      SolveSummary* summary) {
+    if (!cg_ && !analysed_) {
+      cholmod_->analyzePattern(a);
+      analysed_ = true;
+    }
+    return Factorize(a, b, d, summary);
   }
 
   // False when no usable direction came out (the caller falls back to steepest descent).
@@ -90,6 +140,7 @@ class LinearSolver {
       *d = cg_->solve(b);
       summary->linear_iterations += static_cast<int>(cg_->iterations());
     } else {
+      const SerialOpenMp serial;
       cholmod_->factorize(m);
       ++summary->factorizations;
       if (cholmod_->info() != Eigen::Success) return false;
@@ -199,6 +250,33 @@ struct Run {
   }
 };
 
+// When Newton tries the exact Hessian (SolveOptions::exact_below): at once after a success,
+// else after 1, 2, 4, ... 16 steps, since a try that fails (the Hessian is indefinite: the
+// state is not yet in a minimum's basin) costs an assembly and a factorisation for nothing.
+class ExactHessianTries {
+ public:
+  // Whether to try this step (counts the wait down).
+  bool Due() {
+    if (wait_ == 0) return true;
+    --wait_;
+    return false;
+  }
+  // Records a try's outcome and returns it.
+  bool Took(bool success) {
+    if (success) {
+      backoff_ = 1;
+    } else {
+      wait_ = backoff_;
+      backoff_ = std::min(2 * backoff_, 16);
+    }
+    return success;
+  }
+
+ private:
+  int wait_ = 0;
+  int backoff_ = 1;
+};
+
 SolveSummary Newton(Run& run) {
   ClothProblem& p = *run.problem;
   Vertices& x = *run.x;
@@ -210,12 +288,23 @@ SolveSummary Newton(Run& run) {
   double energy = p.EnergyGradient(x, &grad);
   double residual = p.RelativeResidual(grad);
   double slid = 0.0;
+  ExactHessianTries exact;
   Eigen::VectorXd d;
   for (int it = 0;; ++it) {
     if (run.Done(it, energy, residual, slid)) return run.Finish(energy, residual);
-    const SparseMatrix& h = p.Hessian(x, o.projection);
     const Eigen::VectorXd g = Flat(grad);
-    if (!linear.Solve(h, -g, &d, &run.summary) || d.dot(g) >= 0.0) d = -g;
+    bool exact_step = false;
+    if (residual < o.exact_below && o.projection != HessianProjection::kNone &&
+        o.linear == LinearSolverKind::kCholmod && exact.Due()) {
+      const SparseMatrix& h = p.Hessian(x, HessianProjection::kNone);
+      exact_step = exact.Took(linear.SolveUnshifted(h, -g, &d, &run.summary) && d.dot(g) < 0.0);
+    }
+    if (exact_step) {
+      ++run.summary.exact_steps;
+    } else {
+      const SparseMatrix& h = p.Hessian(x, o.projection);
+      if (!linear.Solve(h, -g, &d, &run.summary) || d.dot(g) >= 0.0) d = -g;
+    }
     // Step cap: no vertex moves further than max_step in one iteration.
     double largest = 0.0;
     for (int i = 0; i < p.num_vertices(); ++i) largest = std::max(largest, d.segment<3>(3 * i).norm());
@@ -369,6 +458,7 @@ bool SolveOptions::Check(std::string* why) const {
   if (cg_max_iterations < 1) return fail("cg_max_iterations must be >= 1");
   if (!(anchor_tolerance >= 0.0)) return fail("anchor_tolerance must be >= 0");
   if (!(fall_limit > 0.0)) return fail("fall_limit must be > 0");
+  if (!(exact_below >= 0.0)) return fail("exact_below must be >= 0");
   return true;
 }
 

@@ -43,6 +43,16 @@ TEST(CliDrape, PlainDrapeWritesResultOutlinePngAndObj) {
   EXPECT_TRUE(j["nodes"].is_number());
   EXPECT_TRUE(j["nodes_sd"].is_number());
   EXPECT_EQ(j["scene"]["mount"], "clamped");
+  // The solver report: a factorisation per Newton step at least, the exact-Hessian steps among
+  // them, a residual under the tolerance.
+  for (const auto& seed : j["seeds"]) {
+    const auto& solver = seed["solver"];
+    EXPECT_TRUE(solver["converged"].get<bool>());
+    EXPECT_GE(solver["factorizations"].get<int>(), solver["iterations"].get<int>());
+    EXPECT_GE(solver["exact_hessian_steps"].get<int>(), 0);
+    EXPECT_LE(solver["exact_hessian_steps"].get<int>(), solver["iterations"].get<int>());
+    EXPECT_LT(solver["residual"].get<double>(), 1e-4);
+  }
   // Outline CSV next to the result: a header and one row per 1° bin, radii between the
   // support and the specimen.
   const std::string csv = ReadAll(dir / "drape.outline.csv");

@@ -275,17 +275,20 @@ void Run(const DrapeArgs& a) {
   DrapeOptions o = Options(a);
   const Material m = ReadMaterial(a.material);
   // The fabric's turn-down length ℓ at the rim. DC converges at first order in the rim's
-  // element size e, from below, by about 0.06 e/ℓ (the Fig. 8 fabric's study,
-  // docs/drapemeter.md, "Resolution at the rim"): `--rim-mm auto` meshes the rim with ℓ/3, and
-  // an expected shortfall over 0.02 gets a note (an estimate: smaller with seams, near DC = 1).
+  // element size e, from below, by about 0.1 e/ℓ for a plain fabric (the Fig. 8 fabric's four-seed
+  // study down to e = 1.5 mm, docs/drapemeter.md, "Resolution at the rim"; less with seams and
+  // near DC = 1, hence "up to"): `--rim-mm auto` meshes the rim with ℓ/3, and an expected
+  // shortfall over 0.02 gets a note.
   const double turn_down = RimTurnDownLength(m, o);
   if (a.rim_mm == "auto") o.rim_element_size = std::clamp(turn_down / 3.0, 0.0005, o.element_size);
   const double rim_size = o.rim_element_size > 0.0 ? o.rim_element_size : o.element_size;
   std::string note;  // reported with the result (a refused run prints its one error line only)
-  if (const double shortfall = 0.06 * rim_size / turn_down; shortfall > 0.02) {
+  if (const double shortfall = 0.1 * rim_size / turn_down; shortfall > 0.02) {
     note = "DC may be low by up to about " + Num(shortfall, 1) + ": the rim's elements (" +
            Num(units::MToMm(rim_size), 3) + " mm) are coarse against this fabric's turn-down length there (" +
-           Num(units::MToMm(turn_down), 2) + " mm); --rim-mm auto meshes it finer (slower; docs/drapemeter.md)";
+           Num(units::MToMm(turn_down), 2) + " mm); " +
+           (o.rim_element_size > 0.0 ? std::string("a smaller --rim-mm") : std::string("--rim-mm auto")) +
+           " meshes it finer (slower; docs/drapemeter.md)";
   }
   // Check the outputs' folders before computing.
   AtomicFile result_file(a.out);

@@ -92,13 +92,13 @@ struct DrapeOptions {
   double frame_angle = 0.0;
 
   // Target edge length of the fine mesh away from seams [m]. The default keeps a single-seed
-  // plain drape near 2 CPU s (the budget is 5 s); 8 mm costs 13 CPU s and moves DC by
-  // less than the seed-to-seed spread (docs/drapemeter.md).
+  // plain drape under 0.5 s (the budget is 5 s). Its DC is low, mostly because of the
+  // support's rim (below), little because of the rest of the disk (docs/drapemeter.md).
   double element_size = 0.012;
   // The support's rim, where the overhang turns down over the length RimTurnDownLength (8.6 mm
   // for the Fig. 8 fabric). A mesh of element_size there folds along the clamp's edges too
-  // cheaply, and the DC comes out low, by about 0.06 × element / turn-down length at least
-  // (docs/drapemeter.md, "Resolution at the rim"). Edges are at most rim_element_size [m] from
+  // cheaply, and the DC comes out low, by about 0.1 × element / turn-down length for a plain
+  // fabric (docs/drapemeter.md, "Resolution at the rim"). Edges are at most rim_element_size [m] from
   // one such element inside the support to rim_band [m] beyond its edge, growing by half the
   // distance past that; 0: no band (the default, for run time).
   double rim_element_size = 0.0;

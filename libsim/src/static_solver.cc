@@ -284,7 +284,7 @@ SolveSummary Newton(Run& run) {
   const double max_step = o.max_step > 0.0 ? o.max_step : 0.1 * run.diagonal;
   LinearSolver linear(o);
   p.UpdateAnchors(x, x);
-  Vertices grad, trial, trial_grad;
+  Vertices grad, trial, trial_grad, longer, longer_grad;
   double energy = p.EnergyGradient(x, &grad);
   double residual = p.RelativeResidual(grad);
   double slid = 0.0;
@@ -309,7 +309,8 @@ SolveSummary Newton(Run& run) {
     double largest = 0.0;
     for (int i = 0; i < p.num_vertices(); ++i) largest = std::max(largest, d.segment<3>(3 * i).norm());
     if (largest > max_step) d *= max_step / largest;
-    d *= p.ContactStepLimit(x, d);
+    const double contact_scale = p.ContactStepLimit(x, d);
+    d *= contact_scale;
     // Armijo backtracking; near convergence, where E is flat to round-off, a full step that
     // lowers the residual is taken as well.
     const double slope = d.dot(g);
@@ -326,6 +327,21 @@ SolveSummary Newton(Run& run) {
            trial_energy <= energy + 1e-12 * std::abs(energy))) {
         accepted = true;
         break;
+      }
+    }
+    // SolveOptions::expand_steps: an accepted full projected step is doubled while the energy
+    // keeps falling, within the step cap (not near contact, whose step limit holds for the step
+    // as it is; not for the exact Hessian's steps, which are scaled right).
+    if (o.expand_steps && accepted && alpha == 1.0 && !exact_step && contact_scale >= 1.0) {
+      const double length = std::min(largest, max_step);
+      for (double a = 2.0; a * length <= max_step; a *= 2.0) {
+        longer = x;
+        Flat(longer) += a * d;
+        const double longer_energy = p.EnergyGradient(longer, &longer_grad);
+        if (!(longer_energy < trial_energy)) break;
+        trial_energy = longer_energy;
+        trial.swap(longer);
+        trial_grad.swap(longer_grad);
       }
     }
     if (!accepted) {

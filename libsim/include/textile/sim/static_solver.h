@@ -55,6 +55,13 @@ struct SolveOptions {
   // fewer steps to the same equilibria (docs/drapemeter.md, "Solver"). ≥ 0; 0: never, ∞:
   // from the start.
   double exact_below = 1.0;
+  // Newton: when a full projected step is accepted, try it doubled, quadrupled ... (within
+  // max_step) while the energy keeps falling. Where folds form, the projected Hessian is far
+  // stiffer than the energy along the folds' way: a drape's steps moved no vertex more than
+  // 10-100 µm for a hundred iterations, and doubling them halved the steps to the same
+  // equilibria (docs/drapemeter.md, "Solver"). Off by default: such long steps can cross
+  // into another basin, and did on the ACPM shell's strip (an overhang 0.39 of the true one).
+  bool expand_steps = false;
   double tolerance = 1e-6;       // on the relative residual [-]
   int max_iterations = 1000;     // Newton steps or kinetic-damping time steps
   double max_seconds = 60.0;     // wall-time cap [s], finite, ≥ 0 (0: stop at the first check)

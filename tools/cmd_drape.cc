@@ -280,7 +280,9 @@ void Run(const DrapeArgs& a) {
   // near DC = 1, hence "up to"): `--rim-mm auto` meshes the rim with ℓ/3, and an expected
   // shortfall over 0.02 gets a note.
   const double turn_down = RimTurnDownLength(m, o);
-  if (a.rim_mm == "auto") o.rim_element_size = std::clamp(turn_down / 3.0, 0.0005, o.element_size);
+  // ℓ/3, at least 0.5 mm, at most the element size (which may itself be under 0.5 mm when the
+  // overhang is tiny: then the rim gets the element size).
+  if (a.rim_mm == "auto") o.rim_element_size = std::min(std::max(turn_down / 3.0, 0.0005), o.element_size);
   const double rim_size = o.rim_element_size > 0.0 ? o.rim_element_size : o.element_size;
   std::string note;  // reported with the result (a refused run prints its one error line only)
   if (const double shortfall = 0.1 * rim_size / turn_down; shortfall > 0.02) {

@@ -197,7 +197,7 @@ SolveOptions DefaultDrapeSolveOptions() {
   s.tolerance = 1e-4;
   s.max_iterations = 3000;
   s.max_seconds = 600.0;  // wall time: generous, the machine may be shared
-  s.expand_steps = true;  // the same equilibria in 0.5-1× the steps (docs/drapemeter.md, "Solver")
+  s.expand_steps = true;  // the same equilibria in 0.4-1× the steps (docs/drapemeter.md, "Solver")
   return s;
 }
 

@@ -309,32 +309,34 @@ SolveSummary Newton(Run& run) {
     double largest = 0.0;
     for (int i = 0; i < p.num_vertices(); ++i) largest = std::max(largest, d.segment<3>(3 * i).norm());
     if (largest > max_step) d *= max_step / largest;
-    const double contact_scale = p.ContactStepLimit(x, d);
-    d *= contact_scale;
+    d *= p.ContactStepLimit(x, d);
     // Armijo backtracking; near convergence, where E is flat to round-off, a full step that
     // lowers the residual is taken as well.
     const double slope = d.dot(g);
     double alpha = 1.0;
     bool accepted = false;
+    bool armijo = false;  // accepted by the energy's decrease, not by the residual's
     double trial_energy = 0.0;
     for (int k = 0; k < 40; ++k, alpha *= 0.5) {
       trial = x;
       Flat(trial) += alpha * d;
       trial_energy = p.EnergyGradient(trial, &trial_grad);
       if (!std::isfinite(trial_energy)) continue;
-      if (trial_energy <= energy + 1e-4 * alpha * slope ||
-          (k == 0 && p.RelativeResidual(trial_grad) < residual &&
-           trial_energy <= energy + 1e-12 * std::abs(energy))) {
+      armijo = trial_energy <= energy + 1e-4 * alpha * slope;
+      if (armijo || (k == 0 && p.RelativeResidual(trial_grad) < residual &&
+                     trial_energy <= energy + 1e-12 * std::abs(energy))) {
         accepted = true;
         break;
       }
     }
-    // SolveOptions::expand_steps: an accepted full projected step is doubled while the energy
-    // keeps falling, within the step cap (not near contact, whose step limit holds for the step
-    // as it is; not for the exact Hessian's steps, which are scaled right).
-    if (o.expand_steps && accepted && alpha == 1.0 && !exact_step && contact_scale >= 1.0) {
+    // SolveOptions::expand_steps: a full projected step that lowered the energy (not one taken
+    // for its residual where E is flat to round-off) is doubled while the energy keeps falling,
+    // within the step cap and the contact step limit of the longer step; not the exact
+    // Hessian's steps, which are scaled right.
+    if (o.expand_steps && armijo && alpha == 1.0 && !exact_step) {
       const double length = std::min(largest, max_step);
       for (double a = 2.0; a * length <= max_step; a *= 2.0) {
+        if (p.ContactStepLimit(x, a * d) < 1.0) break;
         longer = x;
         Flat(longer) += a * d;
         const double longer_energy = p.EnergyGradient(longer, &longer_grad);

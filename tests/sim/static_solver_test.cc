@@ -226,7 +226,7 @@ TEST(StaticSolver, ExactHessianNearTheEndReachesTheSameStateInFewerSteps) {
     ASSERT_TRUE(s.converged);
     if (exact_below == 0.0) {
       EXPECT_EQ(s.exact_steps, 0);
-      EXPECT_EQ(s.factorizations, s.iterations);
+      EXPECT_GE(s.factorizations, s.iterations);  // shifted retries may add some
       projected_only = s;
       reference = x;
       continue;

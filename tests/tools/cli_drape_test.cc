@@ -114,6 +114,8 @@ TEST(CliDrape, CoarseRimGetsANoteAndAutoMeshesItFiner) {
       "note: DC may be low by up to about 0.2: the rim's elements (15 mm) are coarse against this "
       "fabric's turn-down length there (8.6 mm)";
   EXPECT_NE(plain.out.find(note), std::string::npos) << plain.out;
+  // Without a band it points to auto (with one, to a smaller --rim-mm: the test above).
+  EXPECT_NE(plain.out.find("--rim-mm auto meshes it finer"), std::string::npos) << plain.out;
   const auto j = nlohmann::json::parse(ReadAll(dir / "plain.json"));
   EXPECT_EQ(j["note"].get<std::string>().rfind(note.substr(6), 0), 0u) << j["note"];
   // No --rim-mm: the default, auto, ℓ/3 = 2.9 mm along the rim, several times the plain 15 mm

@@ -51,12 +51,12 @@ struct SolveOptions {
   // definite, so the step heads for a minimum, never a saddle), else the projected one; after a
   // failed try the next waits 1, 2, 4 ... 16 steps. The projected Hessian alone converges only
   // linearly where folds compress the membrane and bend the hinges (a drape's last 100 steps
-  // cut the residual by ×0.94 each); with the exact one near the end the drapes took 1.5-12×
+  // cut the residual by ×0.94 each); with the exact one near the end the drapes took 1.3-11×
   // fewer steps to the same equilibria (docs/drapemeter.md, "Solver"). ≥ 0; 0: never, ∞:
   // from the start.
   double exact_below = 1.0;
-  // Newton: when a full projected step is accepted, try it doubled, quadrupled ... (within
-  // max_step) while the energy keeps falling. Where folds form, the projected Hessian is far
+  // Newton: when a full projected step lowers the energy, try it doubled, quadrupled ...
+  // (within max_step and the contact step limit) while the energy keeps falling. Where folds form, the projected Hessian is far
   // stiffer than the energy along the folds' way: a drape's steps moved no vertex more than
   // 10-100 µm for a hundred iterations, and doubling them halved the steps to the same
   // equilibria (docs/drapemeter.md, "Solver"). Off by default: such long steps can cross

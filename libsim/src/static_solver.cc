@@ -50,12 +50,12 @@ class SerialOpenMp {
   SerialOpenMp() {
     static const Api api = Lookup();
     if (api.set == nullptr || api.get == nullptr) return;
-    set_ = api.set;
+    api_ = &api;
     before_ = api.get();
-    set_(0);
+    api.set(0);
   }
   ~SerialOpenMp() {
-    if (set_ != nullptr) set_(before_);
+    if (api_ != nullptr) api_->set(before_);
   }
   SerialOpenMp(const SerialOpenMp&) = delete;
   SerialOpenMp& operator=(const SerialOpenMp&) = delete;
@@ -71,7 +71,7 @@ class SerialOpenMp {
     api.get = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_max_active_levels"));
     return api;
   }
-  void (*set_)(int) = nullptr;
+  const Api* api_ = nullptr;
   int before_ = 0;
 };
 
@@ -95,20 +95,12 @@ class LinearSolver {
   // One factorisation of `a` as it is (no shift): false when it is not positive definite.
   bool SolveUnshifted(const SparseMatrix& a, const Eigen::VectorXd& b, Eigen::VectorXd* d,
                       SolveSummary* summary) {
-    if (!cg_ && !analysed_) {
-      cholmod_->analyzePattern(a);
-      analysed_ = true;
-    }
     return Factorize(a, b, d, summary);
   }
 
   // False when no usable direction came out (the caller falls back to steepest descent).
   bool Solve(const SparseMatrix& a, const Eigen::VectorXd& b, Eigen::VectorXd* d,
              SolveSummary* summary) {
-    if (!cg_ && !analysed_) {
-      cholmod_->analyzePattern(a);
-      analysed_ = true;
-    }
     // Singular or indefinite matrices (a flat sheet has no out-of-plane stiffness) get λ I
     // added, λ growing ×100 from 1e-10 to 1e-2 of the mean diagonal. The last shift that
     // worked is where the next solve starts (÷100), so a run of singular steps does not pay
@@ -141,6 +133,10 @@ class LinearSolver {
       summary->linear_iterations += static_cast<int>(cg_->iterations());
     } else {
       const SerialOpenMp serial;
+      if (!analysed_) {  // every matrix here has the same pattern (shifts stay on the diagonal)
+        cholmod_->analyzePattern(m);
+        analysed_ = true;
+      }
       cholmod_->factorize(m);
       ++summary->factorizations;
       if (cholmod_->info() != Eigen::Success) return false;

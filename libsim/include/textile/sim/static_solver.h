@@ -56,10 +56,10 @@ struct SolveOptions {
   // from the start.
   double exact_below = 1.0;
   // Newton: when a full projected step lowers the energy, try it doubled, quadrupled ...
-  // (within max_step and the contact step limit) while the energy keeps falling. Where folds form, the projected Hessian is far
-  // stiffer than the energy along the folds' way: a drape's steps moved no vertex more than
-  // 10-100 µm for a hundred iterations, and doubling them halved the steps to the same
-  // equilibria (docs/drapemeter.md, "Solver"). Off by default: such long steps can cross
+  // (within max_step and the contact step limit) while the energy keeps falling. Where folds
+  // form, the projected Hessian is far stiffer than the energy along the folds' way: a drape's
+  // steps moved no vertex more than 10-100 µm for a hundred iterations, and doubling them
+  // halved the steps to the same equilibria (docs/drapemeter.md, "Solver"). Off by default: such long steps can cross
   // into another basin, and did on the ACPM shell's strip (an overhang 0.39 of the true one).
   bool expand_steps = false;
   double tolerance = 1e-6;       // on the relative residual [-]

@@ -1,9 +1,20 @@
-// The `textile` shell and `textile law`, through the real executable.
+// The `textile` shell, `textile law` and two quick benchmarks (`textile bench`), through the
+// real executable.
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
 
 #include "run_cli.h"
 
@@ -123,6 +134,170 @@ TEST(CliLaw, RejectsNonFiniteKappa) {
   const auto r = RunTextile("law --material samples/materials/pabst-fig8.json --kappa nan", "law_nan");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--kappa"), std::string::npos) << r.err;
+}
+
+// A benchmark's CSV (tools/bench/bench_common.cc WriteCsv): a header line, then one line per row;
+// strings are in double quotes and may hold commas (never a quote), numbers are bare.
+struct Csv {
+  std::vector<std::string> header;
+  std::vector<std::map<std::string, std::string>> rows;
+};
+
+std::vector<std::string> CsvFields(const std::string& line) {
+  std::vector<std::string> fields(1);
+  bool quoted = false;
+  for (char c : line) {
+    if (c == '"') {
+      quoted = !quoted;
+    } else if (c == ',' && !quoted) {
+      fields.emplace_back();
+    } else {
+      fields.back() += c;
+    }
+  }
+  return fields;
+}
+
+Csv ReadCsv(const fs::path& path) {
+  Csv csv;
+  std::ifstream in(path);
+  std::string line;
+  if (!std::getline(in, line)) return csv;
+  csv.header = CsvFields(line);
+  while (std::getline(in, line)) {
+    const std::vector<std::string> fields = CsvFields(line);
+    EXPECT_EQ(fields.size(), csv.header.size()) << path << ": " << line;
+    std::map<std::string, std::string> row;
+    for (size_t i = 0; i < std::min(fields.size(), csv.header.size()); ++i)
+      row[csv.header[i]] = fields[i];
+    csv.rows.push_back(row);
+  }
+  return csv;
+}
+
+// The number in a field; NaN for an empty or malformed one, so that a finiteness check fails.
+double Number(const std::map<std::string, std::string>& row, const std::string& column) {
+  const auto it = row.find(column);
+  if (it == row.end() || it->second.empty()) return std::nan("");
+  char* end = nullptr;
+  const double v = std::strtod(it->second.c_str(), &end);
+  return *end == '\0' ? v : std::nan("");
+}
+
+void ExpectPng(const fs::path& png) {
+  ASSERT_TRUE(fs::exists(png)) << png;
+  EXPECT_GT(fs::file_size(png), 10000u) << png;  // a real chart, not an empty image
+  EXPECT_EQ(testing::ReadAll(png).substr(1, 3), "PNG") << png;
+}
+
+const std::set<std::string> kBendingModels = {"volino", "bridson", "isometric", "pabst"};
+
+// Pabst Fig. 10 (docs/bending.md, "hinge-curve"): one curve per fabric and model, and the shapes
+// the paper describes. Physics only: no timing.
+TEST(CliBench, HingeCurveQuickWritesPabstFig10Curves) {
+  const auto d = Scratch("CliBench.HingeCurve");
+  const auto r = RunTextile("bench hinge-curve --quick -o '" + d.string() + "'", "bench_hinge");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(d / "hinge-curve.csv")) << r.out;
+  ExpectPng(d / "hinge-curve.png");
+  const Csv csv = ReadCsv(d / "hinge-curve.csv");
+  EXPECT_EQ(csv.header,
+            (std::vector<std::string>{"fabric", "model", "opening_deg", "bend_deg", "kappa_per_m",
+                                      "normal_force_mn", "tangential_force_mn"}));
+
+  // (fabric, model) -> (opening angle, normal force), in file order.
+  std::map<std::pair<std::string, std::string>, std::vector<std::pair<double, double>>> curves;
+  for (const auto& row : csv.rows) {
+    const double opening = Number(row, "opening_deg"), fn = Number(row, "normal_force_mn");
+    for (const char* c : {"opening_deg", "bend_deg", "kappa_per_m", "normal_force_mn",
+                          "tangential_force_mn"})
+      EXPECT_TRUE(std::isfinite(Number(row, c))) << c << " in " << row.at("model");
+    EXPECT_EQ(opening + Number(row, "bend_deg"), 180.0);
+    EXPECT_GE(Number(row, "kappa_per_m"), 0.0);
+    curves[{row.at("fabric"), row.at("model")}].emplace_back(opening, fn);
+  }
+  std::map<std::string, std::set<std::string>> models_of;
+  for (const auto& [key, curve] : curves) models_of[key.first].insert(key.second);
+  ASSERT_EQ(models_of.size(), 2u) << "two fabrics (Fig. 8 fabric, interlining)";
+  for (const auto& [fabric, models] : models_of) EXPECT_EQ(models, kBendingModels) << fabric;
+
+  const auto& first = curves.begin()->second;
+  for (const auto& [key, curve] : curves) {
+    SCOPED_TRACE(key.first + " / " + key.second);
+    ASSERT_GE(curve.size(), 10u);
+    // The same angles for every curve, from flat (180°) closing towards 0°, 90° among them.
+    std::vector<double> angles, first_angles;
+    for (const auto& p : curve) angles.push_back(p.first);
+    for (const auto& p : first) first_angles.push_back(p.first);
+    EXPECT_EQ(angles, first_angles);
+    EXPECT_EQ(curve.front().first, 180.0);
+    EXPECT_TRUE(std::is_sorted(angles.rbegin(), angles.rend())) << "opening angles not closing";
+    EXPECT_LE(curve.back().first, 20.0);
+    EXPECT_NEAR(curve.front().second, 0.0, 1e-9) << "a flat hinge bends nothing";
+    const auto peak = *std::max_element(
+        curve.begin(), curve.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+    if (key.second == "volino" || key.second == "isometric") {
+      // ∝ sin θ: rises to 90° and falls back as the hinge closes.
+      EXPECT_NEAR(peak.first, 90.0, 10.0);
+      EXPECT_LT(curve.back().second, 0.5 * peak.second) << "no fall after the peak";
+      EXPECT_LT(curve[1].second, 0.5 * peak.second);
+    } else {
+      // Bridson (∝ sin θ/2) and Pabst: rise monotonically all the way as the hinge closes.
+      for (size_t i = 1; i < curve.size(); ++i)
+        EXPECT_GT(curve[i].second, curve[i - 1].second)
+            << "at " << curve[i].first << "° after " << curve[i - 1].first << "°";
+      EXPECT_EQ(peak.first, curve.back().first);
+    }
+  }
+  // "The isometric curve lies on Volino's" for one hinge.
+  for (const auto& [fabric, models] : models_of) {
+    const auto& volino = curves[{fabric, "volino"}];
+    const auto& isometric = curves[{fabric, "isometric"}];
+    ASSERT_EQ(volino.size(), isometric.size());
+    for (size_t i = 0; i < volino.size(); ++i)
+      EXPECT_NEAR(isometric[i].second, volino[i].second, 1e-5 * std::abs(volino[i].second) + 1e-9)
+          << fabric << " at " << volino[i].first << "°";
+  }
+}
+
+// The bend-force CSV: the columns docs/benchmarks.md reads, one row per model and thread count
+// (1, and all hardware threads when there are more), every time positive and finite. No
+// thresholds on the times: they belong to the benchmark.
+TEST(CliBench, BendForceQuickWritesOneRowPerModelAndThreadCount) {
+  const auto d = Scratch("CliBench.BendForce");
+  const auto r = RunTextile("bench bend-force --quick -o '" + d.string() + "'", "bench_bend_force");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(d / "bend-force.csv")) << r.out;
+  ExpectPng(d / "bend-force.png");
+  const Csv csv = ReadCsv(d / "bend-force.csv");
+  for (const char* c : {"model", "threads", "triangles", "force_ms", "force_jacobian_ms"})
+    EXPECT_NE(std::find(csv.header.begin(), csv.header.end(), c), csv.header.end())
+        << "no column " << c;
+
+  const unsigned hardware = std::thread::hardware_concurrency();
+  std::set<int> thread_counts = {1};
+  if (hardware > 1) thread_counts.insert(static_cast<int>(hardware));
+  std::map<std::string, std::multiset<int>> threads_of;
+  for (const auto& row : csv.rows) {
+    const std::string model = row.count("model") ? row.at("model") : "";
+    SCOPED_TRACE(model + ", " + (row.count("threads") ? row.at("threads") : "?") + " threads");
+    threads_of[model].insert(static_cast<int>(Number(row, "threads")));
+    EXPECT_EQ(Number(row, "triangles"), 3600.0) << "Pabst's Table 3 sheet";
+    int times = 0;
+    for (const std::string& c : csv.header) {
+      if (c.size() < 3 || c.compare(c.size() - 3, 3, "_ms") != 0) continue;
+      ++times;
+      const double ms = Number(row, c);
+      EXPECT_TRUE(std::isfinite(ms) && ms > 0) << c << " = " << ms;
+    }
+    EXPECT_GE(times, 2);
+  }
+  EXPECT_EQ(csv.rows.size(), kBendingModels.size() * thread_counts.size());
+  for (const std::string& model : kBendingModels) {
+    EXPECT_EQ(threads_of[model], std::multiset<int>(thread_counts.begin(), thread_counts.end()))
+        << model;
+  }
+  EXPECT_EQ(threads_of.size(), kBendingModels.size());
 }
 
 }  // namespace

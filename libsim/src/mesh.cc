@@ -146,6 +146,92 @@ std::vector<std::array<int, 2>> BoundaryEdges(const TriangleMesh& m) {
   return out;
 }
 
+Vertices RefinedMesh::Prolong(const Vertices& x) const {
+  const long old = mesh.vertices.rows() - static_cast<long>(parents.size());
+  if (x.rows() != old)
+    throw InputError("prolong: " + std::to_string(x.rows()) + " positions for a mesh of " +
+                     std::to_string(old) + " vertices");
+  Vertices out(mesh.vertices.rows(), 3);
+  out.topRows(old) = x;
+  for (size_t i = 0; i < parents.size(); ++i)
+    out.row(old + static_cast<long>(i)) = 0.5 * (x.row(parents[i][0]) + x.row(parents[i][1]));
+  return out;
+}
+
+RefinedMesh RefineTriangles(const TriangleMesh& m, const std::vector<bool>& marked) {
+  const int nf = m.num_triangles();
+  if (static_cast<int>(marked.size()) != nf)
+    throw InputError("refine: " + std::to_string(marked.size()) + " flags for " +
+                     std::to_string(nf) + " triangles");
+  auto key = [](int a, int b) { return a < b ? std::make_pair(a, b) : std::make_pair(b, a); };
+  // Edges to split; closure: a triangle with two split edges gets its third split too.
+  std::map<std::pair<int, int>, int> split;  // edge -> new vertex id (assigned below)
+  std::vector<bool> red(marked);
+  for (int f = 0; f < nf; ++f)
+    if (red[f])
+      for (int k = 0; k < 3; ++k) split[key(m.triangles(f, k), m.triangles(f, (k + 1) % 3))] = -1;
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (int f = 0; f < nf; ++f) {
+      if (red[f]) continue;
+      int count = 0;
+      for (int k = 0; k < 3; ++k)
+        count += split.count(key(m.triangles(f, k), m.triangles(f, (k + 1) % 3))) ? 1 : 0;
+      if (count >= 2) {
+        red[f] = true;
+        changed = true;
+        for (int k = 0; k < 3; ++k) split[key(m.triangles(f, k), m.triangles(f, (k + 1) % 3))] = -1;
+      }
+    }
+  }
+  RefinedMesh r;
+  const int nv = m.num_vertices();
+  int next = nv;
+  for (auto& [edge, id] : split) {
+    id = next++;
+    r.parents.push_back({edge.first, edge.second});
+  }
+  r.mesh.vertices.resize(next, 3);
+  r.mesh.vertices.topRows(nv) = m.vertices;
+  for (size_t i = 0; i < r.parents.size(); ++i)
+    r.mesh.vertices.row(nv + static_cast<long>(i)) =
+        0.5 * (m.vertices.row(r.parents[i][0]) + m.vertices.row(r.parents[i][1]));
+  std::vector<std::array<int, 3>> tris;
+  for (int f = 0; f < nf; ++f) {
+    const int a = m.triangles(f, 0), b = m.triangles(f, 1), c = m.triangles(f, 2);
+    auto mid = [&](int p, int q) {
+      const auto it = split.find(key(p, q));
+      return it == split.end() ? -1 : it->second;
+    };
+    const int ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
+    auto add = [&](int p, int q, int s) {
+      tris.push_back({p, q, s});
+      r.parent_triangle.push_back(f);
+    };
+    if (red[f]) {
+      add(a, ab, ca);
+      add(ab, b, bc);
+      add(ca, bc, c);
+      add(ab, bc, ca);
+    } else if (ab >= 0) {
+      add(a, ab, c);
+      add(ab, b, c);
+    } else if (bc >= 0) {
+      add(b, bc, a);
+      add(bc, c, a);
+    } else if (ca >= 0) {
+      add(c, ca, b);
+      add(ca, a, b);
+    } else {
+      add(a, b, c);
+    }
+  }
+  r.mesh.triangles.resize(static_cast<long>(tris.size()), 3);
+  for (size_t t = 0; t < tris.size(); ++t)
+    for (int k = 0; k < 3; ++k) r.mesh.triangles(static_cast<long>(t), k) = tris[t][k];
+  return r;
+}
+
 TriangleMesh RegularGridMesh(double width, double height, int nx, int ny) {
   if (!(width > 0) || !(height > 0) || nx < 1 || ny < 1) {
     throw InputError("grid mesh: sizes must be > 0 and cell counts >= 1");

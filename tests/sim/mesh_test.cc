@@ -29,6 +29,64 @@ TEST(Mesh, GridsHaveEulerCountsAndPassChecks) {
   }
 }
 
+// Red-green refinement: the marked triangles in four, closure by repeated red and single green
+// splits, a conforming mesh of the same area and outline, and positions carried over exactly
+// for a surface that is flat on each old triangle.
+TEST(Mesh, RefineTrianglesSplitsMarkedTrianglesAndStaysConforming) {
+  const TriangleMesh m = RegularGridMesh(0.4, 0.3, 4, 3);  // 24 triangles, cells 0.1 m
+  std::vector<bool> marked(static_cast<size_t>(m.num_triangles()), false);
+  marked[0] = marked[9] = true;
+  const RefinedMesh r = RefineTriangles(m, marked);
+  EXPECT_NO_THROW(CheckMesh(r.mesh));
+  EXPECT_EQ(r.mesh.num_vertices(), m.num_vertices() + static_cast<int>(r.parents.size()));
+  EXPECT_EQ(static_cast<int>(r.parent_triangle.size()), r.mesh.num_triangles());
+  EXPECT_NEAR(TriangleAreas(r.mesh).sum(), 0.12, 1e-15);
+  EXPECT_EQ(BoundaryEdges(r.mesh).size(), BoundaryEdges(m).size() +
+                                              [&] {  // split boundary edges count twice
+                                                size_t n = 0;
+                                                for (const auto& e : BoundaryEdges(m))
+                                                  for (const auto& p : r.parents)
+                                                    n += (std::min(e[0], e[1]) == p[0] &&
+                                                          std::max(e[0], e[1]) == p[1]);
+                                                return n;
+                                              }());
+  // Each marked triangle became four of a quarter of its area; the Euler count holds.
+  const Eigen::VectorXd old_area = TriangleAreas(m), new_area = TriangleAreas(r.mesh);
+  for (int marked_face : {0, 9}) {
+    int children = 0;
+    for (int t = 0; t < r.mesh.num_triangles(); ++t) {
+      if (r.parent_triangle[static_cast<size_t>(t)] != marked_face) continue;
+      ++children;
+      EXPECT_NEAR(new_area(t), 0.25 * old_area(marked_face), 1e-15);
+    }
+    EXPECT_EQ(children, 4);
+  }
+  const int e = static_cast<int>(BuildHinges(r.mesh).size() + BoundaryEdges(r.mesh).size());
+  EXPECT_EQ(r.mesh.num_vertices() - e + r.mesh.num_triangles(), 1);
+  // Prolongation: an affine map of the rest positions is carried over exactly.
+  Eigen::Matrix3d a;
+  a << 1.1, 0.2, 0.0, -0.3, 0.9, 0.1, 0.5, 0.4, 1.0;
+  const Eigen::RowVector3d shift(0.01, -0.02, 0.3);
+  const Vertices x = (m.vertices * a.transpose()).rowwise() + shift;
+  const Vertices fine = r.Prolong(x);
+  const Vertices expected = (r.mesh.vertices * a.transpose()).rowwise() + shift;
+  EXPECT_LT((fine - expected).cwiseAbs().maxCoeff(), 1e-15);
+  // Nothing marked: the same mesh.
+  const RefinedMesh same = RefineTriangles(m, std::vector<bool>(marked.size(), false));
+  EXPECT_EQ(same.mesh.triangles, m.triangles);
+  EXPECT_TRUE(same.parents.empty());
+  // Everything marked: four times the triangles.
+  EXPECT_EQ(RefineTriangles(m, std::vector<bool>(marked.size(), true)).mesh.num_triangles(),
+            4 * m.num_triangles());
+}
+
+TEST(Mesh, RefineTrianglesRefusesMismatchedSizes) {
+  const TriangleMesh m = RegularGridMesh(0.4, 0.3, 4, 3);
+  EXPECT_THROW(RefineTriangles(m, std::vector<bool>(5, true)), InputError);
+  const RefinedMesh r = RefineTriangles(m, std::vector<bool>(24, true));
+  EXPECT_THROW(r.Prolong(r.mesh.vertices), InputError);  // the new mesh's size, not the old one's
+}
+
 TEST(Mesh, HingesKeepTriangleOrientation) {
   const TriangleMesh m = CrissCrossGridMesh(1.0, 1.0, 3, 3);
   for (const Hinge& h : BuildHinges(m)) {
@@ -52,20 +110,20 @@ TEST(Mesh, RejectsBadMeshesNamingTheElement) {
   ExpectRejected(m, "vertex 4 has a NaN");
   m = good;
   m.triangles(3, 2) = 99;
-  ExpectRejected(m, "triangle 3 refers to vertex 99");
+  ExpectRejected(m, "triangle 3 refers to vertex 99, outside 0..8");
   m = good;
   m.triangles(2, 1) = m.triangles(2, 0);
   ExpectRejected(m, "triangle 2 repeats a vertex");
   m = good;
-  m.vertices.row(4) = m.vertices.row(0);  // collapses triangles around vertex 4 onto vertex 0's
-  ExpectRejected(m, "degenerate");
+  m.vertices.row(4) = m.vertices.row(0);  // triangle 0 = (0, 1, 4) collapses to a segment
+  ExpectRejected(m, "triangle 0 is degenerate");
   m = good;
   m.vertices.conservativeResize(m.vertices.rows() + 1, 3);
   m.vertices.row(m.vertices.rows() - 1) << 5, 5, 0;
-  ExpectRejected(m, "is used by no triangle");
+  ExpectRejected(m, "vertex 9 is used by no triangle");
   m = good;
   m.triangles.row(0) = Eigen::Vector3i(m.triangles(0, 0), m.triangles(0, 2), m.triangles(0, 1));
-  ExpectRejected(m, "oriented the same way");
+  ExpectRejected(m, "edge (0, 4) of triangles 0 and 1 is oriented the same way");
   m = TriangleMesh{};
   ExpectRejected(m, "no triangles");
 }

@@ -61,6 +61,27 @@ TriangleMesh CrissCrossGridMesh(double width, double height, int nx, int ny);
 // Per-triangle rest areas [m²] (#F).
 Eigen::VectorXd TriangleAreas(const TriangleMesh& mesh);
 
+// A mesh refined by splitting edges at their midpoints (red-green refinement).
+struct RefinedMesh {
+  TriangleMesh mesh;  // the old vertices keep their ids; split points follow
+  // Per new vertex (id #V_old + i): the old edge {a, b}, a < b, whose midpoint it is.
+  std::vector<std::array<int, 2>> parents;
+  // Per new triangle: the old triangle it lies in.
+  std::vector<int> parent_triangle;
+  // Positions of the old mesh (#V_old×3), e.g. a deformed state, carried to the new one:
+  // old vertices as they are, each split point at the middle of its parent edge. A surface
+  // that is flat on each old triangle stays the same surface.
+  Vertices Prolong(const Vertices& x) const;
+};
+
+// Splits each `marked` triangle (#F flags) into four at its edge midpoints. A triangle with two
+// split edges is split in four too (repeated until none is left), one with a single split edge
+// in two across it, so the result is conforming (no hanging vertices) and its triangles keep
+// the orientation and, for the fours, the shape of their parents. The rest positions of the
+// split points are the midpoints of the rest edges (so the pattern's area and outline stay
+// those of the old mesh). Throws InputError when `marked` does not have #F entries.
+RefinedMesh RefineTriangles(const TriangleMesh& mesh, const std::vector<bool>& marked);
+
 }  // namespace textile
 
 #endif  // TEXTILE_SIM_MESH_H_

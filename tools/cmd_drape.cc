@@ -37,6 +37,7 @@ struct DrapeArgs {
   std::optional<double> tolerance;
   double max_seconds = 600.0;
   bool coarse = false, no_coarse = false;
+  bool extrapolate = false;
   bool json = false;
 };
 
@@ -116,6 +117,8 @@ DrapeOptions Options(const DrapeArgs& a) {
   o.rim_band = units::MmToM(band);
   if (a.coarse && a.no_coarse) throw InputError("--coarse-to-fine and --no-coarse-to-fine: give one");
   o.coarse_to_fine = a.coarse;
+  if (a.extrapolate && a.rim_mm != "auto" && o.rim_element_size == 0.0)
+    throw InputError("--extrapolate: needs a rim band (--rim-mm auto or a size, not 0)");
   if (a.tolerance) {
     if (!(*a.tolerance > 0.0) || *a.tolerance > 0.1) throw InputError("--tolerance: must be in (0, 0.1]");
     o.solver.tolerance = *a.tolerance;
@@ -226,8 +229,13 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
   j["seeds"] = nlohmann::json::array();
   for (const DrapeSeedResult& s : r.per_seed) {
     nlohmann::json js = {{"seed", s.seed}, {"converged", s.converged}, {"solver", SummaryJson(s.summary)}};
+    if (o.rim_extrapolation && s.summary.converged) js["split_solver"] = SummaryJson(s.split_summary);
     if (s.converged) {
       js["drape_coefficient"] = s.drape_coefficient;
+      if (o.rim_extrapolation) {
+        js["base_drape_coefficient"] = s.base_drape_coefficient;
+        js["split_drape_coefficient"] = s.split_drape_coefficient;
+      }
       js["nodes"] = s.nodes.angles.size();
       js["shadow_area_mm2"] = s.shadow.area * 1e6;
       js["min_radius_mm"] = units::MToMm(s.min_radius);
@@ -253,6 +261,8 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
                 {"rim_band_mm", units::MToMm(o.rim_band)},
                 {"rim_turn_down_mm", units::MToMm(turn_down)},
                 {"coarse_to_fine", o.coarse_to_fine},
+                {"extrapolate", o.rim_extrapolation},
+                {"base_vertices", r.base_vertices},
                 {"tolerance", o.solver.tolerance},
                 {"raster_cell_mm", units::MToMm(o.raster_cell)},
                 {"vertices", r.mesh.num_vertices()},
@@ -283,9 +293,11 @@ void Run(const DrapeArgs& a) {
   // ℓ/3, at least 0.5 mm, at most the element size (which may itself be under 0.5 mm when the
   // overhang is tiny: then the rim gets the element size).
   if (a.rim_mm == "auto") o.rim_element_size = std::min(std::max(turn_down / 3.0, 0.0005), o.element_size);
+  o.rim_extrapolation = a.extrapolate;
   const double rim_size = o.rim_element_size > 0.0 ? o.rim_element_size : o.element_size;
   std::string note;  // reported with the result (a refused run prints its one error line only)
-  if (const double shortfall = 0.1 * rim_size / turn_down; shortfall > 0.02) {
+  // (An extrapolated DC has no first-order shortfall: no note.)
+  if (const double shortfall = 0.1 * rim_size / turn_down; shortfall > 0.02 && !o.rim_extrapolation) {
     note = "DC may be low by up to about " + Num(shortfall, 1) + ": the rim's elements (" +
            Num(units::MToMm(rim_size), 3) + " mm) are coarse against this fabric's turn-down length there (" +
            Num(units::MToMm(turn_down), 2) + " mm); " +
@@ -341,11 +353,18 @@ void Run(const DrapeArgs& a) {
                     ? ", " + Num(units::MToMm(o.rim_element_size), 3) + " mm to " +
                           Num(units::MToMm(o.rim_band)) + " mm past the rim"
                     : std::string())
+            << (o.rim_extrapolation ? "; " + std::to_string(r.base_vertices) + " before the rim's split"
+                                    : std::string())
             << ")\n";
   for (const DrapeSeedResult& s : r.per_seed) {
     std::cout << "  seed " << s.seed << ": DC " << Num(s.drape_coefficient, 4) << ", " << s.nodes.angles.size()
               << " nodes, r " << Num(units::MToMm(s.min_radius), 4) << ".." << Num(units::MToMm(s.max_radius), 4)
-              << " mm, " << s.summary.iterations << " iterations, " << Num(s.summary.seconds, 3) << " s\n";
+              << " mm, " << s.summary.iterations << " iterations, " << Num(s.summary.seconds, 3) << " s";
+    if (o.rim_extrapolation)
+      std::cout << "; extrapolated from " << Num(s.base_drape_coefficient, 4) << " and, rim split, "
+                << Num(s.split_drape_coefficient, 4) << " (" << s.split_summary.iterations << " iterations, "
+                << Num(s.split_summary.seconds, 3) << " s)";
+    std::cout << "\n";
   }
   std::cout << "drape coefficient: " << Num(r.drape_coefficient, 4);
   if (r.per_seed.size() > 1) std::cout << " ± " << Num(r.drape_coefficient_sd, 3);
@@ -391,6 +410,9 @@ void RegisterDrape(CLI::App& app) {
   sub->add_option("--max-seconds", a->max_seconds, "Solver wall-time cap per level and seed [s] (default 600)");
   sub->add_flag("--coarse-to-fine", a->coarse, "Solve on a mesh twice as coarse first (cascadic)");
   sub->add_flag("--no-coarse-to-fine", a->no_coarse, "Solve on the fine mesh only (the default)");
+  sub->add_flag("--extrapolate", a->extrapolate,
+                "Split the rim band's triangles, solve again from the drape and extrapolate the DC "
+                "to a zero rim element");
   sub->add_option("-o,--output", a->out, "Result JSON file; the outline CSV goes next to it")->required();
   sub->add_option("--png", a->png, "Top-view shadow picture (PNG)");
   sub->add_option("--obj", a->obj, "Draped mesh of the first seed (OBJ)");

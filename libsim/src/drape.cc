@@ -5,6 +5,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <map>
 #include <memory>
 #include <numbers>
 #include <random>
@@ -20,6 +21,7 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 bool Fail(std::string* why, const std::string& text) {
   if (why) *why = text;
@@ -91,6 +93,50 @@ Pattern MeshPattern(const DrapeOptions& o, const std::vector<Seam>& seams, doubl
   Pattern p;
   p.pm = MeshDisk(o.specimen_radius, lines, mo);
   // The circle's polyline vertices lie at R_s up to round-off; everything inside is clamped.
+  const double limit = o.support_radius * (1.0 + 1e-9);
+  for (int v = 0; v < p.pm.mesh.num_vertices(); ++v)
+    if (p.pm.mesh.vertices.row(v).head<2>().norm() <= limit) p.clamp.push_back(v);
+  return p;
+}
+
+// The rim band's triangles split in four (rim extrapolation): those whose centroid lies from
+// 1.5 rim elements inside the support's circle to rim_band beyond it. Seam paths follow.
+Pattern SplitRim(const Pattern& base, const DrapeOptions& o, RefinedMesh* refined) {
+  const TriangleMesh& m = base.pm.mesh;
+  std::vector<bool> marked(static_cast<size_t>(m.num_triangles()), false);
+  const double inner = o.support_radius - 1.5 * o.rim_element_size;
+  const double outer = o.support_radius + o.rim_band;
+  for (int f = 0; f < m.num_triangles(); ++f) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) c += m.vertices.row(m.triangles(f, k)).transpose() / 3.0;
+    const double r = c.head<2>().norm();
+    marked[static_cast<size_t>(f)] = r >= inner && r <= outer;
+  }
+  *refined = RefineTriangles(m, marked);
+  Pattern p;
+  p.pm.mesh = refined->mesh;
+  std::map<std::pair<int, int>, int> midpoint;
+  const int nv = m.num_vertices();
+  for (size_t i = 0; i < refined->parents.size(); ++i)
+    midpoint[{refined->parents[i][0], refined->parents[i][1]}] = nv + static_cast<int>(i);
+  p.pm.vertex_seam = base.pm.vertex_seam;
+  p.pm.vertex_seam.resize(static_cast<size_t>(p.pm.mesh.num_vertices()), -1);
+  for (size_t k = 0; k < base.pm.seam_paths.size(); ++k) {
+    const std::vector<int>& path = base.pm.seam_paths[k];
+    std::vector<int> out;
+    for (size_t i = 0; i < path.size(); ++i) {
+      if (i > 0) {
+        const auto it = midpoint.find({std::min(path[i - 1], path[i]), std::max(path[i - 1], path[i])});
+        if (it != midpoint.end()) {
+          out.push_back(it->second);
+          if (p.pm.vertex_seam[static_cast<size_t>(it->second)] < 0)
+            p.pm.vertex_seam[static_cast<size_t>(it->second)] = static_cast<int>(k);
+        }
+      }
+      out.push_back(path[i]);
+    }
+    p.pm.seam_paths.push_back(std::move(out));
+  }
   const double limit = o.support_radius * (1.0 + 1e-9);
   for (int v = 0; v < p.pm.mesh.num_vertices(); ++v)
     if (p.pm.mesh.vertices.row(v).head<2>().norm() <= limit) p.clamp.push_back(v);
@@ -233,6 +279,8 @@ bool DrapeOptions::Check(std::string* why) const {
     return Fail(why, "rim_element_size: below 0.1 mm is not a drape mesh");
   if (!Finite(rim_band) || rim_band < 0.0 || rim_band > specimen_radius - support_radius)
     return Fail(why, "rim_band: must be in [0, the overhang]");
+  if (rim_extrapolation && rim_element_size == 0.0)
+    return Fail(why, "rim_extrapolation: needs a rim band (rim_element_size > 0)");
   if (!Finite(coarse_factor) || coarse_factor < 1.0 || coarse_factor > 8.0)
     return Fail(why, "coarse_factor: must be in [1, 8]");
   if (coarse_to_fine && coarse_factor * element_size > 0.5 * (specimen_radius - support_radius))
@@ -463,8 +511,13 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
     coarse = std::make_unique<Pattern>(MeshPattern(o, seams, o.coarse_factor));
     result.coarse_vertices = coarse->pm.mesh.num_vertices();
   }
-  result.mesh = fine.pm.mesh;
-  result.seam_paths = fine.pm.seam_paths;
+  std::unique_ptr<Pattern> split;
+  RefinedMesh refined;
+  if (o.rim_extrapolation) split = std::make_unique<Pattern>(SplitRim(fine, o, &refined));
+  const Pattern& last = split ? *split : fine;
+  result.base_vertices = fine.pm.mesh.num_vertices();
+  result.mesh = last.pm.mesh;
+  result.seam_paths = last.pm.seam_paths;
   result.seam_paths.pop_back();  // the support circle is not a seam
   result.specimen_area = TriangleAreas(fine.pm.mesh).sum();
   result.support_area = kPi * o.support_radius * o.support_radius;
@@ -473,6 +526,9 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
     line << "mesh: " << fine.pm.mesh.num_vertices() << " vertices, " << fine.pm.mesh.num_triangles()
          << " triangles" << (coarse ? " (coarse " + std::to_string(result.coarse_vertices) + " vertices)" : "")
          << ", " << fine.clamp.size() << " on the support";
+    if (split)
+      line << "; split at the rim: " << split->pm.mesh.num_vertices() << " vertices, "
+           << split->pm.mesh.num_triangles() << " triangles";
     say(line.str());
   }
 
@@ -491,10 +547,38 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
       seed.summary = SolveStatic(fine_problem.get(), &seed.positions, o.solver);
     }
     seed.converged = seed.summary.converged;
-    seed.drape_coefficient = kNaN;
+    seed.drape_coefficient = seed.base_drape_coefficient = seed.split_drape_coefficient = kNaN;
+    const auto measure = [&](const Vertices& x, const TriangleMesh& mesh) {
+      seed.shadow = MeasureShadow(x, mesh.triangles, o.raster_cell, o.outline_bins);
+      return DrapeCoefficient(seed.shadow.area, result.specimen_area, result.support_area);
+    };
+    if (seed.converged && split) {
+      // The base equilibrium on the split mesh (the same surface), then its own equilibrium.
+      seed.base_drape_coefficient = measure(seed.positions, fine.pm.mesh);
+      {
+        std::ostringstream line;
+        line << "seed " << seed.seed << ": base " << seed.summary.BriefReport() << "; DC "
+             << seed.base_drape_coefficient;
+        say(line.str());
+      }
+      auto split_problem = MakeProblem(*split, material, seams, o);
+      result.mass = split_problem->total_mass();
+      seed.positions = refined.Prolong(seed.positions);
+      // The carried-over drape is near the split mesh's equilibrium: the exact Hessian from the
+      // first step (taken where it is positive definite) halved the steps (seed 2 of the Fig. 8
+      // fabric: 104 → 52; docs/drapemeter.md, "Extrapolated DC").
+      SolveOptions split_solver = o.solver;
+      if (split_solver.exact_below > 0.0) split_solver.exact_below = kInf;
+      seed.split_summary = SolveStatic(split_problem.get(), &seed.positions, split_solver);
+      seed.converged = seed.split_summary.converged;
+      if (!seed.converged) seed.summary.message = "rim split: " + seed.split_summary.message;
+    }
     if (seed.converged) {
-      seed.shadow = MeasureShadow(seed.positions, fine.pm.mesh.triangles, o.raster_cell, o.outline_bins);
-      seed.drape_coefficient = DrapeCoefficient(seed.shadow.area, result.specimen_area, result.support_area);
+      seed.drape_coefficient = measure(seed.positions, last.pm.mesh);
+      if (split) {
+        seed.split_drape_coefficient = seed.drape_coefficient;
+        seed.drape_coefficient = 2.0 * seed.split_drape_coefficient - seed.base_drape_coefficient;
+      }
       seed.nodes = FindNodes(seed.shadow.radii, o.smoothing_bins, o.node_prominence,
                              o.node_prominence_relative);
       seed.min_radius = seed.shadow.radii.minCoeff();
@@ -508,9 +592,13 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
     }
     {
       std::ostringstream line;
-      line << "seed " << seed.seed << ": " << seed.summary.BriefReport();
-      if (seed.converged)
+      line << "seed " << seed.seed << ": "
+           << (split && seed.summary.converged ? "split " + seed.split_summary.BriefReport()
+                                               : seed.summary.BriefReport());
+      if (seed.converged) {
+        if (split) line << "; DC " << seed.split_drape_coefficient << ", extrapolated";
         line << "; DC " << seed.drape_coefficient << ", " << seed.nodes.angles.size() << " nodes";
+      }
       say(line.str());
     }
     if (!seed.converged && result.message.empty()) {

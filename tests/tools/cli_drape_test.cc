@@ -106,6 +106,30 @@ TEST(CliDrape, RimBandIsMeshedReportedAndRecorded) {
   EXPECT_TRUE(j["converged"].get<bool>());
 }
 
+// --extrapolate: the rim band split, a second solve, the DC extrapolated; both DCs and both
+// solver reports in the JSON, no shortfall note.
+TEST(CliDrape, ExtrapolateReportsBothDrapesAndTheExtrapolatedDc) {
+  const auto dir = Scratch("CliDrape.Extrapolate");
+  const auto r = Textile("drape " + kFig8 + kCoarseMesh + " --rim-mm 5 --extrapolate -o " +
+                         (dir / "x.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("before the rim's split)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("; extrapolated from "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("note:"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(ReadAll(dir / "x.json"));
+  EXPECT_TRUE(j["scene"]["extrapolate"].get<bool>());
+  EXPECT_GT(j["scene"]["vertices"].get<int>(), 2 * j["scene"]["base_vertices"].get<int>());
+  const auto& seed = j["seeds"][0];
+  const double base = seed["base_drape_coefficient"].get<double>();
+  const double split = seed["split_drape_coefficient"].get<double>();
+  EXPECT_GT(split, base);
+  EXPECT_NEAR(seed["drape_coefficient"].get<double>(), 2.0 * split - base, 1e-12);
+  EXPECT_NEAR(j["drape_coefficient"].get<double>(), 2.0 * split - base, 1e-12);
+  EXPECT_TRUE(seed["split_solver"]["converged"].get<bool>());
+  EXPECT_GT(seed["split_solver"]["iterations"].get<int>(), 0);
+  EXPECT_TRUE(j["note"].is_null());
+}
+
 TEST(CliDrape, CoarseRimGetsANoteAndAutoMeshesItFiner) {
   const auto dir = Scratch("CliDrape.RimNote");
   const auto plain = Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "plain.json").string());

@@ -103,6 +103,11 @@ struct DrapeOptions {
   // distance past that; 0: no band (the default, for run time).
   double rim_element_size = 0.0;
   double rim_band = 0.02;
+  // Rim extrapolation (needs rim_element_size > 0; docs/drapemeter.md, "Extrapolated DC"): after
+  // each seed's solve, the triangles of the rim band are split in four (RefineTriangles), the
+  // equilibrium is carried over (the same surface, the same folds) and solved again, and the
+  // DC is extrapolated to a zero rim element at first order: DC = 2 DC_split − DC_base.
+  bool rim_extrapolation = false;
   // Coarse → fine: solve on a mesh coarse_factor × element_size first and prolong (cascadic).
   // Off by default: the folds of the coarse solution are not the fine mesh's, and the fine level
   // spent more Newton steps re-folding than a cold start needs (8 mm: 236 steps and 13 CPU s
@@ -180,6 +185,11 @@ struct DrapeSeedResult {
   DrapeNodes nodes;                  // empty unless converged
   double min_radius = 0.0, max_radius = 0.0, mean_radius = 0.0;  // of the outline [m]
   Vertices positions;                // #V×3 final state [m] (also when not converged)
+  // Rim extrapolation only (else NaN / empty): the DC of the base mesh and of the split one
+  // (drape_coefficient above is then the extrapolated value; shadow, nodes and radii are the
+  // split mesh's), and the split mesh's solve (summary above is the base mesh's).
+  double base_drape_coefficient = 0.0, split_drape_coefficient = 0.0;
+  SolveSummary split_summary;
 };
 
 struct DrapeResult {
@@ -190,7 +200,9 @@ struct DrapeResult {
   double nodes = 0.0, nodes_sd = 0.0;
   double mean_radius = 0.0, min_radius = 0.0, max_radius = 0.0;  // means over seeds [m]
   std::vector<DrapeSeedResult> per_seed;
-  TriangleMesh mesh;                         // the fine pattern (rest, z = 0)
+  TriangleMesh mesh;                         // the fine pattern (rest, z = 0); split at the rim
+                                             // with rim_extrapolation
+  int base_vertices = 0;                     // before the rim's split (= mesh's without it)
   std::vector<std::vector<int>> seam_paths;  // vertex ids along each seam of the scene
   std::vector<SeamLine> seam_lines;          // the seams of the scene [m]
   int coarse_vertices = 0;                   // 0 without coarse → fine

@@ -235,6 +235,7 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
       if (o.rim_extrapolation) {
         js["base_drape_coefficient"] = s.base_drape_coefficient;
         js["split_drape_coefficient"] = s.split_drape_coefficient;
+        js["extrapolation_bound"] = s.extrapolation_bound;
       }
       js["nodes"] = s.nodes.angles.size();
       js["shadow_area_mm2"] = s.shadow.area * 1e6;
@@ -294,6 +295,7 @@ void Run(const DrapeArgs& a) {
   // overhang is tiny: then the rim gets the element size).
   if (a.rim_mm == "auto") o.rim_element_size = std::min(std::max(turn_down / 3.0, 0.0005), o.element_size);
   o.rim_extrapolation = a.extrapolate;
+  if (std::string why; !o.Check(&why)) throw InputError("drape: " + why);
   const double rim_size = o.rim_element_size > 0.0 ? o.rim_element_size : o.element_size;
   std::string note;  // reported with the result (a refused run prints its one error line only)
   // (An extrapolated DC has no first-order shortfall: no note.)
@@ -361,9 +363,10 @@ void Run(const DrapeArgs& a) {
               << " nodes, r " << Num(units::MToMm(s.min_radius), 4) << ".." << Num(units::MToMm(s.max_radius), 4)
               << " mm, " << s.summary.iterations << " iterations, " << Num(s.summary.seconds, 3) << " s";
     if (o.rim_extrapolation)
-      std::cout << "; extrapolated from " << Num(s.base_drape_coefficient, 4) << " and, rim split, "
+      std::cout << "; DC ± " << Num(s.extrapolation_bound, 2) << ": between the split rim's "
                 << Num(s.split_drape_coefficient, 4) << " (" << s.split_summary.iterations << " iterations, "
-                << Num(s.split_summary.seconds, 3) << " s)";
+                << Num(s.split_summary.seconds, 3) << " s) and " << Num(2.0 * s.split_drape_coefficient - s.base_drape_coefficient, 4)
+                << " (first order from the base's " << Num(s.base_drape_coefficient, 4) << ")";
     std::cout << "\n";
   }
   std::cout << "drape coefficient: " << Num(r.drape_coefficient, 4);

@@ -65,6 +65,16 @@ struct Pattern {
   std::vector<int> clamp;  // vertices held by the clamp (r ≤ R_s)
 };
 
+// The vertices within the support's circle (held by a clamped mount). The circle's polyline
+// vertices lie at R_s up to round-off; midpoints of its chords (a split rim) lie inside.
+std::vector<int> ClampedVertices(const TriangleMesh& mesh, const DrapeOptions& o) {
+  std::vector<int> clamp;
+  const double limit = o.support_radius * (1.0 + 1e-9);
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    if (mesh.vertices.row(v).head<2>().norm() <= limit) clamp.push_back(v);
+  return clamp;
+}
+
 // The mesh at `scale` × the options' sizes (1: the fine mesh; coarse_factor: the coarse one).
 Pattern MeshPattern(const DrapeOptions& o, const std::vector<Seam>& seams, double scale) {
   const double element_size = scale * o.element_size;
@@ -92,10 +102,7 @@ Pattern MeshPattern(const DrapeOptions& o, const std::vector<Seam>& seams, doubl
   }
   Pattern p;
   p.pm = MeshDisk(o.specimen_radius, lines, mo);
-  // The circle's polyline vertices lie at R_s up to round-off; everything inside is clamped.
-  const double limit = o.support_radius * (1.0 + 1e-9);
-  for (int v = 0; v < p.pm.mesh.num_vertices(); ++v)
-    if (p.pm.mesh.vertices.row(v).head<2>().norm() <= limit) p.clamp.push_back(v);
+  p.clamp = ClampedVertices(p.pm.mesh, o);
   return p;
 }
 
@@ -137,9 +144,7 @@ Pattern SplitRim(const Pattern& base, const DrapeOptions& o, RefinedMesh* refine
     }
     p.pm.seam_paths.push_back(std::move(out));
   }
-  const double limit = o.support_radius * (1.0 + 1e-9);
-  for (int v = 0; v < p.pm.mesh.num_vertices(); ++v)
-    if (p.pm.mesh.vertices.row(v).head<2>().norm() <= limit) p.clamp.push_back(v);
+  p.clamp = ClampedVertices(p.pm.mesh, o);
   return p;
 }
 
@@ -281,6 +286,10 @@ bool DrapeOptions::Check(std::string* why) const {
     return Fail(why, "rim_band: must be in [0, the overhang]");
   if (rim_extrapolation && rim_element_size == 0.0)
     return Fail(why, "rim_extrapolation: needs a rim band (rim_element_size > 0)");
+  if (rim_extrapolation && rim_band < rim_element_size)
+    return Fail(why, "rim_extrapolation: needs a rim band at least one rim element wide");
+  if (rim_extrapolation && mount != DrapeMount::kClamped)
+    return Fail(why, "rim_extrapolation: clamped mount only (a second solve would restart friction)");
   if (!Finite(coarse_factor) || coarse_factor < 1.0 || coarse_factor > 8.0)
     return Fail(why, "coarse_factor: must be in [1, 8]");
   if (coarse_to_fine && coarse_factor * element_size > 0.5 * (specimen_radius - support_radius))
@@ -548,10 +557,13 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
     }
     seed.converged = seed.summary.converged;
     seed.drape_coefficient = seed.base_drape_coefficient = seed.split_drape_coefficient = kNaN;
+    seed.extrapolation_bound = kNaN;
+    std::string failure = seed.summary.message;  // why this seed has no DC
     const auto measure = [&](const Vertices& x, const TriangleMesh& mesh) {
       seed.shadow = MeasureShadow(x, mesh.triangles, o.raster_cell, o.outline_bins);
       return DrapeCoefficient(seed.shadow.area, result.specimen_area, result.support_area);
     };
+    if (split && !seed.converged) seed.positions = refined.Prolong(seed.positions);  // #V of mesh
     if (seed.converged && split) {
       // The base equilibrium on the split mesh (the same surface), then its own equilibrium.
       seed.base_drape_coefficient = measure(seed.positions, fine.pm.mesh);
@@ -562,7 +574,6 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
         say(line.str());
       }
       auto split_problem = MakeProblem(*split, material, seams, o);
-      result.mass = split_problem->total_mass();
       seed.positions = refined.Prolong(seed.positions);
       // The carried-over drape is near the split mesh's equilibrium: the exact Hessian from the
       // first step (taken where it is positive definite) halved the steps (seed 2 of the Fig. 8
@@ -571,13 +582,20 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
       if (split_solver.exact_below > 0.0) split_solver.exact_below = kInf;
       seed.split_summary = SolveStatic(split_problem.get(), &seed.positions, split_solver);
       seed.converged = seed.split_summary.converged;
-      if (!seed.converged) seed.summary.message = "rim split: " + seed.split_summary.message;
+      if (!seed.converged) {
+        failure = "rim split: " + seed.split_summary.message;
+        seed.shadow = DrapeShadow{};
+        seed.base_drape_coefficient = kNaN;
+      }
     }
     if (seed.converged) {
       seed.drape_coefficient = measure(seed.positions, last.pm.mesh);
       if (split) {
+        // Between the split rim's DC and its first-order extrapolation: the middle, and half
+        // the bracket as the bound (docs/drapemeter.md, "Extrapolated DC").
         seed.split_drape_coefficient = seed.drape_coefficient;
-        seed.drape_coefficient = 2.0 * seed.split_drape_coefficient - seed.base_drape_coefficient;
+        seed.extrapolation_bound = 0.5 * (seed.split_drape_coefficient - seed.base_drape_coefficient);
+        seed.drape_coefficient = seed.split_drape_coefficient + seed.extrapolation_bound;
       }
       seed.nodes = FindNodes(seed.shadow.radii, o.smoothing_bins, o.node_prominence,
                              o.node_prominence_relative);
@@ -596,13 +614,13 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
            << (split && seed.summary.converged ? "split " + seed.split_summary.BriefReport()
                                                : seed.summary.BriefReport());
       if (seed.converged) {
-        if (split) line << "; DC " << seed.split_drape_coefficient << ", extrapolated";
-        line << "; DC " << seed.drape_coefficient << ", " << seed.nodes.angles.size() << " nodes";
+        if (split) line << "; split DC " << seed.split_drape_coefficient << "; extrapolated";
+        line << " DC " << seed.drape_coefficient << ", " << seed.nodes.angles.size() << " nodes";
       }
       say(line.str());
     }
     if (!seed.converged && result.message.empty()) {
-      result.message = "seed " + std::to_string(seed.seed) + ": " + seed.summary.message;
+      result.message = "seed " + std::to_string(seed.seed) + ": " + failure;
     }
     result.per_seed.push_back(std::move(seed));
   }

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <set>
+
 #include "textile/sim/error.h"
 
 namespace textile {
@@ -38,6 +41,42 @@ TEST(Mesh, RefineTrianglesSplitsMarkedTrianglesAndStaysConforming) {
   marked[0] = marked[9] = true;
   const RefinedMesh r = RefineTriangles(m, marked);
   EXPECT_NO_THROW(CheckMesh(r.mesh));
+  // Every child keeps the counter-clockwise orientation (positive signed area).
+  const auto ccw = [](const TriangleMesh& t) {
+    for (int f = 0; f < t.num_triangles(); ++f) {
+      const Eigen::Vector3d a = t.vertices.row(t.triangles(f, 0)), b = t.vertices.row(t.triangles(f, 1)),
+                            c = t.vertices.row(t.triangles(f, 2));
+      if (!((b - a).cross(c - a).z() > 0.0)) return false;
+    }
+    return true;
+  };
+  EXPECT_TRUE(ccw(r.mesh));
+  // Two marked triangles that leave a neighbour with two split edges: that one is split in four
+  // too (closure), and the green splits meet the split edge in each of its three positions.
+  std::vector<bool> closure(marked.size(), false);
+  closure[2] = closure[10] = true;
+  const RefinedMesh c = RefineTriangles(m, closure);
+  EXPECT_NO_THROW(CheckMesh(c.mesh));
+  EXPECT_TRUE(ccw(c.mesh));
+  EXPECT_NEAR(TriangleAreas(c.mesh).sum(), 0.12, 1e-15);
+  std::vector<int> children(marked.size(), 0);
+  for (int parent : c.parent_triangle) ++children[static_cast<size_t>(parent)];
+  int fours = 0, twos = 0;
+  std::set<int> green_edge_positions;
+  for (int f = 0; f < m.num_triangles(); ++f) {
+    fours += children[static_cast<size_t>(f)] == 4;
+    if (children[static_cast<size_t>(f)] != 2) continue;
+    ++twos;
+    for (int k = 0; k < 3; ++k) {
+      const int p = std::min(m.triangles(f, k), m.triangles(f, (k + 1) % 3));
+      const int q = std::max(m.triangles(f, k), m.triangles(f, (k + 1) % 3));
+      for (const auto& e : c.parents)
+        if (e[0] == p && e[1] == q) green_edge_positions.insert(k);
+    }
+  }
+  EXPECT_EQ(fours, 3);  // the two marked and the closure
+  EXPECT_GT(twos, 0);
+  EXPECT_EQ(green_edge_positions.size(), 3u);
   EXPECT_EQ(r.mesh.num_vertices(), m.num_vertices() + static_cast<int>(r.parents.size()));
   EXPECT_EQ(static_cast<int>(r.parent_triangle.size()), r.mesh.num_triangles());
   EXPECT_NEAR(TriangleAreas(r.mesh).sum(), 0.12, 1e-15);

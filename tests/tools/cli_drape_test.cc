@@ -114,7 +114,7 @@ TEST(CliDrape, ExtrapolateReportsBothDrapesAndTheExtrapolatedDc) {
                          (dir / "x.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("before the rim's split)"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("; extrapolated from "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(": between the split rim's "), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("note:"), std::string::npos) << r.out;
   const auto j = nlohmann::json::parse(ReadAll(dir / "x.json"));
   EXPECT_TRUE(j["scene"]["extrapolate"].get<bool>());
@@ -123,8 +123,9 @@ TEST(CliDrape, ExtrapolateReportsBothDrapesAndTheExtrapolatedDc) {
   const double base = seed["base_drape_coefficient"].get<double>();
   const double split = seed["split_drape_coefficient"].get<double>();
   EXPECT_GT(split, base);
-  EXPECT_NEAR(seed["drape_coefficient"].get<double>(), 2.0 * split - base, 1e-12);
-  EXPECT_NEAR(j["drape_coefficient"].get<double>(), 2.0 * split - base, 1e-12);
+  EXPECT_NEAR(seed["extrapolation_bound"].get<double>(), 0.5 * (split - base), 1e-12);
+  EXPECT_NEAR(seed["drape_coefficient"].get<double>(), 1.5 * split - 0.5 * base, 1e-12);
+  EXPECT_NEAR(j["drape_coefficient"].get<double>(), 1.5 * split - 0.5 * base, 1e-12);
   EXPECT_TRUE(seed["split_solver"]["converged"].get<bool>());
   EXPECT_GT(seed["split_solver"]["iterations"].get<int>(), 0);
   EXPECT_TRUE(j["note"].is_null());

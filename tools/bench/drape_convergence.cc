@@ -26,13 +26,15 @@ struct Run {
   int vertices = 0, iterations = 0;
 };
 
-Run Drape(const Material& m, DrapeSeams seams, double h, double rim, double tolerance, bool cascadic) {
+Run Drape(const Material& m, DrapeSeams seams, double h, double rim, double tolerance, bool cascadic,
+          bool extrapolate) {
   DrapeOptions o;
   o.seams = seams;
   o.seam_profile = SeamPreset("C-plain");
   o.element_size = h;
   o.rim_element_size = rim;
   o.coarse_to_fine = cascadic && 2.0 * h <= 0.5 * (o.specimen_radius - o.support_radius);
+  o.rim_extrapolation = extrapolate;
   o.solver.tolerance = tolerance;
   o.solver.max_seconds = 600.0;
   const auto start = std::chrono::steady_clock::now();
@@ -57,13 +59,13 @@ Run Drape(const Material& m, DrapeSeams seams, double h, double rim, double tole
 Benchmark DrapeConvergenceBenchmark() {
   return {
       "drape-convergence",
-      "Drapemeter: DC and nodes against resolution (uniform and a finer rim band) and tolerance, "
-      "against run time (Fig. 8 fabric, "
-      "plain and C-plain weft seam)",
+      "Drapemeter: DC and nodes against resolution (uniform and a finer rim band), tolerance and "
+      "the rim extrapolation, against run time (Fig. 8 fabric, plain and C-plain weft seam)",
       [](const Context& ctx) {
         Result res;
-        res.columns = {"seams",      "resolution_mm", "rim_mm",    "tolerance",         "coarse_to_fine", "seconds",
-                       "cpu_seconds", "vertices",     "iterations", "converged", "drape_coefficient", "nodes"};
+        res.columns = {"seams",       "resolution_mm", "rim_mm",     "tolerance", "coarse_to_fine",
+                       "extrapolated", "seconds",      "cpu_seconds", "vertices",  "iterations",
+                       "converged",   "drape_coefficient", "nodes"};
         Material m;
         m.name = "Pabst Fig. 8";
         m.areal_density = 0.2;
@@ -78,13 +80,17 @@ Benchmark DrapeConvergenceBenchmark() {
             ctx.quick ? std::vector<double>{6} : std::vector<double>{6, 4, 3, 2};
         const double default_h = DrapeOptions{}.element_size;
         const double default_tol = DefaultDrapeSolveOptions().tolerance;
-        auto add = [&](DrapeSeams seams, double h, double rim, double tol, bool cascadic) {
-          const Run r = Drape(m, seams, h, rim, tol, cascadic);
+        // The CLI's default rim, ℓ/3, for the rim extrapolation's rows (--extrapolate).
+        const double auto_rim = RimTurnDownLength(m, DrapeOptions{}) / 3.0;
+        auto add = [&](DrapeSeams seams, double h, double rim, double tol, bool cascadic,
+                       bool extrapolate = false) {
+          const Run r = Drape(m, seams, h, rim, tol, cascadic, extrapolate);
           res.rows.push_back({{"seams", DrapeSeamsName(seams)},
                               {"resolution_mm", h * 1e3},
                               {"rim_mm", rim * 1e3},
                               {"tolerance", tol},
                               {"coarse_to_fine", cascadic},
+                              {"extrapolated", extrapolate},
                               {"seconds", r.seconds},
                               {"cpu_seconds", r.cpu_seconds},
                               {"vertices", r.vertices},
@@ -93,9 +99,9 @@ Benchmark DrapeConvergenceBenchmark() {
                               {"drape_coefficient", std::isfinite(r.dc) ? nlohmann::json(r.dc) : nlohmann::json()},
                               {"nodes", std::isfinite(r.nodes) ? nlohmann::json(r.nodes) : nlohmann::json()}});
           if (ctx.print)
-            std::fprintf(stderr, "drape-convergence: %s h=%.1f mm rim=%.1f mm tol=%.0e %s: %.2f s, DC %.4f, %g nodes\n",
+            std::fprintf(stderr, "drape-convergence: %s h=%.1f mm rim=%.1f mm tol=%.0e %s%s: %.2f s, DC %.4f, %g nodes\n",
                          DrapeSeamsName(seams).c_str(), h * 1e3, rim * 1e3, tol, cascadic ? "cascadic" : "direct",
-                         r.seconds, r.dc, r.nodes);
+                         extrapolate ? ", extrapolated" : "", r.seconds, r.dc, r.nodes);
         };
         for (DrapeSeams seams : {DrapeSeams::kNone, DrapeSeams::kWeft}) {
           for (double h_mm : resolutions_mm) add(seams, h_mm * 1e-3, 0.0, default_tol, false);
@@ -103,6 +109,9 @@ Benchmark DrapeConvergenceBenchmark() {
           for (double tol : tolerances)
             if (tol != default_tol) add(seams, default_h, 0.0, tol, false);
           add(seams, default_h, 0.0, default_tol, true);  // the coarse → fine shortcut's own row
+          // Rim extrapolation: from the 6 mm rim (quick) and from ℓ/3, the CLI's default (full).
+          for (double rim : ctx.quick ? std::vector<double>{6e-3} : std::vector<double>{6e-3, auto_rim})
+            add(seams, default_h, rim, default_tol, false, true);
         }
 
         // Summary: error against the finest converged mesh at the default tolerance, "finest" by
@@ -113,14 +122,14 @@ Benchmark DrapeConvergenceBenchmark() {
         };
         std::ostringstream sum;
         char line[240];
-        std::snprintf(line, sizeof line, "%-6s %8s %8s %8s %9s %9s %8s %6s %10s\n", "seams", "h [mm]", "rim [mm]",
-                      "tol", "c->f", "seconds", "DC", "nodes", "|dDC|");
+        std::snprintf(line, sizeof line, "%-6s %8s %8s %8s %9s %6s %9s %8s %6s %10s\n", "seams", "h [mm]",
+                      "rim [mm]", "tol", "c->f", "extrap", "seconds", "DC", "nodes", "|dDC|");
         sum << line;
         for (const char* seams : {"none", "weft"}) {
           double reference = std::nan(""), finest = 1e9;
           for (const auto& r : res.rows) {
             if (r["seams"] != seams || r["tolerance"].get<double>() != default_tol || !r["converged"].get<bool>() ||
-                r["coarse_to_fine"].get<bool>())
+                r["coarse_to_fine"].get<bool>() || r["extrapolated"].get<bool>())
               continue;
             if (smallest_mm(r) < finest) {
               finest = smallest_mm(r);
@@ -132,15 +141,17 @@ Benchmark DrapeConvergenceBenchmark() {
             const bool ok = r["converged"].get<bool>();
             const double dc = ok ? r["drape_coefficient"].get<double>() : std::nan("");
             r["dc_error_vs_finest"] = ok ? nlohmann::json(std::abs(dc - reference)) : nlohmann::json();
-            std::snprintf(line, sizeof line, "%-6s %8.1f %8.1f %8.0e %9s %9.2f %8.4f %6.0f %10.4f\n", seams,
+            std::snprintf(line, sizeof line, "%-6s %8.1f %8.2f %8.0e %9s %6s %9.2f %8.4f %6.0f %10.4f\n", seams,
                           r["resolution_mm"].get<double>(), r["rim_mm"].get<double>(), r["tolerance"].get<double>(),
-                          r["coarse_to_fine"].get<bool>() ? "yes" : "no", r["seconds"].get<double>(), dc,
+                          r["coarse_to_fine"].get<bool>() ? "yes" : "no",
+                          r["extrapolated"].get<bool>() ? "yes" : "no", r["seconds"].get<double>(), dc,
                           ok ? r["nodes"].get<double>() : std::nan(""), std::abs(dc - reference));
             sum << line;
           }
         }
-        sum << "(|dDC|: against the finest mesh (smallest element, rim band included) at the default tolerance;"
-               " rim 0: no band; one seed)\n";
+        sum << "(|dDC|: against the finest mesh (smallest element, rim band included) at the default tolerance,"
+               " not extrapolated; rim 0: no band; extrap: the rim split and the DC extrapolated, --extrapolate;"
+               " one seed)\n";
         res.columns.push_back("dc_error_vs_finest");
         res.summary = sum.str();
 
@@ -160,7 +171,8 @@ Benchmark DrapeConvergenceBenchmark() {
                            .color = chart::PaletteColor(k + 2)};
           chart::Series rt = rd;
           for (const auto& r : res.rows) {
-            if (r["seams"] != seams || r["tolerance"].get<double>() != default_tol || r["coarse_to_fine"].get<bool>())
+            if (r["seams"] != seams || r["tolerance"].get<double>() != default_tol || r["coarse_to_fine"].get<bool>() ||
+                r["extrapolated"].get<bool>())
               continue;
             const bool rim = r["rim_mm"].get<double>() > 0.0;
             (rim ? rd : sd).x.push_back(smallest_mm(r));

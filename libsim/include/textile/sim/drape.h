@@ -103,10 +103,13 @@ struct DrapeOptions {
   // distance past that; 0: no band (the default, for run time).
   double rim_element_size = 0.0;
   double rim_band = 0.02;
-  // Rim extrapolation (needs rim_element_size > 0; docs/drapemeter.md, "Extrapolated DC"): after
-  // each seed's solve, the triangles of the rim band are split in four (RefineTriangles), the
-  // equilibrium is carried over (the same surface, the same folds) and solved again, and the
-  // DC is extrapolated to a zero rim element at first order: DC = 2 DC_split − DC_base.
+  // Rim extrapolation (clamped mount, rim_element_size > 0, rim_band ≥ rim_element_size;
+  // docs/drapemeter.md, "Extrapolated DC"): after each seed's solve, the triangles of the rim
+  // band are split in four (RefineTriangles), the equilibrium is carried over (the same
+  // surface, the same folds) and solved again. The DC converges from below at an order between
+  // 1 and 2 in the rim element (measured on three nested levels), so the converged value lies
+  // between DC_split and the first-order extrapolation 2 DC_split − DC_base: the DC reported is
+  // the middle, DC_split + (DC_split − DC_base)/2, within half that bracket.
   bool rim_extrapolation = false;
   // Coarse → fine: solve on a mesh coarse_factor × element_size first and prolong (cascadic).
   // Off by default: the folds of the coarse solution are not the fine mesh's, and the fine level
@@ -185,10 +188,12 @@ struct DrapeSeedResult {
   DrapeNodes nodes;                  // empty unless converged
   double min_radius = 0.0, max_radius = 0.0, mean_radius = 0.0;  // of the outline [m]
   Vertices positions;                // #V×3 final state [m] (also when not converged)
-  // Rim extrapolation only (else NaN / empty): the DC of the base mesh and of the split one
-  // (drape_coefficient above is then the extrapolated value; shadow, nodes and radii are the
-  // split mesh's), and the split mesh's solve (summary above is the base mesh's).
+  // Rim extrapolation only (else NaN / empty): the DC of the base mesh and of the split one,
+  // and the bound (DC_split − DC_base)/2 on the extrapolated drape_coefficient above; shadow,
+  // nodes, radii and positions are the split mesh's (positions: the base state carried over
+  // when the base solve failed). summary is the base mesh's solve, split_summary the split's.
   double base_drape_coefficient = 0.0, split_drape_coefficient = 0.0;
+  double extrapolation_bound = 0.0;
   SolveSummary split_summary;
 };
 

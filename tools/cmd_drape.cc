@@ -37,7 +37,7 @@ struct DrapeArgs {
   std::optional<double> tolerance;
   double max_seconds = 600.0;
   bool coarse = false, no_coarse = false;
-  bool extrapolate = false;
+  bool extrapolate = false, no_extrapolate = false;
   bool json = false;
 };
 
@@ -117,6 +117,7 @@ DrapeOptions Options(const DrapeArgs& a) {
   o.rim_band = units::MmToM(band);
   if (a.coarse && a.no_coarse) throw InputError("--coarse-to-fine and --no-coarse-to-fine: give one");
   o.coarse_to_fine = a.coarse;
+  if (a.extrapolate && a.no_extrapolate) throw InputError("--extrapolate and --no-extrapolate: give one");
   if (a.extrapolate && a.rim_mm != "auto" && o.rim_element_size == 0.0)
     throw InputError("--extrapolate: needs a rim band (--rim-mm auto or a size, not 0)");
   if (a.tolerance) {
@@ -285,16 +286,22 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
 void Run(const DrapeArgs& a) {
   DrapeOptions o = Options(a);
   const Material m = ReadMaterial(a.material);
-  // The fabric's turn-down length ℓ at the rim. DC converges at first order in the rim's
-  // element size e, from below, by about 0.1 e/ℓ for a plain fabric (the Fig. 8 fabric's four-seed
-  // study down to e = 1.5 mm, docs/drapemeter.md, "Resolution at the rim"; less with seams and
-  // near DC = 1, hence "up to"): `--rim-mm auto` meshes the rim with ℓ/3, and an expected
-  // shortfall over 0.02 gets a note.
+  // The fabric's turn-down length ℓ at the rim. DC converges from below as the rim's element e
+  // shrinks, by about 0.1 e/ℓ at e = ℓ/3 for a plain fabric (docs/drapemeter.md, "Resolution
+  // at the rim"; less with seams and near DC = 1, hence "up to").
   const double turn_down = RimTurnDownLength(m, o);
-  // ℓ/3, at least 0.5 mm, at most the element size (which may itself be under 0.5 mm when the
-  // overhang is tiny: then the rim gets the element size).
-  if (a.rim_mm == "auto") o.rim_element_size = std::min(std::max(turn_down / 3.0, 0.0005), o.element_size);
-  o.rim_extrapolation = a.extrapolate;
+  // The rim extrapolation (split rim, second solve, the bracket's middle; docs/drapemeter.md,
+  // "Extrapolated DC") is the default wherever it applies: a clamped specimen with a rim band
+  // at least one rim element wide. --extrapolate demands it, --no-extrapolate turns it off.
+  // `--rim-mm auto` meshes the rim with ℓ/2 when extrapolating (within 0.01 of the converged
+  // DC in about 5 s), else ℓ/3 (an expected shortfall over 0.02 gets a note); at least 0.5 mm,
+  // at most the element size (which may itself be under 0.5 mm when the overhang is tiny).
+  const bool extrapolate_possible = o.mount == DrapeMount::kClamped && (a.rim_mm == "auto" || o.rim_element_size > 0.0);
+  o.rim_extrapolation = a.extrapolate || (!a.no_extrapolate && extrapolate_possible);
+  if (a.rim_mm == "auto")
+    o.rim_element_size =
+        std::min(std::max(turn_down / (o.rim_extrapolation ? 2.0 : 3.0), 0.0005), o.element_size);
+  if (o.rim_extrapolation && !a.extrapolate && o.rim_band < o.rim_element_size) o.rim_extrapolation = false;
   if (std::string why; !o.Check(&why)) throw InputError("drape: " + why);
   const double rim_size = o.rim_element_size > 0.0 ? o.rim_element_size : o.element_size;
   std::string note;  // reported with the result (a refused run prints its one error line only)
@@ -399,9 +406,9 @@ void RegisterDrape(CLI::App& app) {
   sub->add_option("--first-seed", a->first_seed, "First seed (default 1)");
   sub->add_option("--resolution-mm", a->resolution_mm, "Element size away from seams [mm] (default 12)");
   sub->add_option("--rim-mm", a->rim_mm,
-                  "Element size along the support's rim [mm]; auto (the default): a third of the "
-                  "fabric's turn-down length; 0: no finer rim (10x faster, DC about 0.1 low; "
-                  "docs/drapemeter.md)");
+                  "Element size along the support's rim [mm]; auto (the default): half the fabric's "
+                  "turn-down length when extrapolating, else a third; 0: no finer rim and no "
+                  "extrapolation (10x faster, DC about 0.1 low; docs/drapemeter.md)");
   sub->add_option("--rim-band-mm", a->rim_band_mm,
                   "Width of that finer band beyond the rim [mm] (default 20)");
   sub->add_option("--specimen-mm", a->specimen_mm, "Specimen radius [mm] (default 150)");
@@ -414,8 +421,10 @@ void RegisterDrape(CLI::App& app) {
   sub->add_flag("--coarse-to-fine", a->coarse, "Solve on a mesh twice as coarse first (cascadic)");
   sub->add_flag("--no-coarse-to-fine", a->no_coarse, "Solve on the fine mesh only (the default)");
   sub->add_flag("--extrapolate", a->extrapolate,
-                "Split the rim band's triangles, solve again from the drape and extrapolate the DC "
-                "to a zero rim element");
+                "Split the rim band's triangles, solve again from the drape and report the middle of "
+                "the bracket the two DCs give for a zero rim element (the default where it applies: "
+                "clamped, with a rim band)");
+  sub->add_flag("--no-extrapolate", a->no_extrapolate, "One solve on the rim band as meshed");
   sub->add_option("-o,--output", a->out, "Result JSON file; the outline CSV goes next to it")->required();
   sub->add_option("--png", a->png, "Top-view shadow picture (PNG)");
   sub->add_option("--obj", a->obj, "Draped mesh of the first seed (OBJ)");

@@ -89,7 +89,7 @@ TEST(CliDrape, SeamFromPresetOrFileRaisesDc) {
 
 TEST(CliDrape, RimBandIsMeshedReportedAndRecorded) {
   const auto dir = Scratch("CliDrape.Rim");
-  const auto r = Textile("drape " + kFig8 + kCoarseMesh + " --rim-mm 5 --rim-band-mm 20 -o " +
+  const auto r = Textile("drape " + kFig8 + kCoarseMesh + " --rim-mm 5 --rim-band-mm 20 --no-extrapolate -o " +
                          (dir / "rim.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("(h = 15 mm, 5 mm to 20 mm past the rim)"), std::string::npos) << r.out;
@@ -106,13 +106,13 @@ TEST(CliDrape, RimBandIsMeshedReportedAndRecorded) {
   EXPECT_TRUE(j["converged"].get<bool>());
 }
 
-// --extrapolate: the rim band split, a second solve, the DC extrapolated; both DCs and both
-// solver reports in the JSON, no shortfall note.
+// The default: the rim band (auto: ℓ/2 = 4.31 mm) split, a second solve, the DC extrapolated;
+// both DCs and both solver reports in the JSON, no shortfall note.
 TEST(CliDrape, ExtrapolateReportsBothDrapesAndTheExtrapolatedDc) {
   const auto dir = Scratch("CliDrape.Extrapolate");
-  const auto r = Textile("drape " + kFig8 + kCoarseMesh + " --rim-mm 5 --extrapolate -o " +
-                         (dir / "x.json").string());
+  const auto r = Textile("drape " + kFig8 + kCoarseMesh + " -o " + (dir / "x.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("(h = 15 mm, 4.31 mm to 20 mm past the rim; "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("before the rim's split)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find(": between the split rim's "), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("note:"), std::string::npos) << r.out;
@@ -129,6 +129,29 @@ TEST(CliDrape, ExtrapolateReportsBothDrapesAndTheExtrapolatedDc) {
   EXPECT_TRUE(seed["split_solver"]["converged"].get<bool>());
   EXPECT_GT(seed["split_solver"]["iterations"].get<int>(), 0);
   EXPECT_TRUE(j["note"].is_null());
+  EXPECT_NEAR(j["scene"]["rim_mm"].get<double>(), 8.622 / 2.0, 1e-3);
+}
+
+// `--rim-mm auto` is ℓ/2 when extrapolating (the default) and ℓ/3 with --no-extrapolate; the
+// mesh is reported before the solve (capped runs: nothing is written).
+TEST(CliDrape, AutoRimIsHalfTheTurnDownWhenExtrapolatingElseAThird) {
+  const auto dir = Scratch("CliDrape.AutoRim");
+  const auto capped = kFig8 + kCoarseMesh + " --max-seconds 0.001 -o " + (dir / "r.json").string();
+  const auto extrapolating = Textile("drape " + capped);
+  const auto single = Textile("drape " + capped + " --no-extrapolate");
+  const auto both = Textile("drape " + capped + " --extrapolate --no-extrapolate");
+  EXPECT_EQ(extrapolating.exit_code, 3) << extrapolating.err;
+  EXPECT_EQ(single.exit_code, 3) << single.err;
+  EXPECT_EQ(both.exit_code, 2) << both.err;
+  const auto vertices = [](const std::string& err) {
+    const auto at = err.find("drape: mesh: ");
+    return at == std::string::npos ? 0 : std::stoi(err.substr(at + 13));
+  };
+  EXPECT_NE(extrapolating.err.find("; split at the rim: "), std::string::npos) << extrapolating.err;
+  EXPECT_EQ(single.err.find("split at the rim"), std::string::npos) << single.err;
+  // ℓ/3 along the rim has about (3/2)² the rim's vertices of ℓ/2.
+  EXPECT_GT(vertices(single.err), vertices(extrapolating.err) * 5 / 4) << single.err << extrapolating.err;
+  EXPECT_FALSE(fs::exists(dir / "r.json"));
 }
 
 TEST(CliDrape, CoarseRimGetsANoteAndAutoMeshesItFiner) {

@@ -147,10 +147,19 @@ void ClothProblem::BuildPattern() {
     membrane_.AddHessianTriplets(x, &triplets_, false, f, std::min(f + kAssemblyChunk, rest_.num_triangles()));
     for (const auto& t : triplets_) triplet_slot_.push_back(slot(t.row(), t.col()));
   }
-  for (int h = 0; h < num_bending_elements(); h += kAssemblyChunk) {
-    triplets_.clear();
-    BendingTriplets(x, HessianProjection::kNone, h, std::min(h + kAssemblyChunk, num_bending_elements()));
-    for (const auto& t : triplets_) triplet_slot_.push_back(slot(t.row(), t.col()));
+  if (tensor_) {
+    for (int h = 0; h < num_bending_elements(); h += kAssemblyChunk) {
+      triplets_.clear();
+      BendingTriplets(x, HessianProjection::kNone, h, std::min(h + kAssemblyChunk, num_bending_elements()));
+      for (const auto& t : triplets_) triplet_slot_.push_back(slot(t.row(), t.col()));
+    }
+  } else {
+    bending_hessian_ = bending_->HessianPattern(/*upper=*/false);
+    bending_slots_ = bending_->HessianSlots(bending_hessian_, /*upper=*/false);
+    bending_value_slot_.resize(static_cast<size_t>(bending_hessian_.nonZeros()));
+    for (int col = 0; col < bending_hessian_.outerSize(); ++col)
+      for (int k = bending_hessian_.outerIndexPtr()[col]; k < bending_hessian_.outerIndexPtr()[col + 1]; ++k)
+        bending_value_slot_[static_cast<size_t>(k)] = slot(bending_hessian_.innerIndexPtr()[k], col);
   }
   triplets_ = {};
   triplet_slot_.shrink_to_fit();
@@ -219,6 +228,7 @@ void ClothProblem::DropFixedFromPattern() {
       std::lower_bound(new_inner + new_outer[first], new_inner + new_outer[first + 1], first) -
       new_inner);
   for (int& slot : triplet_slot_) slot = new_slot[slot] >= 0 ? new_slot[slot] : trash;
+  for (int& slot : bending_value_slot_) slot = new_slot[slot] >= 0 ? new_slot[slot] : trash;
   for (int& slot : diagonal_block_slot_) slot = new_slot[slot] >= 0 ? new_slot[slot] : trash;
   hessian_ = std::move(reduced);
   for (int v : fixed_)
@@ -322,10 +332,16 @@ const Eigen::SparseMatrix<double>& ClothProblem::Hessian(const Vertices& x,
                                  std::min(f + kAssemblyChunk, rest_.num_triangles()));
     scatter();
   }
-  for (int h = 0; h < num_bending_elements(); h += kAssemblyChunk) {
-    triplets_.clear();
-    BendingTriplets(x, projection, h, std::min(h + kAssemblyChunk, num_bending_elements()));
-    scatter();
+  if (tensor_) {
+    for (int h = 0; h < num_bending_elements(); h += kAssemblyChunk) {
+      triplets_.clear();
+      BendingTriplets(x, projection, h, std::min(h + kAssemblyChunk, num_bending_elements()));
+      scatter();
+    }
+  } else if (bending_hessian_.nonZeros() > 0) {
+    bending_->SetHessian(x, projection, bending_slots_, &bending_hessian_);
+    const double* b = bending_hessian_.valuePtr();
+    for (size_t k = 0; k < bending_value_slot_.size(); ++k) values[bending_value_slot_[k]] += b[k];
   }
   assert(next == triplet_slot_.size());
   if (!supports_.empty()) {

@@ -80,8 +80,9 @@ Benchmark DrapeConvergenceBenchmark() {
             ctx.quick ? std::vector<double>{6} : std::vector<double>{6, 4, 3, 2};
         const double default_h = DrapeOptions{}.element_size;
         const double default_tol = DefaultDrapeSolveOptions().tolerance;
-        // The CLI's default rim, ℓ/3, for the rim extrapolation's rows (--extrapolate).
-        const double auto_rim = RimTurnDownLength(m, DrapeOptions{}) / 3.0;
+        // The rim extrapolation's rows: the CLI's default (`--rim-mm auto` with the extrapolation,
+        // ℓ/2) and ℓ/3 (auto without it).
+        const double turn_down = RimTurnDownLength(m, DrapeOptions{});
         auto add = [&](DrapeSeams seams, double h, double rim, double tol, bool cascadic,
                        bool extrapolate = false) {
           const Run r = Drape(m, seams, h, rim, tol, cascadic, extrapolate);
@@ -109,8 +110,9 @@ Benchmark DrapeConvergenceBenchmark() {
           for (double tol : tolerances)
             if (tol != default_tol) add(seams, default_h, 0.0, tol, false);
           add(seams, default_h, 0.0, default_tol, true);  // the coarse → fine shortcut's own row
-          // Rim extrapolation: from the 6 mm rim (quick) and from ℓ/3, the CLI's default (full).
-          for (double rim : ctx.quick ? std::vector<double>{6e-3} : std::vector<double>{6e-3, auto_rim})
+          // Rim extrapolation: from ℓ/2 (the CLI's default; quick and full) and ℓ/3 (full).
+          for (double rim : ctx.quick ? std::vector<double>{turn_down / 2.0}
+                                      : std::vector<double>{turn_down / 2.0, turn_down / 3.0})
             add(seams, default_h, rim, default_tol, false, true);
         }
 

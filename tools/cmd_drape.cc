@@ -296,12 +296,12 @@ void Run(const DrapeArgs& a) {
   // `--rim-mm auto` meshes the rim with ℓ/2 when extrapolating (within 0.01 of the converged
   // DC in about 5 s), else ℓ/3 (an expected shortfall over 0.02 gets a note); at least 0.5 mm,
   // at most the element size (which may itself be under 0.5 mm when the overhang is tiny).
-  const bool extrapolate_possible = o.mount == DrapeMount::kClamped && (a.rim_mm == "auto" || o.rim_element_size > 0.0);
+  const double rim_if_extrapolating =
+      a.rim_mm == "auto" ? AutoRimElementSize(m, o, true) : o.rim_element_size;
+  const bool extrapolate_possible = o.mount == DrapeMount::kClamped &&
+                                    rim_if_extrapolating > 0.0 && o.rim_band >= rim_if_extrapolating;
   o.rim_extrapolation = a.extrapolate || (!a.no_extrapolate && extrapolate_possible);
-  if (a.rim_mm == "auto")
-    o.rim_element_size =
-        std::min(std::max(turn_down / (o.rim_extrapolation ? 2.0 : 3.0), 0.0005), o.element_size);
-  if (o.rim_extrapolation && !a.extrapolate && o.rim_band < o.rim_element_size) o.rim_extrapolation = false;
+  if (a.rim_mm == "auto") o.rim_element_size = AutoRimElementSize(m, o, o.rim_extrapolation);
   if (std::string why; !o.Check(&why)) throw InputError("drape: " + why);
   const double rim_size = o.rim_element_size > 0.0 ? o.rim_element_size : o.element_size;
   std::string note;  // reported with the result (a refused run prints its one error line only)

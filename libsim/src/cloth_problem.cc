@@ -154,12 +154,22 @@ void ClothProblem::BuildPattern() {
       for (const auto& t : triplets_) triplet_slot_.push_back(slot(t.row(), t.col()));
     }
   } else {
-    bending_hessian_ = bending_->HessianPattern(/*upper=*/false);
-    bending_slots_ = bending_->HessianSlots(bending_hessian_, /*upper=*/false);
-    bending_value_slot_.resize(static_cast<size_t>(bending_hessian_.nonZeros()));
-    for (int col = 0; col < bending_hessian_.outerSize(); ++col)
-      for (int k = bending_hessian_.outerIndexPtr()[col]; k < bending_hessian_.outerIndexPtr()[col + 1]; ++k)
-        bending_value_slot_[static_cast<size_t>(k)] = slot(bending_hessian_.innerIndexPtr()[k], col);
+    // The elements' own pattern, its upper half (half the slots' memory): once, fixing does not
+    // change it. Each value goes to its place and, off the diagonal, to its mirror.
+    if (bending_slots_.slot.empty()) {
+      bending_hessian_ = bending_->HessianPattern(/*upper=*/true);
+      bending_slots_ = bending_->HessianSlots(bending_hessian_, /*upper=*/true);
+    }
+    const int* b_outer = bending_hessian_.outerIndexPtr();
+    const int* b_inner = bending_hessian_.innerIndexPtr();
+    bending_value_slot_.assign(2 * static_cast<size_t>(bending_hessian_.nonZeros()), -1);
+    for (int col = 0; col < bending_hessian_.outerSize(); ++col) {
+      for (int k = b_outer[col]; k < b_outer[col + 1]; ++k) {
+        const int row = b_inner[k];
+        bending_value_slot_[2 * static_cast<size_t>(k)] = slot(row, col);
+        if (row != col) bending_value_slot_[2 * static_cast<size_t>(k) + 1] = slot(col, row);
+      }
+    }
   }
   triplets_ = {};
   triplet_slot_.shrink_to_fit();
@@ -228,7 +238,8 @@ void ClothProblem::DropFixedFromPattern() {
       std::lower_bound(new_inner + new_outer[first], new_inner + new_outer[first + 1], first) -
       new_inner);
   for (int& slot : triplet_slot_) slot = new_slot[slot] >= 0 ? new_slot[slot] : trash;
-  for (int& slot : bending_value_slot_) slot = new_slot[slot] >= 0 ? new_slot[slot] : trash;
+  for (int& slot : bending_value_slot_)
+    if (slot >= 0) slot = new_slot[slot] >= 0 ? new_slot[slot] : trash;
   for (int& slot : diagonal_block_slot_) slot = new_slot[slot] >= 0 ? new_slot[slot] : trash;
   hessian_ = std::move(reduced);
   for (int v : fixed_)
@@ -341,7 +352,11 @@ const Eigen::SparseMatrix<double>& ClothProblem::Hessian(const Vertices& x,
   } else if (bending_hessian_.nonZeros() > 0) {
     bending_->SetHessian(x, projection, bending_slots_, &bending_hessian_);
     const double* b = bending_hessian_.valuePtr();
-    for (size_t k = 0; k < bending_value_slot_.size(); ++k) values[bending_value_slot_[k]] += b[k];
+    const int* to = bending_value_slot_.data();
+    for (long k = 0; k < bending_hessian_.nonZeros(); ++k) {
+      values[to[2 * k]] += b[k];
+      if (to[2 * k + 1] >= 0) values[to[2 * k + 1]] += b[k];
+    }
   }
   assert(next == triplet_slot_.size());
   if (!supports_.empty()) {

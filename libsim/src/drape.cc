@@ -502,6 +502,11 @@ double RimTurnDownLength(const Material& material, const DrapeOptions& o) {
   return std::sqrt(b / (material.areal_density * g * overhang));
 }
 
+double AutoRimElementSize(const Material& material, const DrapeOptions& o, bool extrapolate) {
+  const double turn_down = RimTurnDownLength(material, o);
+  return std::min(std::max(turn_down / (extrapolate ? 2.0 : 3.0), 0.0005), o.element_size);
+}
+
 DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   std::string why;
@@ -563,7 +568,9 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
       seed.shadow = MeasureShadow(x, mesh.triangles, o.raster_cell, o.outline_bins);
       return DrapeCoefficient(seed.shadow.area, result.specimen_area, result.support_area);
     };
-    if (split && !seed.converged) seed.positions = refined.Prolong(seed.positions);  // #V of mesh
+    // #V of the split mesh (a failed coarse level of a cascade leaves no positions).
+    if (split && !seed.converged && seed.positions.rows() == fine.pm.mesh.num_vertices())
+      seed.positions = refined.Prolong(seed.positions);
     if (seed.converged && split) {
       // The base equilibrium on the split mesh (the same surface), then its own equilibrium.
       seed.base_drape_coefficient = measure(seed.positions, fine.pm.mesh);

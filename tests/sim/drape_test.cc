@@ -202,6 +202,17 @@ TEST(Drape, RimTurnDownLengthIsTheClampedStripsBoundaryLayer) {
   Material none = Fig8();
   none.areal_density = 0.0;
   EXPECT_THROW(RimTurnDownLength(none, o), InputError);
+  // `--rim-mm auto`: ℓ/2 to be split (extrapolating), ℓ/3 for one solve; clamped to
+  // [0.5 mm, element size].
+  EXPECT_NEAR(AutoRimElementSize(Fig8(), o, true), 8.622e-3 / 2.0, 1e-6);
+  EXPECT_NEAR(AutoRimElementSize(Fig8(), o, false), 8.622e-3 / 3.0, 1e-6);
+  DrapeOptions fine = o;
+  fine.element_size = 0.003;
+  EXPECT_EQ(AutoRimElementSize(Fig8(), fine, true), 0.003);
+  Material light = Fig8();
+  light.bending = BendingLaw::FromKes(1e-5, 1e-5, 0.0);  // ℓ ≈ 0.09 mm
+  EXPECT_EQ(AutoRimElementSize(light, o, false), 0.0005);
+  EXPECT_THROW(AutoRimElementSize(none, o, true), InputError);
 }
 
 // The overhang turns down at the rim over a few millimetres; a mesh too coarse there lets it

@@ -8,7 +8,9 @@
 #include <limits>
 #include <random>
 
+#include "textile/sim/cloth_problem.h"
 #include "textile/sim/error.h"
+#include "textile/sim/seam.h"
 #include "textile/sim/units.h"
 
 namespace textile {
@@ -571,6 +573,52 @@ TEST(ClothProblem, FixedDofsLeaveThePatternAndTheFreeBlockIsUnchanged) {
   EXPECT_NEAR(h2.coeff(3 * v + 1, 3 * v), full(3 * v + 1, 3 * v),
               1e-9 * std::abs(full(3 * v, 3 * v)));
   EXPECT_GT(std::abs(full(3 * v + 1, 3 * v)), 0.0);
+}
+
+// The hinge bending's Hessian reaches the problem's matrix through the elements' fixed-pattern
+// fill: the free block equals the membrane's and the bending elements' triplets assembled
+// directly, for every projection, with a seam (multipliers) and fixed vertices.
+TEST(ClothProblem, HessianEqualsTheElementsTripletsForEveryProjection) {
+  const TriangleMesh mesh = CrissCrossGridMesh(0.2, 0.12, 10, 6);
+  SeamLine line(2, 2);
+  line << 0.1, 0.0, 0.1, 0.12;
+  const std::vector<Seam> seams{Seam{SeamPreset("C-plain"), line}};
+  ClothProblem problem(mesh, Cotton(), seams, {});
+  const auto edge = VerticesWhere(mesh, [](double x, double) { return x < 1e-12; });
+  problem.FixVertices(edge, Rows(mesh.vertices, edge));
+  Vertices x = mesh.vertices;
+  for (int i = 0; i < x.rows(); ++i)
+    x(i, 2) = 0.02 * std::sin(20.0 * x(i, 0)) * std::cos(9.0 * x(i, 1)) - 0.1 * x(i, 0);
+  problem.ApplyFixed(&x);
+  const auto& fixed = problem.is_fixed();
+  for (HessianProjection projection :
+       {HessianProjection::kNone, HessianProjection::kGaussNewton, HessianProjection::kEigen}) {
+    std::vector<Eigen::Triplet<double>> triplets;
+    problem.membrane().AddHessianTriplets(x, &triplets, projection != HessianProjection::kNone);
+    problem.hinge_bending()->AddHessianTriplets(x, &triplets, projection);
+    Eigen::SparseMatrix<double> direct(3 * mesh.num_vertices(), 3 * mesh.num_vertices());
+    direct.setFromTriplets(triplets.begin(), triplets.end());
+    const Eigen::MatrixXd expected(direct);
+    const Eigen::SparseMatrix<double>& h = problem.Hessian(x, projection);
+    const double scale = expected.cwiseAbs().maxCoeff();
+    double worst = 0.0;
+    int compared = 0;
+    for (int col = 0; col < h.cols(); ++col) {
+      for (Eigen::SparseMatrix<double>::InnerIterator it(h, col); it; ++it) {
+        if (fixed[it.row() / 3] || fixed[col / 3]) continue;
+        worst = std::max(worst, std::abs(it.value() - expected(it.row(), col)));
+        ++compared;
+      }
+    }
+    EXPECT_GT(compared, 1000);
+    EXPECT_LT(worst, 1e-11 * scale) << "projection " << static_cast<int>(projection);
+    // The bending part matters at that tolerance: the membrane's alone is far off.
+    std::vector<Eigen::Triplet<double>> membrane_only;
+    problem.membrane().AddHessianTriplets(x, &membrane_only, projection != HessianProjection::kNone);
+    Eigen::SparseMatrix<double> m(direct.rows(), direct.cols());
+    m.setFromTriplets(membrane_only.begin(), membrane_only.end());
+    EXPECT_GT((expected - Eigen::MatrixXd(m)).cwiseAbs().maxCoeff(), 1e-6 * scale);
+  }
 }
 
 TEST(ClothProblem, BuildsOnlyTheChosenBendingDiscretisation) {

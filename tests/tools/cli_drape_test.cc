@@ -89,8 +89,8 @@ TEST(CliDrape, SeamFromPresetOrFileRaisesDc) {
 
 TEST(CliDrape, RimBandIsMeshedReportedAndRecorded) {
   const auto dir = Scratch("CliDrape.Rim");
-  const auto r = Textile("drape " + kFig8 + kCoarseMesh + " --rim-mm 5 --rim-band-mm 20 --no-extrapolate -o " +
-                         (dir / "rim.json").string());
+  const auto r = Textile("drape " + kFig8 + kCoarseMesh +
+                         " --rim-mm 5 --rim-band-mm 20 --no-extrapolate -o " + (dir / "rim.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("(h = 15 mm, 5 mm to 20 mm past the rim)"), std::string::npos) << r.out;
   const auto j = nlohmann::json::parse(ReadAll(dir / "rim.json"));
@@ -151,6 +151,12 @@ TEST(CliDrape, AutoRimIsHalfTheTurnDownWhenExtrapolatingElseAThird) {
   EXPECT_EQ(single.err.find("split at the rim"), std::string::npos) << single.err;
   // ℓ/3 along the rim has about (3/2)² the rim's vertices of ℓ/2.
   EXPECT_GT(vertices(single.err), vertices(extrapolating.err) * 5 / 4) << single.err << extrapolating.err;
+  // A band narrower than ℓ/2 cannot be split: one solve with ℓ/3, as with --no-extrapolate.
+  const auto narrow = Textile("drape " + capped + " --rim-band-mm 3");
+  const auto narrow_single = Textile("drape " + capped + " --rim-band-mm 3 --no-extrapolate");
+  EXPECT_EQ(narrow.exit_code, 3) << narrow.err;
+  EXPECT_EQ(narrow.err.find("split at the rim"), std::string::npos) << narrow.err;
+  EXPECT_EQ(vertices(narrow.err), vertices(narrow_single.err)) << narrow.err << narrow_single.err;
   EXPECT_FALSE(fs::exists(dir / "r.json"));
 }
 
@@ -188,6 +194,15 @@ TEST(CliDrape, NonConvergenceIsExit3WithOneLineAndNoFiles) {
   EXPECT_NE(last.find("not converged"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "r.json"));
   EXPECT_FALSE(fs::exists(dir / "r.outline.csv"));
+  // The same when a cascade's coarse level stops short ahead of the (default) rim split.
+  const auto c = Textile("drape " + kFig8 + " --coarse-to-fine --max-seconds 0.01 -o " +
+                         (dir / "c.json").string());
+  EXPECT_EQ(c.exit_code, 3) << c.err;
+  EXPECT_NE(c.err.find("split at the rim"), std::string::npos) << c.err;
+  const std::string c_last = c.err.substr(c.err.rfind("error: "));
+  EXPECT_EQ(testing::CountLines(c_last), 1) << c.err;
+  EXPECT_NE(c_last.find("not converged (seed 1: coarse level: time cap"), std::string::npos) << c.err;
+  EXPECT_FALSE(fs::exists(dir / "c.json"));
 }
 
 // Gmsh is loaded when a mesh is needed, not at start-up (libsim/src/gmsh_api.h): without it a

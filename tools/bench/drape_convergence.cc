@@ -82,7 +82,8 @@ Benchmark DrapeConvergenceBenchmark() {
         const double default_tol = DefaultDrapeSolveOptions().tolerance;
         // The rim extrapolation's rows: the CLI's default (`--rim-mm auto` with the extrapolation,
         // ℓ/2) and ℓ/3 (auto without it).
-        const double turn_down = RimTurnDownLength(m, DrapeOptions{});
+        const double half_rim = AutoRimElementSize(m, DrapeOptions{}, true);
+        const double third_rim = AutoRimElementSize(m, DrapeOptions{}, false);
         auto add = [&](DrapeSeams seams, double h, double rim, double tol, bool cascadic,
                        bool extrapolate = false) {
           const Run r = Drape(m, seams, h, rim, tol, cascadic, extrapolate);
@@ -111,8 +112,7 @@ Benchmark DrapeConvergenceBenchmark() {
             if (tol != default_tol) add(seams, default_h, 0.0, tol, false);
           add(seams, default_h, 0.0, default_tol, true);  // the coarse → fine shortcut's own row
           // Rim extrapolation: from ℓ/2 (the CLI's default; quick and full) and ℓ/3 (full).
-          for (double rim : ctx.quick ? std::vector<double>{turn_down / 2.0}
-                                      : std::vector<double>{turn_down / 2.0, turn_down / 3.0})
+          for (double rim : ctx.quick ? std::vector<double>{half_rim} : std::vector<double>{half_rim, third_rim})
             add(seams, default_h, rim, default_tol, false, true);
         }
 

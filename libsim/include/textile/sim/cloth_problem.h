@@ -163,11 +163,14 @@ class ClothProblem {
   std::vector<Eigen::Triplet<double>> triplets_;
   std::vector<int> triplet_slot_;
   // Hinge bending: the elements' own fixed-pattern fill (BendingElements::SetHessian, 3×3
-  // vertex-pair blocks, 8 hinges a SIMD block) into their pattern, whose values then go to their
-  // slots here: one pass over its nonzeros instead of 144 scattered additions a hinge.
+  // vertex-pair blocks, 8 hinges a SIMD block) into their upper-half pattern, whose values then
+  // go to their slots here: one pass over its nonzeros instead of 144 scattered additions a
+  // hinge.
   Eigen::SparseMatrix<double> bending_hessian_;
   BendingHessianSlots bending_slots_;
-  std::vector<int> bending_value_slot_;   // per nonzero of bending_hessian_: its slot in hessian_
+  // Per nonzero k of bending_hessian_ (upper half): slots 2k (its place in hessian_) and 2k + 1
+  // (its mirror's; -1 on the diagonal).
+  std::vector<int> bending_value_slot_;
   std::vector<int> diagonal_block_slot_;  // #V×9: slot of (3i+a, 3i+b)
   std::vector<int> fixed_diagonal_slots_;  // the fixed dofs' diagonals
   bool pattern_reduced_ = false;           // fixed dofs' off-diagonal entries dropped

@@ -108,8 +108,9 @@ struct DrapeOptions {
   // band are split in four (RefineTriangles), the equilibrium is carried over (the same
   // surface, the same folds) and solved again. The DC converges from below at an order between
   // 1 and 2 in the rim element (measured on three nested levels), so the converged value lies
-  // between DC_split and the first-order extrapolation 2 DC_split − DC_base: the DC reported is
-  // the middle, DC_split + (DC_split − DC_base)/2, within half that bracket.
+  // near the bracket [DC_split, 2 DC_split − DC_base] (within it, or up to 0.001 beyond for
+  // orders near 1): the DC reported is its middle, DC_split + (DC_split − DC_base)/2, and the
+  // bound its half-width.
   bool rim_extrapolation = false;
   // Coarse → fine: solve on a mesh coarse_factor × element_size first and prolong (cascadic).
   // Off by default: the folds of the coarse solution are not the fine mesh's, and the fine level
@@ -228,6 +229,11 @@ std::vector<SeamLine> DrapeSeamLines(const DrapeOptions& options);
 // ℓ/3. Throws InputError for a material without a density or a specimen not larger than the
 // support.
 double RimTurnDownLength(const Material& material, const DrapeOptions& options);
+
+// The rim element size of `--rim-mm auto` [m]: ℓ/2 for a rim extrapolation (the split halves
+// it), else ℓ/3 (docs/drapemeter.md, "Extrapolated DC"); at least 0.5 mm, at most
+// options.element_size. Throws as RimTurnDownLength.
+double AutoRimElementSize(const Material& material, const DrapeOptions& options, bool extrapolate);
 
 // Runs the drapemeter. Throws InputError for bad options or material (a specimen not larger
 // than the support, ...) and ComputeError when meshing fails; a solve that does not converge is

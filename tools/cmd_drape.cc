@@ -30,6 +30,7 @@ struct DrapeArgs {
   int seeds = 1;
   unsigned first_seed = 1;
   std::optional<double> resolution_mm;
+  std::optional<double> seam_rib;
   std::string rim_mm = "auto";  // a length [mm], 0 (off) or "auto" (the default)
   double rim_band_mm = 20.0;
   double specimen_mm = 150.0, support_mm = 90.0, shift_mm = 50.0, perturbation_mm = 2.0;
@@ -55,6 +56,16 @@ SeamProfile LoadSeamProfile(const DrapeArgs& a) {
   return SeamPreset("C-plain");  // Fig. 8: a double lap seam
 }
 
+// The seam profile with --seam-rib applied (it overrides the file's or preset's rib_factor).
+SeamProfile SeamProfileWithRib(const DrapeArgs& a) {
+  SeamProfile p = LoadSeamProfile(a);
+  if (!a.seam_rib) return p;
+  p.rib_factor = *a.seam_rib;
+  std::string why;
+  if (!p.Check(&why)) throw InputError("--seam-rib: " + why);
+  return p;
+}
+
 DrapeOptions Options(const DrapeArgs& a) {
   DrapeOptions o;
   try {
@@ -67,9 +78,9 @@ DrapeOptions Options(const DrapeArgs& a) {
   } catch (const InputError&) {
     throw InputError("--mount: '" + a.mount + "' is not clamped or resting");
   }
-  if (o.seams == DrapeSeams::kNone && (!a.seam_type.empty() || !a.seam_file.empty()))
-    throw InputError("--seam-type/--seam-file: need --seams weft, weft+warp or shifted");
-  o.seam_profile = LoadSeamProfile(a);
+  if (o.seams == DrapeSeams::kNone && (!a.seam_type.empty() || !a.seam_file.empty() || a.seam_rib))
+    throw InputError("--seam-type/--seam-file/--seam-rib: need --seams weft, weft+warp or shifted");
+  o.seam_profile = SeamProfileWithRib(a);
   auto finite = [](double v, const char* flag) {
     if (!std::isfinite(v)) throw InputError(std::string(flag) + ": must be a finite number");
     return v;
@@ -401,6 +412,9 @@ void RegisterDrape(CLI::App& app) {
   sub->add_option("--seams", a->seams, "none (default), weft, weft+warp or shifted");
   sub->add_option("--seam-type", a->seam_type, "Table 2 seam type A-plain .. C-twill (default C-plain)");
   sub->add_option("--seam-file", a->seam_file, "Seam JSON file (from fit-seam) instead of --seam-type");
+  sub->add_option("--seam-rib", a->seam_rib,
+                  "Lengthwise stiffness of the seam band as a factor on S (>= 1; default the "
+                  "seam file's rib_factor, 1 for the presets: the paper's model; docs/seams.md)");
   sub->add_option("--mount", a->mount, "clamped (default: held between two disks) or resting (friction)");
   sub->add_option("--seeds", a->seeds, "Number of perturbations (repeated tests; default 1)");
   sub->add_option("--first-seed", a->first_seed, "First seed (default 1)");

@@ -25,6 +25,7 @@ constexpr double kMaxFactor = 100.0;       // largest plausible B_f [-]
 constexpr double kMaxRangeMm = 1000.0;     // fit range, influence range, fade [mm]
 constexpr double kMinInfluenceMm = 1.0;    // below this d_max is surely in metres [mm]
 constexpr double kMaxAllowanceMm = 200.0;  // seam allowance [mm]
+constexpr double kMaxRibFactor = 1000.0;   // lengthwise factor on S [-]
 // Coefficients of a file that names a preset must be Table 2's up to JSON round-off.
 constexpr double kPresetTolerance = 1e-12;
 
@@ -177,6 +178,9 @@ bool SeamProfile::Check(std::string* why) const {
     return fail("allowance_mm",
                 "must lie in [0, " + Num(kMaxAllowanceMm) + "] mm, got " + Num(allowance_mm));
   }
+  if (!(rib_factor >= 1.0 && rib_factor <= kMaxRibFactor)) {
+    return fail("rib_factor", "must lie in [1, " + Num(kMaxRibFactor) + "], got " + Num(rib_factor));
+  }
   if (covariance) {
     const Eigen::Matrix3d& c = *covariance;
     if (!c.allFinite()) return fail("covariance", "must be finite");
@@ -299,7 +303,8 @@ SeamProfile ParseSeamJson(const std::string& text, const std::string& source) {
   if (!root.is_object()) r.Fail("(top level)", "must be a JSON object");
   r.CheckKeys(
       root, {"type", "name", "layers", "coefficients_mm", "range_mm", "covariance", "influence_mm",
-             "fade_mm", "allowance_mm", "multiplier", "fit", "notes", "source", "assumptions"});
+             "fade_mm", "allowance_mm", "multiplier", "rib_factor", "fit", "notes", "source",
+             "assumptions"});
   for (const char* k : {"type", "layers", "coefficients_mm"}) {
     if (!root.contains(k)) r.Fail(k, "missing (required: type, layers, coefficients_mm)");
   }
@@ -333,6 +338,7 @@ SeamProfile ParseSeamJson(const std::string& text, const std::string& source) {
   if (root.contains("fade_mm")) p.fade_mm = r.Number(root["fade_mm"], "fade_mm");
   if (root.contains("allowance_mm"))
     p.allowance_mm = r.Number(root["allowance_mm"], "allowance_mm");
+  if (root.contains("rib_factor")) p.rib_factor = r.Number(root["rib_factor"], "rib_factor");
   if (root.contains("multiplier")) {
     const std::string m = r.String(root["multiplier"], "multiplier");
     if (m == "factor") {
@@ -383,6 +389,7 @@ nlohmann::json SeamProfileToJson(const SeamProfile& p) {
   j["fade_mm"] = p.fade_mm;
   j["allowance_mm"] = p.allowance_mm;
   j["multiplier"] = p.multiplier == SeamMultiplierReading::kFactor ? "factor" : "paper-literal";
+  j["rib_factor"] = p.rib_factor;
   if (!p.fit.is_null()) j["fit"] = p.fit;
   for (const auto& [k, v] : p.extra.items()) j[k] = v;
   return j;
@@ -428,17 +435,39 @@ std::string Point(const Eigen::Vector2d& p) {
 
 }  // namespace
 
-double DistanceToSeamLine(const Eigen::Vector2d& p, const SeamLine& line) {
+namespace {
+
+// The polyline's point nearest to p: its distance [m] and the segment it lies on (0 for a
+// one-point line, the first of equally near segments).
+struct NearestOnLine {
+  double distance = 0.0;
+  Eigen::Index segment = 0;
+};
+
+NearestOnLine Nearest(const Eigen::Vector2d& p, const SeamLine& line) {
   assert(line.rows() >= 1);
-  double best = (p - line.row(0).transpose()).norm();
+  NearestOnLine best{(p - line.row(0).transpose()).norm(), 0};
   for (Eigen::Index k = 0; k + 1 < line.rows(); ++k) {
     const Eigen::Vector2d a = line.row(k).transpose(), b = line.row(k + 1).transpose();
     const Eigen::Vector2d ab = b - a;
     const double len2 = ab.squaredNorm();
     const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    best = std::min(best, (p - (a + t * ab)).norm());
+    const double d = (p - (a + t * ab)).norm();
+    if (d < best.distance) best = {d, k};
   }
   return best;
+}
+
+// Unit direction of the segment of `line` (≥ 2 points, CheckSeams passed) nearest to p.
+Eigen::Vector2d NearestSegmentDirection(const Eigen::Vector2d& p, const SeamLine& line) {
+  const Eigen::Index k = Nearest(p, line).segment;
+  return (line.row(k + 1) - line.row(k)).transpose().normalized();
+}
+
+}  // namespace
+
+double DistanceToSeamLine(const Eigen::Vector2d& p, const SeamLine& line) {
+  return Nearest(p, line).distance;
 }
 
 void CheckSeams(const std::vector<Seam>& seams, const TriangleMesh& mesh) {
@@ -524,8 +553,16 @@ std::vector<double> HingeSeamMultipliers(const TriangleMesh& mesh, const std::ve
   std::vector<double> s(hinges.size(), 1.0);
   for (const Seam& seam : seams) {
     const std::vector<double> d = HingeSeamDistances(mesh, hinges, seam.line);
+    const double half_band = 0.5 * units::MmToM(seam.profile.allowance_mm);
+    const double rib = seam.profile.rib_factor;
     for (std::size_t h = 0; h < d.size(); ++h) {
-      s[h] = std::max(s[h], seam.profile.Multiplier(units::MToMm(d[h])));
+      double lengthwise = 1.0;
+      if (rib > 1.0 && d[h] <= half_band) {
+        const Eigen::Vector2d a = Xy(mesh, hinges[h].v[2]), b = Xy(mesh, hinges[h].v[3]);
+        const double cos_phi = (b - a).normalized().dot(NearestSegmentDirection(0.5 * (a + b), seam.line));
+        lengthwise = 1.0 + (rib - 1.0) * (1.0 - cos_phi * cos_phi);
+      }
+      s[h] = std::max(s[h], lengthwise * seam.profile.Multiplier(units::MToMm(d[h])));
     }
   }
   return s;

@@ -385,6 +385,78 @@ TEST(SeamHinges, GridWithSeamAlongXConstPicksUpTheSeam) {
   EXPECT_EQ(far_on_across, 1);
 }
 
+TEST(SeamHinges, RibFactorStiffensTheBandAgainstBendingTheSeamLine) {
+  // 10 mm cells cut along one diagonal; a C-plain seam up x = 0.2 with a 12 mm band: the edges
+  // across it (horizontal, midpoints 5 mm off) bend the seam line fully, the diagonals beside it
+  // (midpoints 5 mm off, φ = 45°) half, the edges on it (φ = 0) not at all.
+  const TriangleMesh mesh = RegularGridMesh(0.4, 0.2, 40, 20);
+  const std::vector<Hinge> hinges = BuildHinges(mesh);
+  Seam seam = MakeSeam("C-plain", {{0.2, 0.0}, {0.2, 0.2}});
+  seam.profile.allowance_mm = 12.0;
+  const std::vector<double> plain = HingeSeamMultipliers(mesh, hinges, {seam});
+  seam.profile.rib_factor = 10.0;
+  const std::vector<double> rib = HingeSeamMultipliers(mesh, hinges, {seam});
+  int across = 0, diagonal = 0, along = 0, outside = 0;
+  for (std::size_t h = 0; h < hinges.size(); ++h) {
+    const Eigen::Vector2d a = mesh.vertices.row(hinges[h].v[2]).head<2>().transpose();
+    const Eigen::Vector2d b = mesh.vertices.row(hinges[h].v[3]).head<2>().transpose();
+    const double d = std::abs(0.5 * (a.x() + b.x()) - 0.2);
+    const bool horizontal = std::abs(a.y() - b.y()) < 1e-12;
+    const bool vertical = std::abs(a.x() - b.x()) < 1e-12;
+    if (d > 0.006) {
+      EXPECT_EQ(rib[h], plain[h]) << "hinge " << h;
+      ++outside;
+    } else if (horizontal) {
+      EXPECT_NEAR(rib[h], 10.0 * plain[h], 1e-12) << "hinge " << h;
+      ++across;
+    } else if (vertical) {
+      EXPECT_NEAR(rib[h], plain[h], 1e-12) << "hinge " << h;
+      EXPECT_NEAR(plain[h], 9.07, 1e-12);  // on the line
+      ++along;
+    } else {
+      EXPECT_NEAR(rib[h], 5.5 * plain[h], 1e-12) << "hinge " << h;
+      ++diagonal;
+    }
+  }
+  EXPECT_EQ(across, 2 * 19);  // interior horizontal edges on either side, 19 rows
+  EXPECT_EQ(diagonal, 2 * 20);
+  EXPECT_EQ(along, 20);
+  EXPECT_GT(outside, 1000);
+
+  // A bent seam: each hinge takes the direction of the segment nearest to it. The edge
+  // (0.1, 0.05)-(0.11, 0.05) crosses the vertical leg, the edge (0.2, 0.1)-(0.2, 0.11) the
+  // horizontal one: both are bent the full way; the edge (0.2, 0.1)-(0.21, 0.1) lies on the
+  // horizontal leg, along it: not at all.
+  Seam bent = MakeSeam("C-plain", {{0.1, 0.0}, {0.1, 0.1}, {0.3, 0.1}});
+  bent.profile.allowance_mm = 12.0;
+  bent.profile.rib_factor = 10.0;
+  const std::vector<double> bent_plain = [&] {
+    Seam b = bent;
+    b.profile.rib_factor = 1.0;
+    return HingeSeamMultipliers(mesh, hinges, {b});
+  }();
+  const std::vector<double> bent_rib = HingeSeamMultipliers(mesh, hinges, {bent});
+  int checked = 0;
+  for (std::size_t h = 0; h < hinges.size(); ++h) {
+    const Eigen::Vector2d a = mesh.vertices.row(hinges[h].v[2]).head<2>().transpose();
+    const Eigen::Vector2d b = mesh.vertices.row(hinges[h].v[3]).head<2>().transpose();
+    const auto is = [&](double x0, double y0, double x1, double y1) {
+      const Eigen::Vector2d p(x0, y0), q(x1, y1);
+      return ((a - p).norm() < 1e-12 && (b - q).norm() < 1e-12) ||
+             ((a - q).norm() < 1e-12 && (b - p).norm() < 1e-12);
+    };
+    if (is(0.1, 0.05, 0.11, 0.05) || is(0.2, 0.1, 0.2, 0.11)) {
+      EXPECT_NEAR(bent_rib[h], 10.0 * bent_plain[h], 1e-12) << "hinge " << h;
+      ++checked;
+    }
+    if (is(0.2, 0.1, 0.21, 0.1)) {  // on the horizontal leg, along it
+      EXPECT_EQ(bent_rib[h], bent_plain[h]);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 3);
+}
+
 TEST(SeamHinges, NoSeamsGiveOnes) {
   const TriangleMesh mesh = CrissCrossGridMesh(0.1, 0.1, 3, 3);
   const std::vector<Hinge> hinges = BuildHinges(mesh);
@@ -516,6 +588,7 @@ TEST(SeamFile, DefaultsWhenSettingsOmitted) {
   EXPECT_EQ(p.fade_mm, 20.0);
   EXPECT_EQ(p.allowance_mm, 10.0);
   EXPECT_EQ(p.multiplier, SeamMultiplierReading::kFactor);
+  EXPECT_EQ(p.rib_factor, 1.0);
   EXPECT_EQ(p.range_mm, (std::array<double, 2>{0.0, 100.0}));
   EXPECT_FALSE(p.covariance.has_value());
 }
@@ -526,7 +599,7 @@ TEST(SeamFile, JsonRoundTrip) {
       "coefficients_mm": [1.5e-4, -0.06, 7.5], "range_mm": [2.5, 95],
       "covariance": [[1e-10, -2e-9, 1e-8], [-2e-9, 1e-6, -3e-6], [1e-8, -3e-6, 2e-3]],
       "influence_mm": 90, "fade_mm": 15, "allowance_mm": 12, "multiplier": "paper-literal",
-      "fit": {"rms": 0.08, "points": 17}, "notes": "measured 2024"})",
+      "rib_factor": 7.5, "fit": {"rms": 0.08, "points": 17}, "notes": "measured 2024"})",
                                       "round trip");
   const SeamProfile b = ParseSeamJson(SeamProfileToJson(a).dump(), "written");
   EXPECT_EQ(b.type, a.type);
@@ -540,6 +613,7 @@ TEST(SeamFile, JsonRoundTrip) {
   EXPECT_EQ(b.fade_mm, 15.0);
   EXPECT_EQ(b.allowance_mm, 12.0);
   EXPECT_EQ(b.multiplier, SeamMultiplierReading::kPaperLiteral);
+  EXPECT_EQ(b.rib_factor, 7.5);
   EXPECT_EQ(b.fit, a.fit);
   EXPECT_EQ(b.extra, a.extra);
   for (const std::string& type : SeamPresetNames()) {
@@ -559,6 +633,15 @@ TEST(SeamFile, CheckCatchesWhatJsonCannotSay) {
   p.fade_mm = std::nan("");
   EXPECT_FALSE(p.Check(&why));
   EXPECT_NE(why.find("fade_mm"), std::string::npos) << why;
+  p = SeamPreset("C-plain");
+  p.rib_factor = 0.5;  // a rib softer than the band's own S is not a seam
+  EXPECT_FALSE(p.Check(&why));
+  EXPECT_EQ(why, "rib_factor: must lie in [1, 1000], got 0.5");
+  p.rib_factor = std::nan("");
+  EXPECT_FALSE(p.Check(&why));
+  EXPECT_EQ(why, "rib_factor: must lie in [1, 1000], got nan");
+  p.rib_factor = 1000.0;
+  EXPECT_TRUE(p.Check(&why)) << why;
 }
 
 struct BadCase {
@@ -618,6 +701,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"allowance-negative.json", "allowance_mm: ", "must lie in [0, 200] mm, got -10"},
         BadCase{"allowance-absurd.json", "allowance_mm: ", "got 1000"},
         BadCase{"multiplier-unknown.json", "multiplier: ", "unknown reading 'literal'"},
+        BadCase{"rib-soft.json", "rib_factor: ", "must lie in [1, 1000], got 0.5"},
+        BadCase{"rib-string.json", "rib_factor: ", "must be a number"},
         BadCase{"covariance-asymmetric.json", "covariance: ", "must be symmetric"},
         BadCase{"covariance-negative-variance.json", "covariance: ", "diagonal must be >= 0"},
         BadCase{"covariance-shape.json", "covariance: ", "must be a 3×3 array"},

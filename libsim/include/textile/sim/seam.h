@@ -53,6 +53,12 @@ struct SeamProfile {
   double allowance_mm = 10.0;  // width of the band (centred on the seam line) that carries
                                // `layers` times the fabric's areal density [mm]
   SeamMultiplierReading multiplier = SeamMultiplierReading::kFactor;
+  // Lengthwise stiffness of the seam band, as a factor on S [-]. Inside the band (d ≤
+  // allowance/2) a hinge whose rest edge makes the angle φ with the seam line gets
+  // S(d) (1 + (rib_factor - 1) sin²φ): sin²φ is the share of its bend that bends the seam line
+  // itself, which the ACPM200 (bending about axes parallel to the seam) does not measure.
+  // 1 = the paper's scalar S of eq. 6 (the default). See docs/seams.md, "Lengthwise stiffness".
+  double rib_factor = 1.0;
   nlohmann::json fit;    // fit-seam's report, when a fit made this file (carried through)
   nlohmann::json extra;  // "notes", "source", "assumptions" (carried through)
 
@@ -81,7 +87,8 @@ struct SeamProfile {
   // known type (a preset's layers and coefficients must be Table 2's: use "fitted" otherwise),
   // 1 ≤ layers ≤ 20, finite coefficients, 0 < B_f ≤ 100 on [0, d_max] (larger values are a unit
   // mix-up), 0 ≤ lo < hi ≤ 1000 mm, 1 ≤ d_max ≤ 1000 mm,
-  // 0 < fade ≤ 1000 mm, 0 ≤ allowance ≤ 200 mm, covariance finite, symmetric, diagonal ≥ 0.
+  // 0 < fade ≤ 1000 mm, 0 ≤ allowance ≤ 200 mm, 1 ≤ rib_factor ≤ 1000, covariance finite,
+  // symmetric, diagonal ≥ 0.
   bool Check(std::string* why) const;
 };
 
@@ -94,7 +101,8 @@ std::vector<std::string> SeamPresetNames();
 
 // Seam JSON (cli.md): {"type", "layers", "coefficients_mm": [a2, a1, a0], "range_mm": [lo, hi],
 // "covariance": [[3], [3], [3]], "name", "influence_mm", "fade_mm", "allowance_mm",
-// "multiplier": "factor" | "paper-literal", "fit": {...}, "notes", "source", "assumptions"}.
+// "multiplier": "factor" | "paper-literal", "rib_factor", "fit": {...}, "notes", "source",
+// "assumptions"}.
 // type, layers and coefficients_mm are required. Throws InputError "<source>: <field>: <problem>".
 SeamProfile ParseSeamJson(const std::string& text, const std::string& source);
 // Reads a seam file. Throws InputError (unreadable file or any invalid field).
@@ -128,7 +136,7 @@ std::vector<double> HingeSeamDistances(const TriangleMesh& mesh, const std::vect
                                        const SeamLine& line);
 
 // Per-hinge bending multipliers S (#H, ≥ 1), as BendingElements takes them: for each hinge the
-// largest S_i(d_i) over the seams (max, not product: crossing seams are as stiff as the
+// largest S_i(d_i) over the seams (times the lengthwise term of rib_factor inside a band) (max, not product: crossing seams are as stiff as the
 // stiffer one; physics.md fixes no rule). No seams: all ones. Calls CheckSeams.
 std::vector<double> HingeSeamMultipliers(const TriangleMesh& mesh, const std::vector<Hinge>& hinges,
                                          const std::vector<Seam>& seams);

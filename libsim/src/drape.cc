@@ -621,7 +621,11 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
            << (split && seed.summary.converged ? "split " + seed.split_summary.BriefReport()
                                                : seed.summary.BriefReport());
       if (seed.converged) {
-        if (split) line << "; split DC " << seed.split_drape_coefficient << "; extrapolated";
+        if (split) {
+          line << "; split DC " << seed.split_drape_coefficient << "; extrapolated";
+        } else {
+          line << ";";
+        }
         line << " DC " << seed.drape_coefficient << ", " << seed.nodes.angles.size() << " nodes";
       }
       say(line.str());

@@ -190,17 +190,24 @@ void ExpectPng(const fs::path& png) {
   EXPECT_EQ(testing::ReadAll(png).substr(1, 3), "PNG") << png;
 }
 
+// Runs `textile bench <name> --quick` into a scratch folder, checks it wrote <name>.csv and a
+// real <name>.png chart, and reads the CSV into *csv.
+void RunQuickBench(const std::string& name, Csv* csv) {
+  const auto d = Scratch("CliBench." + name);
+  const auto r = RunTextile("bench " + name + " --quick -o '" + d.string() + "'", "bench_" + name);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(d / (name + ".csv"))) << r.out;
+  ExpectPng(d / (name + ".png"));
+  *csv = ReadCsv(d / (name + ".csv"));
+}
+
 const std::set<std::string> kBendingModels = {"volino", "bridson", "isometric", "pabst"};
 
 // Pabst Fig. 10 (docs/bending.md, "hinge-curve"): one curve per fabric and model, and the shapes
 // the paper describes. Physics only: no timing.
 TEST(CliBench, HingeCurveQuickWritesPabstFig10Curves) {
-  const auto d = Scratch("CliBench.HingeCurve");
-  const auto r = RunTextile("bench hinge-curve --quick -o '" + d.string() + "'", "bench_hinge");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  ASSERT_TRUE(fs::exists(d / "hinge-curve.csv")) << r.out;
-  ExpectPng(d / "hinge-curve.png");
-  const Csv csv = ReadCsv(d / "hinge-curve.csv");
+  Csv csv;
+  ASSERT_NO_FATAL_FAILURE(RunQuickBench("hinge-curve", &csv));
   EXPECT_EQ(csv.header,
             (std::vector<std::string>{"fabric", "model", "opening_deg", "bend_deg", "kappa_per_m",
                                       "normal_force_mn", "tangential_force_mn"}));
@@ -264,12 +271,8 @@ TEST(CliBench, HingeCurveQuickWritesPabstFig10Curves) {
 // (1, and all hardware threads when there are more), every time positive and finite. No
 // thresholds on the times: they belong to the benchmark.
 TEST(CliBench, BendForceQuickWritesOneRowPerModelAndThreadCount) {
-  const auto d = Scratch("CliBench.BendForce");
-  const auto r = RunTextile("bench bend-force --quick -o '" + d.string() + "'", "bench_bend_force");
-  ASSERT_EQ(r.exit_code, 0) << r.err;
-  ASSERT_TRUE(fs::exists(d / "bend-force.csv")) << r.out;
-  ExpectPng(d / "bend-force.png");
-  const Csv csv = ReadCsv(d / "bend-force.csv");
+  Csv csv;
+  ASSERT_NO_FATAL_FAILURE(RunQuickBench("bend-force", &csv));
   for (const char* c : {"model", "threads", "triangles", "force_ms", "force_jacobian_ms"})
     EXPECT_NE(std::find(csv.header.begin(), csv.header.end(), c), csv.header.end())
         << "no column " << c;

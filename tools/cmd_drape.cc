@@ -56,6 +56,14 @@ SeamProfile LoadSeamProfile(const DrapeArgs& a) {
   return SeamPreset("C-plain");  // Fig. 8: a double lap seam
 }
 
+// "C-plain", or "C-plain, rib 16" when the band is stiffer along its line (--seam-rib).
+std::string SeamLabel(const SeamProfile& p) {
+  if (p.rib_factor == 1.0) return p.type;
+  std::ostringstream s;
+  s << p.type << ", rib " << p.rib_factor;
+  return s.str();
+}
+
 // The seam profile with --seam-rib applied (it overrides the file's or preset's rib_factor).
 SeamProfile SeamProfileWithRib(const DrapeArgs& a) {
   SeamProfile p = LoadSeamProfile(a);
@@ -332,6 +340,11 @@ void Run(const DrapeArgs& a) {
   if (!a.obj.empty()) obj_file.emplace(a.obj);
 
   o.progress = [](const std::string& line) { Info("drape: " + line); };
+  if (o.mount == DrapeMount::kResting) {
+    Info("drape: note: the resting mount is experimental: on the default mesh it does not "
+         "converge, and the run ends at --max-seconds or the step cap with exit 3 "
+         "(docs/drapemeter.md, \"Limits\")");
+  }
   DrapeResult r;
   try {
     r = SimulateDrape(m, o);
@@ -367,7 +380,7 @@ void Run(const DrapeArgs& a) {
   std::cout << "material: " << (m.name.empty() ? a.material : m.name) << "  [" << a.material << "]\n"
             << "scene: specimen " << Num(a.specimen_mm) << " mm on a " << Num(a.support_mm) << " mm support, "
             << DrapeMountName(o.mount) << ", seams " << DrapeSeamsName(o.seams)
-            << (o.seams != DrapeSeams::kNone ? " (" + o.seam_profile.type + ")" : "") << ", "
+            << (o.seams != DrapeSeams::kNone ? " (" + SeamLabel(o.seam_profile) + ")" : "") << ", "
             << r.mesh.num_vertices() << " vertices (h = " << Num(units::MToMm(o.element_size)) << " mm"
             << (o.rim_element_size > 0.0
                     ? ", " + Num(units::MToMm(o.rim_element_size), 3) + " mm to " +
@@ -415,7 +428,8 @@ void RegisterDrape(CLI::App& app) {
   sub->add_option("--seam-rib", a->seam_rib,
                   "Lengthwise stiffness of the seam band as a factor on S (>= 1; default the "
                   "seam file's rib_factor, 1 for the presets: the paper's model; docs/seams.md)");
-  sub->add_option("--mount", a->mount, "clamped (default: held between two disks) or resting (friction)");
+  sub->add_option("--mount", a->mount, "clamped (default: held between two disks) or resting (friction; experimental, "
+                  "does not converge on the default mesh)");
   sub->add_option("--seeds", a->seeds, "Number of perturbations (repeated tests; default 1)");
   sub->add_option("--first-seed", a->first_seed, "First seed (default 1)");
   sub->add_option("--resolution-mm", a->resolution_mm, "Element size away from seams [mm] (default 12)");

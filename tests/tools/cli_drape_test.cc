@@ -240,6 +240,22 @@ TEST(CliDrape, NonConvergenceIsExit3WithOneLineAndNoFiles) {
 
 // Gmsh is loaded when a mesh is needed, not at start-up (libsim/src/gmsh_api.h): without it a
 // drape fails with one clear line and no files, and a command that meshes nothing still runs.
+TEST(CliDrape, RestingMountSaysItIsExperimentalAndFailsCleanly) {
+  const auto dir = Scratch("CliDrape.Resting");
+  const auto r = Textile("drape " + kFig8 + kCoarse + " --mount resting --max-seconds 0.001 -o " +
+                         (dir / "r.json").string());
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_NE(r.err.find("drape: note: the resting mount is experimental"), std::string::npos) << r.err;
+  const std::string last = r.err.substr(r.err.rfind("error: "));
+  EXPECT_EQ(testing::CountLines(last), 1) << r.err;
+  EXPECT_NE(last.find("not converged"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "r.json"));
+  // The clamped mount says nothing of the kind.
+  const auto c = Textile("drape " + kFig8 + kCoarse + " --max-seconds 0.001 -o " + (dir / "c.json").string());
+  EXPECT_EQ(c.exit_code, 3) << c.err;
+  EXPECT_EQ(c.err.find("experimental"), std::string::npos) << c.err;
+}
+
 TEST(CliDrape, WithoutGmshIsExit3WithOneLineAndNoFiles) {
   const auto dir = Scratch("CliDrape.NoGmsh");
   const std::string missing = "TEXTILE_GMSH=/nonexistent/libgmsh.so.4.8";

@@ -341,8 +341,9 @@ void Run(const DrapeArgs& a) {
 
   o.progress = [](const std::string& line) { Info("drape: " + line); };
   if (o.mount == DrapeMount::kResting) {
-    Info("drape: note: the resting mount is experimental: on the default mesh it does not "
-         "converge, and the run ends at --max-seconds or the step cap with exit 3 "
+    Info("drape: note: the resting mount is experimental: it settles where friction holds the "
+         "specimen (friction 3, --rim-mm 0), not with the samples' 0.3 (it slides) nor with the "
+         "rim band; a run that does not settle ends at --max-seconds or the step cap with exit 3 "
          "(docs/drapemeter.md, \"Limits\")");
   }
   DrapeResult r;
@@ -429,7 +430,7 @@ void RegisterDrape(CLI::App& app) {
                   "Lengthwise stiffness of the seam band as a factor on S (>= 1; default the "
                   "seam file's rib_factor, 1 for the presets: the paper's model; docs/seams.md)");
   sub->add_option("--mount", a->mount, "clamped (default: held between two disks) or resting (friction; experimental, "
-                  "does not converge on the default mesh)");
+                  "settles only with high friction and --rim-mm 0)");
   sub->add_option("--seeds", a->seeds, "Number of perturbations (repeated tests; default 1)");
   sub->add_option("--first-seed", a->first_seed, "First seed (default 1)");
   sub->add_option("--resolution-mm", a->resolution_mm, "Element size away from seams [mm] (default 12)");

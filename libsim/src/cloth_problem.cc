@@ -444,20 +444,60 @@ double ClothProblem::UpdateAnchors(const Vertices& x, const Vertices& previous) 
     // A node that stopped sliding must be pulled 5 % past the limit to slide again: without
     // this hysteresis a node at the limit can flip between the two states forever.
     const double margin = a.stopped ? 1.05 : 1.0 + 1e-6;
-    if (tangential > limit * margin && dt.norm() > 0.0) {
+    if (!options_.contact.lagged_slip && tangential > limit * margin && dt.norm() > 0.0) {
       // The spring pulls harder than friction can hold: it slides (Coulomb), from now on
       // against a constant force μ f_n.
       slid = std::max(slid, dt.norm() - limit / tangential_stiffness_);
       a = Anchor{s, p, n, true, dt.normalized(), limit, a.stopped};
       continue;
     }
-    // Sticking: keep the anchor on the surface under the node (curved shapes turn the normal).
-    const Eigen::Vector3d on_surface = p - phi * n;
-    a.point += n * n.dot(on_surface - a.point);
-    a.normal = n;
+    // Sticking: the anchor is a point of the support and stays one. It is only pulled back onto
+    // the surface (round-off), along the support's own normal there: re-projecting it under the
+    // node instead would drag it after the node on a curved surface (the rounded rim of a
+    // drape's disk), a creep that no friction limit checks.
+    Eigen::Vector3d normal_at_anchor;
+    const double off_surface = supports_[s].SignedDistance(a.point, &normal_at_anchor);
+    a.point -= off_surface * normal_at_anchor;
+    a.normal = normal_at_anchor;
     a.support = s;
   }
   return slid;
+}
+
+double ClothProblem::SlipAnchors(const Vertices& x) {
+  if (!lagged_slip() || supports_.empty()) return 0.0;
+  const double mu = options_.contact.friction;
+  const double excess = options_.contact.slip_excess;
+  const double g = options_.gravity.norm();
+  const double kt = tangential_stiffness_;
+  double moved = 0.0;
+  for (int i = 0; i < num_vertices(); ++i) {
+    Anchor& a = anchors_[i];
+    if (a.support < 0 || a.sliding || is_fixed_[i]) continue;
+    const Eigen::Vector3d p = x.row(i).transpose();
+    const double phi = supports_[a.support].SignedDistance(p, nullptr);
+    const double limit = mu * penalty_(i) * std::max(-phi, 0.0);  // μ f_n [N]
+    const Eigen::Vector3d d = p - a.point;
+    const Eigen::Vector3d dt = d - a.normal * a.normal.dot(d);
+    const double pull = kt * dt.norm();  // [N]
+    // It holds while it pulls at most `excess` past μ f_n (or past its weight, where the normal
+    // force is next to nothing).
+    if (!(pull > limit + excess * std::max(limit, masses_(i) * g))) {
+      a.last_slip = 0.0;
+      continue;
+    }
+    // To the cone's edge; successive slips of one node shrink geometrically (by about
+    // k_t / (k_t + the cloth's stiffness there), close to 1), so the sum of the series is taken
+    // from the last two (Aitken), at most 50 slips ahead.
+    const double slip = (pull - limit) / kt;  // [m]
+    double ahead = 1.0;
+    if (a.last_slip > 0.0 && slip < a.last_slip) ahead = std::min(50.0, 1.0 / (1.0 - slip / a.last_slip));
+    a.last_slip = slip;
+    a.point += ahead * slip / dt.norm() * dt;
+    moved = std::max(moved, ahead * slip);
+    ++anchor_version_;
+  }
+  return moved;
 }
 
 double ClothProblem::ContactStepLimit(const Vertices& x, const Eigen::VectorXd& d) const {

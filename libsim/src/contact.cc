@@ -160,6 +160,10 @@ bool ContactOptions::Check(std::string* why) const {
     *why = "contact anchor_keep_distance must be >= 0 and finite";
     return false;
   }
+  if (!(slip_excess >= 0.0 && slip_excess <= 1.0)) {
+    *why = "contact slip_excess must lie in [0, 1]";
+    return false;
+  }
   return true;
 }
 

@@ -184,6 +184,8 @@ std::unique_ptr<ClothProblem> MakeProblem(const Pattern& p, const Material& mate
                                           const std::vector<Seam>& seams, const DrapeOptions& o) {
   ClothOptions co;
   co.contact.friction = material.friction;
+  // Resting mount: slip between converged stretches (contact.h); per-step switching cycled.
+  co.contact.lagged_slip = true;
   auto problem = std::make_unique<ClothProblem>(p.pm.mesh, material, seams, co);
   if (o.mount == DrapeMount::kClamped) {
     Vertices held(static_cast<long>(p.clamp.size()), 3);

@@ -287,6 +287,15 @@ SolveSummary Newton(Run& run) {
   ExactHessianTries exact;
   Eigen::VectorXd d;
   for (int it = 0;; ++it) {
+    if (p.lagged_slip() && residual < o.tolerance) {
+      // Stuck to tolerance: slip the anchors pulled past the friction cone (contact.h).
+      slid = p.SlipAnchors(x);
+      if (slid > 0.0) {
+        energy = p.EnergyGradient(x, &grad);
+        residual = p.RelativeResidual(grad);
+        ++run.summary.slips;
+      }
+    }
     if (run.Done(it, energy, residual, slid)) return run.Finish(energy, residual);
     const Eigen::VectorXd g = Flat(grad);
     bool exact_step = false;

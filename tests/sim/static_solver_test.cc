@@ -294,9 +294,10 @@ struct SheetOnSlope {
   std::unique_ptr<ClothProblem> problem;
   Vertices start;
   Eigen::Vector3d downhill;
-  explicit SheetOnSlope(double degrees, double friction) {
+  explicit SheetOnSlope(double degrees, double friction, bool lagged_slip = false) {
     ClothOptions options;
     options.contact.friction = friction;
+    options.contact.lagged_slip = lagged_slip;
     problem = std::make_unique<ClothProblem>(mesh, Cotton(), std::vector<Seam>{}, options);
     const double a = degrees * M_PI / 180.0;
     const Eigen::Vector3d normal(-std::sin(a), 0.0, std::cos(a));
@@ -344,6 +345,29 @@ TEST(StaticSolver, FrictionHoldsASheetBelowTheFrictionAngleAndLetsItSlideAbove) 
     const SolveSummary s = SolveStatic(slope.problem.get(), &x, options);
     EXPECT_FALSE(s.converged);
     EXPECT_GT(slope.Slid(x), 1e-2);
+  }
+}
+
+TEST(StaticSolver, LaggedSlipHoldsBelowTheFrictionAngleAndSlidesAbove) {
+  // ContactOptions::lagged_slip: stick during the solve, slip between converged stretches.
+  const double mu = 0.3;
+  {
+    SheetOnSlope slope(10.0, mu, true);
+    Vertices x = slope.start;
+    const SolveSummary s = SolveStatic(slope.problem.get(), &x, {});
+    ASSERT_TRUE(s.converged) << s.BriefReport();
+    EXPECT_EQ(s.contacts, slope.mesh.num_vertices());
+    EXPECT_LT(std::abs(slope.Slid(x)), 1e-4);
+  }
+  {
+    SheetOnSlope slope(25.0, mu, true);
+    Vertices x = slope.start;
+    SolveOptions options;
+    options.max_iterations = 200;
+    const SolveSummary s = SolveStatic(slope.problem.get(), &x, options);
+    EXPECT_FALSE(s.converged) << s.BriefReport();
+    EXPECT_GT(s.slips, 3) << s.BriefReport();  // every converged stretch ends in a slip
+    EXPECT_GT(slope.Slid(x), 1e-4);
   }
 }
 

@@ -66,6 +66,18 @@ struct ContactOptions {
   // Nodes within this distance outside a support keep their anchors (hysteresis, so a node
   // resting on a support does not lose its anchor by round-off) [m].
   double anchor_keep_distance = 1e-6;
+  // Friction by stick, then slip between converged stretches of a solve, instead of switching
+  // nodes between sticking and sliding at every step. Within a stretch every node in contact
+  // sticks to its anchor. Once the residual is below the tolerance, ClothProblem::SlipAnchors
+  // moves the anchors of the nodes pulled past μ f_n (return mapping) and the solve goes on,
+  // until every node holds (slip_excess). The energy is fixed within each stretch, so Newton
+  // does not cycle on nodes at the limit (the drape's resting mount). Newton only: the kinetic
+  // solver keeps every node in contact sticking under this option.
+  bool lagged_slip = false;
+  // Lagged slip: a node sticks while its spring pulls at most this fraction past μ f_n (or past
+  // its own weight, where the normal force is next to nothing) [-]; 1 % is well inside what μ
+  // is known to.
+  double slip_excess = 0.01;
 
   bool Check(std::string* why) const;
 };

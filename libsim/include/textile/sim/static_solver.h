@@ -92,6 +92,7 @@ struct SolveSummary {
   int linear_iterations = 0;   // CG iterations in total (0 with CHOLMOD)
   int factorizations = 0;      // Cholesky factorisations (incl. shifted retries)
   int exact_steps = 0;         // Newton steps taken with the exact Hessian (exact_below)
+  int slips = 0;               // friction updates that moved anchors (ContactOptions::lagged_slip)
   double residual = 0.0;       // final relative residual [-]
   double energy = 0.0;         // final total potential [J]
   double seconds = 0.0;        // wall time [s]

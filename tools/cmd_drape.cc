@@ -227,6 +227,7 @@ nlohmann::json SummaryJson(const SolveSummary& s) {
           {"message", s.message},       {"iterations", s.iterations},
           {"coarse_iterations", s.coarse_iterations},
           {"factorizations", s.factorizations}, {"exact_hessian_steps", s.exact_steps},
+          {"friction_slips", s.slips},
           {"residual", s.residual},     {"energy_J", s.energy},
           {"seconds", s.seconds},       {"coarse_seconds", s.coarse_seconds},
           {"contacts", s.contacts},     {"anchors", s.anchors}};
@@ -321,11 +322,14 @@ void Run(const DrapeArgs& a) {
                                     rim_if_extrapolating > 0.0 && o.rim_band >= rim_if_extrapolating;
   o.rim_extrapolation = a.extrapolate || (!a.no_extrapolate && extrapolate_possible);
   if (a.rim_mm == "auto") o.rim_element_size = AutoRimElementSize(m, o, o.rim_extrapolation);
+  // The resting mount settles only without the rim band (docs/drapemeter.md, "Limits").
+  if (a.rim_mm == "auto" && o.mount == DrapeMount::kResting) o.rim_element_size = 0.0;
   if (std::string why; !o.Check(&why)) throw InputError("drape: " + why);
   const double rim_size = o.rim_element_size > 0.0 ? o.rim_element_size : o.element_size;
   std::string note;  // reported with the result (a refused run prints its one error line only)
   // (An extrapolated DC has no first-order shortfall: no note.)
-  if (const double shortfall = 0.1 * rim_size / turn_down; shortfall > 0.02 && !o.rim_extrapolation) {
+  if (const double shortfall = 0.1 * rim_size / turn_down; shortfall > 0.02 && !o.rim_extrapolation &&
+                                                                o.mount == DrapeMount::kClamped) {
     note = "DC may be low by up to about " + Num(shortfall, 1) + ": the rim's elements (" +
            Num(units::MToMm(rim_size), 3) + " mm) are coarse against this fabric's turn-down length there (" +
            Num(units::MToMm(turn_down), 2) + " mm); " +
@@ -342,9 +346,9 @@ void Run(const DrapeArgs& a) {
   o.progress = [](const std::string& line) { Info("drape: " + line); };
   if (o.mount == DrapeMount::kResting) {
     Info("drape: note: the resting mount is experimental: it settles where friction holds the "
-         "specimen (friction 3, --rim-mm 0), not with the samples' 0.3 (it slides) nor with the "
-         "rim band; a run that does not settle ends at --max-seconds or the step cap with exit 3 "
-         "(docs/drapemeter.md, \"Limits\")");
+         "specimen (a material \"friction\" of 3; no rim band, which --rim-mm auto leaves out "
+         "here), not with the samples' 0.3; a run that does not settle ends at --max-seconds or "
+         "the step cap with exit 3 (docs/drapemeter.md, \"Limits\")");
   }
   DrapeResult r;
   try {
@@ -430,7 +434,7 @@ void RegisterDrape(CLI::App& app) {
                   "Lengthwise stiffness of the seam band as a factor on S (>= 1; default the "
                   "seam file's rib_factor, 1 for the presets: the paper's model; docs/seams.md)");
   sub->add_option("--mount", a->mount, "clamped (default: held between two disks) or resting (friction; experimental, "
-                  "settles only with high friction and --rim-mm 0)");
+                  "settles only with high friction; no rim band by default)");
   sub->add_option("--seeds", a->seeds, "Number of perturbations (repeated tests; default 1)");
   sub->add_option("--first-seed", a->first_seed, "First seed (default 1)");
   sub->add_option("--resolution-mm", a->resolution_mm, "Element size away from seams [mm] (default 12)");

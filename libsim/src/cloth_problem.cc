@@ -8,6 +8,10 @@
 #include "textile/sim/error.h"
 
 namespace textile {
+
+// Lagged slip: the part of a node's weight it may pull past μ f_n even with no normal force.
+constexpr double kSlipFloor = 1e-4;
+
 namespace {
 
 std::optional<BendingLaw> WeftLaw(const Material& m, double scale) {
@@ -416,6 +420,7 @@ double ClothProblem::UpdateAnchors(const Vertices& x, const Vertices& previous) 
     const Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity() - n * n.transpose();
     const double limit = mu * penalty_(i) * std::max(-phi, 0.0);  // μ f_n
     ++anchor_version_;
+    if (a.support >= 0 && a.support != s) a.support = -1;  // another support: a new contact
     if (a.support < 0) {  // contact starts: sticking, anchored under where the node came from
       const Eigen::Vector3d before = previous.row(i).transpose();
       Eigen::Vector3d n_before;
@@ -480,21 +485,28 @@ double ClothProblem::SlipAnchors(const Vertices& x) {
     const Eigen::Vector3d d = p - a.point;
     const Eigen::Vector3d dt = d - a.normal * a.normal.dot(d);
     const double pull = kt * dt.norm();  // [N]
-    // It holds while it pulls at most `excess` past μ f_n (or past its weight, where the normal
-    // force is next to nothing).
-    if (!(pull > limit + excess * std::max(limit, masses_(i) * g))) {
-      a.last_slip = 0.0;
+    // It holds while it pulls at most `excess` of μ f_n past it (plus 1e-4 of its weight, so
+    // that a node with next to no normal force does not slip by round-off).
+    if (!(pull > (1.0 + excess) * limit + kSlipFloor * masses_(i) * g)) {
+      a.last_slip.setZero();
       continue;
     }
-    // To the cone's edge; successive slips of one node shrink geometrically (by about
-    // k_t / (k_t + the cloth's stiffness there), close to 1), so the sum of the series is taken
-    // from the last two (Aitken), at most 50 slips ahead.
-    const double slip = (pull - limit) / kt;  // [m]
+    // To the cone's edge. Successive slips of one node in one direction shrink geometrically
+    // (by r ≈ k_t / (k_t + the cloth's stiffness there), close to 1), so a slip that follows
+    // the previous one with 0 < r < 1 jumps to the series' sum, 1/(1 - r) times it (Aitken, at
+    // most 50), and the next slip starts a new pair.
+    const Eigen::Vector3d slip = (pull - limit) / pull * dt;  // [m]
     double ahead = 1.0;
-    if (a.last_slip > 0.0 && slip < a.last_slip) ahead = std::min(50.0, 1.0 / (1.0 - slip / a.last_slip));
-    a.last_slip = slip;
-    a.point += ahead * slip / dt.norm() * dt;
-    moved = std::max(moved, ahead * slip);
+    const double previous = a.last_slip.squaredNorm();
+    const double r = previous > 0.0 ? slip.dot(a.last_slip) / previous : 0.0;
+    if (r > 0.0 && r < 1.0) {
+      ahead = std::min(50.0, 1.0 / (1.0 - r));
+      a.last_slip.setZero();
+    } else {
+      a.last_slip = slip;
+    }
+    a.point += ahead * slip;
+    moved = std::max(moved, ahead * slip.norm());
     ++anchor_version_;
   }
   return moved;

@@ -185,7 +185,7 @@ std::unique_ptr<ClothProblem> MakeProblem(const Pattern& p, const Material& mate
   ClothOptions co;
   co.contact.friction = material.friction;
   // Resting mount: slip between converged stretches (contact.h); per-step switching cycled.
-  co.contact.lagged_slip = true;
+  co.contact.lagged_slip = o.mount == DrapeMount::kResting;
   auto problem = std::make_unique<ClothProblem>(p.pm.mesh, material, seams, co);
   if (o.mount == DrapeMount::kClamped) {
     Vertices held(static_cast<long>(p.clamp.size()), 3);
@@ -286,12 +286,12 @@ bool DrapeOptions::Check(std::string* why) const {
     return Fail(why, "rim_element_size: below 0.1 mm is not a drape mesh");
   if (!Finite(rim_band) || rim_band < 0.0 || rim_band > specimen_radius - support_radius)
     return Fail(why, "rim_band: must be in [0, the overhang]");
+  if (rim_extrapolation && mount != DrapeMount::kClamped)
+    return Fail(why, "rim_extrapolation: clamped mount only (a second solve would restart friction)");
   if (rim_extrapolation && rim_element_size == 0.0)
     return Fail(why, "rim_extrapolation: needs a rim band (rim_element_size > 0)");
   if (rim_extrapolation && rim_band < rim_element_size)
     return Fail(why, "rim_extrapolation: needs a rim band at least one rim element wide");
-  if (rim_extrapolation && mount != DrapeMount::kClamped)
-    return Fail(why, "rim_extrapolation: clamped mount only (a second solve would restart friction)");
   if (!Finite(coarse_factor) || coarse_factor < 1.0 || coarse_factor > 8.0)
     return Fail(why, "coarse_factor: must be in [1, 8]");
   if (coarse_to_fine && coarse_factor * element_size > 0.5 * (specimen_radius - support_radius))

@@ -557,7 +557,7 @@ std::vector<double> HingeSeamMultipliers(const TriangleMesh& mesh, const std::ve
     const double rib = seam.profile.rib_factor;
     for (std::size_t h = 0; h < d.size(); ++h) {
       double lengthwise = 1.0;
-      if (rib > 1.0 && d[h] <= half_band) {
+      if (rib > 1.0 && d[h] < half_band) {
         const Eigen::Vector2d a = Xy(mesh, hinges[h].v[2]), b = Xy(mesh, hinges[h].v[3]);
         const double cos_phi = (b - a).normalized().dot(NearestSegmentDirection(0.5 * (a + b), seam.line));
         lengthwise = 1.0 + (rib - 1.0) * (1.0 - cos_phi * cos_phi);

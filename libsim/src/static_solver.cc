@@ -171,6 +171,8 @@ struct Run {
   bool Start() {
     std::string why;
     if (!options.Check(&why)) throw InputError("solver options: " + why);
+    if (options.method == SolverMethod::kKineticDamping && problem->lagged_slip())
+      throw InputError("solver: lagged friction slip needs Newton (the kinetic solver never slips)");
     if (x->rows() != problem->num_vertices())
       throw InputError("solver: the start state has " + std::to_string(x->rows()) +
                        " vertices, the mesh " + std::to_string(problem->num_vertices()));
@@ -220,7 +222,7 @@ struct Run {
       summary.message = stop;
       return true;
     }
-    if (residual < options.tolerance && slid <= options.anchor_tolerance) {
+    if (residual < options.tolerance && !Sliding(slid)) {
       summary.converged = true;
       summary.message = "converged: residual below tolerance";
       return true;
@@ -232,9 +234,15 @@ struct Run {
     return false;
   }
 
+  // Whether the friction anchors still move: under lagged slip any move of the last
+  // SlipAnchors (it only moves nodes pulled past the cone), else a slip over anchor_tolerance.
+  bool Sliding(double slid) const {
+    return problem->lagged_slip() ? slid > 0.0 : slid > options.anchor_tolerance;
+  }
+
   std::string CapMessage(double slid) const {
     std::string m = "iteration cap of " + std::to_string(options.max_iterations) + " reached";
-    if (slid > options.anchor_tolerance)
+    if (Sliding(slid))
       m += " with friction anchors still sliding: the cloth slides, no static equilibrium";
     return m;
   }
@@ -356,7 +364,8 @@ SolveSummary Newton(Run& run) {
       return run.Finish(energy, residual);
     }
     const long anchors_before = p.anchor_version();
-    slid = p.UpdateAnchors(trial, x);
+    const double step_slid = p.UpdateAnchors(trial, x);
+    if (!p.lagged_slip()) slid = step_slid;  // lagged: the last SlipAnchors' move stands
     x = trial;
     if (p.anchor_version() != anchors_before) {
       energy = p.EnergyGradient(x, &grad);  // the anchor springs changed

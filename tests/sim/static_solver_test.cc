@@ -367,7 +367,32 @@ TEST(StaticSolver, LaggedSlipHoldsBelowTheFrictionAngleAndSlidesAbove) {
     const SolveSummary s = SolveStatic(slope.problem.get(), &x, options);
     EXPECT_FALSE(s.converged) << s.BriefReport();
     EXPECT_GT(s.slips, 3) << s.BriefReport();  // every converged stretch ends in a slip
+    EXPECT_NE(s.message.find("slides"), std::string::npos) << s.BriefReport();
     EXPECT_GT(slope.Slid(x), 1e-4);
+  }
+  {  // Just past the friction angle (tan 18° = 0.325, 8 % past μ): it must not hold.
+    SheetOnSlope slope(18.0, mu, true);
+    Vertices x = slope.start;
+    SolveOptions options;
+    options.max_iterations = 400;
+    const SolveSummary s = SolveStatic(slope.problem.get(), &x, options);
+    EXPECT_FALSE(s.converged) << s.BriefReport();
+    EXPECT_NE(s.message.find("slides"), std::string::npos) << s.BriefReport();
+  }
+  {  // The kinetic solver never slips: refused, not silently infinite friction.
+    SheetOnSlope slope(25.0, mu, true);
+    Vertices x = slope.start;
+    SolveOptions options;
+    options.method = SolverMethod::kKineticDamping;
+    EXPECT_THROW(SolveStatic(slope.problem.get(), &x, options), InputError);
+  }
+  ContactOptions c;
+  std::string why;
+  EXPECT_TRUE(c.Check(&why)) << why;
+  for (double bad : {-0.01, 1.5, std::nan("")}) {
+    c.slip_excess = bad;
+    EXPECT_FALSE(c.Check(&why)) << bad;
+    EXPECT_EQ(why, "contact slip_excess must lie in [0, 1]");
   }
 }
 

@@ -55,6 +55,7 @@ TEST(CliDrape, PlainDrapeWritesResultOutlinePngAndObj) {
     EXPECT_GE(solver["exact_hessian_steps"].get<int>(), 0);
     EXPECT_LE(solver["exact_hessian_steps"].get<int>(), solver["iterations"].get<int>());
     EXPECT_LT(solver["residual"].get<double>(), 1e-4);
+    EXPECT_EQ(solver["friction_slips"].get<int>(), 0);  // clamped: no support, no friction
   }
   // Outline CSV next to the result: a header and one row per 1° bin, radii between the
   // support and the specimen.
@@ -92,6 +93,18 @@ TEST(CliDrape, SeamFromPresetOrFileRaisesDc) {
 int MeshVertices(const std::string& err) {
   const auto at = err.find("drape: mesh: ");
   return at == std::string::npos ? 0 : std::stoi(err.substr(at + 13));
+}
+
+// The last "error: ..." line of stderr, checked to be one line ("" and a failure if none).
+std::string LastError(const std::string& err) {
+  const auto at = err.rfind("error: ");
+  if (at == std::string::npos) {
+    ADD_FAILURE() << "no error line in: " << err;
+    return {};
+  }
+  const std::string last = err.substr(at);
+  EXPECT_EQ(testing::CountLines(last), 1) << err;
+  return last;
 }
 
 // Degrees from the angle a [deg] to the nearest multiple of 90° (the weft and warp seams' ends).
@@ -222,9 +235,7 @@ TEST(CliDrape, NonConvergenceIsExit3WithOneLineAndNoFiles) {
   const auto dir = Scratch("CliDrape.NoConv");
   const auto r = Textile("drape " + kFig8 + kCoarse + " --max-seconds 0.001 -o " + (dir / "r.json").string());
   EXPECT_EQ(r.exit_code, 3) << r.err;
-  const std::string last = r.err.substr(r.err.rfind("error: "));
-  EXPECT_EQ(testing::CountLines(last), 1) << r.err;
-  EXPECT_NE(last.find("not converged"), std::string::npos) << r.err;
+  EXPECT_NE(LastError(r.err).find("not converged"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "r.json"));
   EXPECT_FALSE(fs::exists(dir / "r.outline.csv"));
   // The same when a cascade's coarse level stops short ahead of the (default) rim split.
@@ -232,23 +243,18 @@ TEST(CliDrape, NonConvergenceIsExit3WithOneLineAndNoFiles) {
                          (dir / "c.json").string());
   EXPECT_EQ(c.exit_code, 3) << c.err;
   EXPECT_NE(c.err.find("split at the rim"), std::string::npos) << c.err;
-  const std::string c_last = c.err.substr(c.err.rfind("error: "));
-  EXPECT_EQ(testing::CountLines(c_last), 1) << c.err;
-  EXPECT_NE(c_last.find("not converged (seed 1: coarse level: time cap"), std::string::npos) << c.err;
+  EXPECT_NE(LastError(c.err).find("not converged (seed 1: coarse level: time cap"), std::string::npos)
+      << c.err;
   EXPECT_FALSE(fs::exists(dir / "c.json"));
 }
 
-// Gmsh is loaded when a mesh is needed, not at start-up (libsim/src/gmsh_api.h): without it a
-// drape fails with one clear line and no files, and a command that meshes nothing still runs.
 TEST(CliDrape, RestingMountSaysItIsExperimentalAndFailsCleanly) {
   const auto dir = Scratch("CliDrape.Resting");
   const auto r = Textile("drape " + kFig8 + kCoarse + " --mount resting --max-seconds 0.001 -o " +
                          (dir / "r.json").string());
   EXPECT_EQ(r.exit_code, 3) << r.err;
   EXPECT_NE(r.err.find("drape: note: the resting mount is experimental"), std::string::npos) << r.err;
-  const std::string last = r.err.substr(r.err.rfind("error: "));
-  EXPECT_EQ(testing::CountLines(last), 1) << r.err;
-  EXPECT_NE(last.find("not converged"), std::string::npos) << r.err;
+  EXPECT_NE(LastError(r.err).find("not converged"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "r.json"));
   // The clamped mount says nothing of the kind.
   const auto c = Textile("drape " + kFig8 + kCoarse + " --max-seconds 0.001 -o " + (dir / "c.json").string());
@@ -256,6 +262,8 @@ TEST(CliDrape, RestingMountSaysItIsExperimentalAndFailsCleanly) {
   EXPECT_EQ(c.err.find("experimental"), std::string::npos) << c.err;
 }
 
+// Gmsh is loaded when a mesh is needed, not at start-up (libsim/src/gmsh_api.h): without it a
+// drape fails with one clear line and no files, and a command that meshes nothing still runs.
 TEST(CliDrape, WithoutGmshIsExit3WithOneLineAndNoFiles) {
   const auto dir = Scratch("CliDrape.NoGmsh");
   const std::string missing = "TEXTILE_GMSH=/nonexistent/libgmsh.so.4.8";

@@ -94,11 +94,14 @@ class ClothProblem {
   // With ContactOptions::lagged_slip no node slides here: touching nodes stick.
   double UpdateAnchors(const Vertices& x, const Vertices& previous);
   // ContactOptions::lagged_slip, between converged stretches of a solve: moves the anchor of
-  // every node whose spring pulls more than slip_excess past μ f_n (Coulomb) along the pull, to
-  // where it pulls μ f_n, or further, by the sum of the geometric series its successive slips
-  // form (Aitken, at most 50 slips ahead). Returns the largest move [m] (0: every node holds).
+  // every node whose spring pulls more than slip_excess of μ f_n past μ f_n (Coulomb) along the
+  // pull, to where it pulls μ f_n, or further, by the sum of the geometric series its
+  // successive slips form (Aitken, at most 50 slips ahead). Returns the largest move [m] (0:
+  // every node holds).
   double SlipAnchors(const Vertices& x);
-  bool lagged_slip() const { return options_.contact.lagged_slip && options_.contact.friction > 0.0; }
+  bool lagged_slip() const {
+    return options_.contact.lagged_slip && options_.contact.friction > 0.0 && !supports_.empty();
+  }
   void ClearAnchors();
   int num_anchors() const;
   // Incremented whenever an anchor is created, released or moved: the energy changed.
@@ -139,7 +142,7 @@ class ClothProblem {
     Eigen::Vector3d slip = Eigen::Vector3d::Zero();  // sliding: unit slip direction
     double friction_force = 0.0;                     // sliding: μ f_n [N]
     bool stopped = false;  // it slid and stopped since contact began (hysteresis)
-    double last_slip = 0.0;  // lagged slip: the node's previous slip, 0 if it held [m]
+    Eigen::Vector3d last_slip = Eigen::Vector3d::Zero();  // lagged slip: the last unpaired slip [m]
   };
   // The deepest support node i touches (φ < limit), or -1; *phi and *normal filled.
   int Touching(const Eigen::Vector3d& p, double limit, double* phi, Eigen::Vector3d* normal) const;

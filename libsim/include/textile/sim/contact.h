@@ -74,9 +74,9 @@ struct ContactOptions {
   // does not cycle on nodes at the limit (the drape's resting mount). Newton only: the kinetic
   // solver keeps every node in contact sticking under this option.
   bool lagged_slip = false;
-  // Lagged slip: a node sticks while its spring pulls at most this fraction past μ f_n (or past
-  // its own weight, where the normal force is next to nothing) [-]; 1 % is well inside what μ
-  // is known to.
+  // Lagged slip: a node sticks while its spring pulls at most this fraction of μ f_n past μ f_n
+  // (plus 1e-4 of its weight, for nodes with next to no normal force) [-]; 1 % is well inside
+  // what μ is known to.
   double slip_excess = 0.01;
 
   bool Check(std::string* why) const;

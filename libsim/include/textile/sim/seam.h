@@ -53,7 +53,7 @@ struct SeamProfile {
   double allowance_mm = 10.0;  // width of the band (centred on the seam line) that carries
                                // `layers` times the fabric's areal density [mm]
   SeamMultiplierReading multiplier = SeamMultiplierReading::kFactor;
-  // Lengthwise stiffness of the seam band, as a factor on S [-]. Inside the band (d ≤
+  // Lengthwise stiffness of the seam band, as a factor on S [-]. Inside the band (d <
   // allowance/2) a hinge whose rest edge makes the angle φ with the seam line gets
   // S(d) (1 + (rib_factor - 1) sin²φ): sin²φ is the share of its bend that bends the seam line
   // itself, which the ACPM200 (bending about axes parallel to the seam) does not measure.
@@ -136,8 +136,9 @@ std::vector<double> HingeSeamDistances(const TriangleMesh& mesh, const std::vect
                                        const SeamLine& line);
 
 // Per-hinge bending multipliers S (#H, ≥ 1), as BendingElements takes them: for each hinge the
-// largest S_i(d_i) over the seams (times the lengthwise term of rib_factor inside a band) (max, not product: crossing seams are as stiff as the
-// stiffer one; physics.md fixes no rule). No seams: all ones. Calls CheckSeams.
+// largest S_i(d_i) over the seams, times the lengthwise term of rib_factor inside a seam's band
+// (max, not product: crossing seams are as stiff as the stiffer one; physics.md fixes no rule).
+// No seams: all ones. Calls CheckSeams.
 std::vector<double> HingeSeamMultipliers(const TriangleMesh& mesh, const std::vector<Hinge>& hinges,
                                          const std::vector<Seam>& seams);
 

@@ -6,6 +6,7 @@
 #include <new>
 #include <string>
 
+#include "common/blas_kernels.h"
 #include "common/cli.h"
 #include "textile/sim/error.h"
 
@@ -20,12 +21,14 @@ std::string OneLine(const char* what) {
 
 int main(int argc, char** argv) {
   namespace cli = textile::cli;
+  cli::ChooseBlasKernels();
   CLI::App app{
       "textile: textile bending characterisation.\n"
       "Cantilever profiles -> nonlinear moment-curvature law {b1, b2, c1} -> virtual tests.\n"
       "Internally SI; files and printouts in lab units (KES: gf·cm, 1/cm; g/m²; mm)."};
   app.name("textile");
-  app.set_version_flag("--version", std::string("textile ") + TEXTILE_VERSION);
+  app.set_version_flag("--version", std::string("textile ") + TEXTILE_VERSION + " (BLAS: " +
+                                        cli::BlasKernels() + ")");
   app.require_subcommand(1);
   app.footer("\nRun 'textile SUBCOMMAND --help' for the flags and an example of each.\n"
              "Exit codes: 0 ok, 2 bad input or usage, 3 computation failed.");

@@ -10,6 +10,7 @@
 
 #include "bench/bench.h"
 #include "common/atomic_file.h"
+#include "common/blas_kernels.h"
 
 namespace textile::bench {
 
@@ -78,6 +79,7 @@ nlohmann::json MachineInfo() {
   return {{"cpu", cpu},
           {"hardware_threads", std::thread::hardware_concurrency()},
           {"threads_used", 1},
+          {"blas_kernels", cli::BlasKernels()},
           {"build", build}};
 }
 

@@ -54,7 +54,8 @@ void Run(const BenchArgs& a) {
   if (!a.json) {
     std::cout << "machine: " << machine["cpu"].get<std::string>() << ", "
               << machine["hardware_threads"] << " hardware threads, 1 used, "
-              << machine["build"].get<std::string>() << "\n";
+              << machine["build"].get<std::string>() << ", BLAS: "
+              << machine["blas_kernels"].get<std::string>() << "\n";
   }
 }
 

@@ -470,7 +470,7 @@ double ClothProblem::UpdateAnchors(const Vertices& x, const Vertices& previous) 
 }
 
 double ClothProblem::SlipAnchors(const Vertices& x) {
-  if (!lagged_slip() || supports_.empty()) return 0.0;
+  if (!lagged_slip()) return 0.0;  // off, or no friction or no support
   const double mu = options_.contact.friction;
   const double excess = options_.contact.slip_excess;
   const double g = options_.gravity.norm();

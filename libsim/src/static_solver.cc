@@ -6,11 +6,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <dlfcn.h>
 #include <limits>
 #include <memory>
 #include <sstream>
 
+#include "serial_openmp.h"
 #include "textile/sim/error.h"
 
 namespace textile {
@@ -36,52 +36,16 @@ double CentreHeight(const ClothProblem& p, const Vertices& x, const Eigen::Vecto
   return -(p.masses().transpose() * (x * down)).value() / p.total_mass();
 }
 
-// While alive, OpenMP regions started on this thread run on it alone (max-active-levels 0,
-// a per-thread setting in libgomp); the setting before is restored at the end.
-// Why: CHOLMOD 3 (SuiteSparse 5) opens an OpenMP region of a fixed 4 threads
-// (CHOLMOD_OMP_NUM_THREADS, compiled in) for each large supernode of every factorisation, and
-// on a 2-core machine the wake-ups cost more than the work they share: a 2100-vertex drape
-// (96 Newton steps) took 6.2 s wall, 1.7 s of it in the kernel (1.1 million futex calls);
-// serial, 3.1 s and 0.2 s (docs/drapemeter.md, "Solver"). The functions are looked up in the
-// process, i.e. in the OpenMP runtime CHOLMOD brought in; without one there is nothing to do,
-// and libsim needs no OpenMP of its own.
-class SerialOpenMp {
- public:
-  SerialOpenMp() {
-    static const Api api = Lookup();
-    if (api.set == nullptr || api.get == nullptr) return;
-    api_ = &api;
-    before_ = api.get();
-    api.set(0);
-  }
-  ~SerialOpenMp() {
-    if (api_ != nullptr) api_->set(before_);
-  }
-  SerialOpenMp(const SerialOpenMp&) = delete;
-  SerialOpenMp& operator=(const SerialOpenMp&) = delete;
-
- private:
-  struct Api {
-    void (*set)(int) = nullptr;
-    int (*get)() = nullptr;
-  };
-  static Api Lookup() {
-    Api api;
-    api.set = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
-    api.get = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_max_active_levels"));
-    return api;
-  }
-  const Api* api_ = nullptr;
-  int before_ = 0;
-};
-
 // Solves A d = b with CHOLMOD (shifting the diagonal when A is singular) or with conjugate
 // gradients. The sparsity of A is the same on every call, so CHOLMOD analyses it once.
+// CHOLMOD reads A's upper triangle: its supernodal factorisation permutes an upper-stored
+// matrix with one transpose and a lower-stored one with two (cholmod_factorize.c); the second
+// was 1.8 % of a default drape's samples.
 class LinearSolver {
  public:
   explicit LinearSolver(const SolveOptions& options) {
     if (options.linear == LinearSolverKind::kCholmod) {
-      cholmod_ = std::make_unique<Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower>>();
+      cholmod_ = std::make_unique<Eigen::CholmodDecomposition<SparseMatrix, Eigen::Upper>>();
       cholmod_->cholmod().print = 0;  // failures are handled here, not printed by CHOLMOD
     } else {
       cg_ = std::make_unique<
@@ -145,7 +109,7 @@ class LinearSolver {
     return d->allFinite();
   }
 
-  std::unique_ptr<Eigen::CholmodDecomposition<SparseMatrix, Eigen::Lower>> cholmod_;
+  std::unique_ptr<Eigen::CholmodDecomposition<SparseMatrix, Eigen::Upper>> cholmod_;
   std::unique_ptr<Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper,
                                            Eigen::IncompleteCholesky<double>>>
       cg_;

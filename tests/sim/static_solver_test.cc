@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <dlfcn.h>
+#include <atomic>
 
 #include <cmath>
 #include <limits>
 #include <random>
 
+#include "serial_openmp.h"
 #include "textile/sim/cloth_problem.h"
 #include "textile/sim/error.h"
 #include "textile/sim/seam.h"
@@ -254,6 +256,43 @@ TEST(StaticSolver, LeavesTheCallersOpenMpSettingAsItWas) {
   EXPECT_GT(s.factorizations, 0);
   EXPECT_EQ(get(), 2);
   set(before);
+}
+
+// CHOLMOD opens its OpenMP regions with libgomp's GOMP_parallel. While a SerialOpenMp lives, a
+// region (called the way CHOLMOD calls it, through the process's symbol) runs its body once on
+// this thread without making a team, so nothing wakes other threads and no barrier ends it;
+// otherwise the call reaches libgomp, which runs a team of the threads asked for.
+TEST(StaticSolver, OpenMpRegionsRunWithoutATeamWhileSerial) {
+  using Body = void (*)(void*);
+  auto parallel =
+      reinterpret_cast<void (*)(Body, void*, unsigned, unsigned)>(dlsym(RTLD_DEFAULT, "GOMP_parallel"));
+  auto level = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_level"));
+  ASSERT_NE(parallel, nullptr);
+  struct Seen {
+    int (*level)();
+    std::atomic<int> calls{0};
+    std::atomic<int> deepest{-1};
+  } seen{level};
+  const Body body = [](void* data) {
+    auto* s = static_cast<Seen*>(data);
+    ++s->calls;
+    const int l = s->level != nullptr ? s->level() : 0;
+    int d = s->deepest.load();
+    while (l > d && !s->deepest.compare_exchange_weak(d, l)) {
+    }
+  };
+  {
+    const SerialOpenMp serial;
+    parallel(body, &seen, 4, 0);
+  }
+  EXPECT_EQ(seen.calls.load(), 1);
+  EXPECT_EQ(seen.deepest.load(), 0);  // not inside any region, not even an inactive one
+  if (level == nullptr) GTEST_SKIP() << "no OpenMP runtime in this process";
+  seen.calls = 0;
+  seen.deepest = -1;
+  parallel(body, &seen, 2, 0);  // the guard is gone: libgomp's team of two
+  EXPECT_EQ(seen.calls.load(), 2);
+  EXPECT_EQ(seen.deepest.load(), 1);
 }
 
 TEST(StaticSolver, BadInputIsRefused) {

@@ -44,7 +44,10 @@ SerialOpenMp::~SerialOpenMp() {
 extern "C" void GOMP_parallel(void (*fn)(void*), void* data, unsigned num_threads, unsigned flags) {
   using Entry = void (*)(void (*)(void*), void*, unsigned, unsigned);
   static const Entry next = reinterpret_cast<Entry>(dlsym(RTLD_NEXT, "GOMP_parallel"));
-  if (textile::serial_depth > 0 || next == nullptr) {
+  static const auto level = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_level"));
+  // Only outside every region: inside one, omp_get_num_threads() would be the enclosing team's,
+  // and the body would do only its share of the work; libgomp's inactive team of one is right.
+  if (next == nullptr || (textile::serial_depth > 0 && (level == nullptr || level() == 0))) {
     fn(data);  // a team of one: this thread, outside any region
     return;
   }

@@ -15,7 +15,8 @@
 // CHOLMOD's calls reach it. Inside a SerialOpenMp it calls the region's body once on this
 // thread, as a team of one would: outside any region omp_get_num_threads() is 1 and
 // omp_get_thread_num() 0, which is all CHOLMOD's regions ask (its only other OpenMP imports).
-// Elsewhere, and on other threads, it hands the call to libgomp (the next definition). Measured
+// Elsewhere, on other threads, and inside a caller's own region (where those would answer for
+// the enclosing team), it hands the call to libgomp (the next definition). Measured
 // in docs/benchmarks.md, "OpenMP teams of one".
 //
 // The max-active-levels setting (a per-thread ICV in libgomp, restored at the end) stays as

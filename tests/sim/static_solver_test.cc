@@ -295,6 +295,46 @@ TEST(StaticSolver, OpenMpRegionsRunWithoutATeamWhileSerial) {
   EXPECT_EQ(seen.deepest.load(), 1);
 }
 
+// Inside a caller's own OpenMP team, a serial region still runs every iteration on each thread:
+// the body sees a team of one (libgomp's inactive region), not the enclosing team, whose size
+// would make CHOLMOD's statically scheduled loops do only this thread's share.
+struct NestedRun {
+  void (*parallel)(void (*)(void*), void*, unsigned, unsigned);
+  int (*num_threads)();
+  std::atomic<int> outer{0};
+  std::atomic<int> inner{0};
+  std::atomic<int> widest{0};  // the largest team size an inner body saw
+};
+
+void InnerBody(void* data) {
+  auto* run = static_cast<NestedRun*>(data);
+  ++run->inner;
+  const int n = run->num_threads();
+  int w = run->widest.load();
+  while (n > w && !run->widest.compare_exchange_weak(w, n)) {
+  }
+}
+
+void OuterBody(void* data) {
+  auto* run = static_cast<NestedRun*>(data);
+  ++run->outer;
+  const SerialOpenMp serial;
+  run->parallel(InnerBody, data, 4, 0);
+}
+
+TEST(StaticSolver, SerialRegionsInsideACallersTeamSeeATeamOfOne) {
+  NestedRun run;
+  run.parallel = reinterpret_cast<void (*)(void (*)(void*), void*, unsigned, unsigned)>(
+      dlsym(RTLD_DEFAULT, "GOMP_parallel"));
+  run.num_threads = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_num_threads"));
+  if (run.parallel == nullptr || run.num_threads == nullptr)
+    GTEST_SKIP() << "no OpenMP runtime in this process";
+  run.parallel(OuterBody, &run, 2, 0);
+  EXPECT_EQ(run.outer.load(), 2);
+  EXPECT_EQ(run.inner.load(), 2);   // one inner region per outer thread
+  EXPECT_EQ(run.widest.load(), 1);  // each a team of one
+}
+
 TEST(StaticSolver, BadInputIsRefused) {
   HangingSheet sheet;
   Vertices wrong(3, 3);

@@ -290,8 +290,10 @@ TEST(StaticSolver, OpenMpRegionsRunWithoutATeamWhileSerial) {
   if (level == nullptr) GTEST_SKIP() << "no OpenMP runtime in this process";
   seen.calls = 0;
   seen.deepest = -1;
-  parallel(body, &seen, 2, 0);  // the guard is gone: libgomp's team of two
-  EXPECT_EQ(seen.calls.load(), 2);
+  // The guard is gone: libgomp's team, of two unless OMP_THREAD_LIMIT or OMP_DYNAMIC give fewer.
+  parallel(body, &seen, 2, 0);
+  EXPECT_GE(seen.calls.load(), 1);
+  EXPECT_LE(seen.calls.load(), 2);
   EXPECT_EQ(seen.deepest.load(), 1);
 }
 
@@ -329,10 +331,11 @@ TEST(StaticSolver, SerialRegionsInsideACallersTeamSeeATeamOfOne) {
   run.num_threads = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_num_threads"));
   if (run.parallel == nullptr || run.num_threads == nullptr)
     GTEST_SKIP() << "no OpenMP runtime in this process";
+  // A team of two (with OMP_THREAD_LIMIT=1 one thread, and the check is then a weak one).
   run.parallel(OuterBody, &run, 2, 0);
-  EXPECT_EQ(run.outer.load(), 2);
-  EXPECT_EQ(run.inner.load(), 2);   // one inner region per outer thread
-  EXPECT_EQ(run.widest.load(), 1);  // each a team of one
+  EXPECT_GE(run.outer.load(), 1);
+  EXPECT_EQ(run.inner.load(), run.outer.load());  // one inner region per outer thread
+  EXPECT_EQ(run.widest.load(), 1);                // each a team of one
 }
 
 TEST(StaticSolver, BadInputIsRefused) {

@@ -39,8 +39,8 @@ double CentreHeight(const ClothProblem& p, const Vertices& x, const Eigen::Vecto
 // Solves A d = b with CHOLMOD (shifting the diagonal when A is singular) or with conjugate
 // gradients. The sparsity of A is the same on every call, so CHOLMOD analyses it once.
 // CHOLMOD reads A's upper triangle: its supernodal factorisation permutes an upper-stored
-// matrix with one transpose and a lower-stored one with two (cholmod_factorize.c); the second
-// was 1.8 % of a default drape's samples.
+// matrix with one transpose and a lower-stored one with two (cholmod_factorize.c): the
+// transposes took 5.5 % of a default drape's samples with two, 3.8 % with one.
 class LinearSolver {
  public:
   explicit LinearSolver(const SolveOptions& options) {

@@ -181,13 +181,16 @@ struct IsotropicEigenvalues {
 
 // h (= ∂²ψ/∂F²) with its negative eigenvalues clamped to zero, from the eigensystem above instead
 // of a 6×6 eigen-solve (8 % of a drape's samples): each negative eigenpair is taken out of h.
-// Near-degenerate triangles (σ2 under 1e-6 σ1, where u2 is ill-defined) take the eigen-solve.
+// σ2 is J/σ1 (J = |f1 × f2| = σ1 σ2), not the root of FᵀF's smaller eigenvalue, which loses
+// eps (σ1/σ2)² of it to cancellation: at σ2 = 1e-5 σ1 the corotational ψ2/σ2 came out so far off
+// that the "projected" matrix had an eigenvalue of −0.18 × 2μ. Triangles collapsed to under
+// 1e-6 σ1 take the eigen-solve.
 template <typename Eigenvalues>
 Mat6 ProjectIsotropicPsd(const Mat32& f, const Mat6& h, Eigenvalues eigenvalues) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> cauchy_green;
   cauchy_green.computeDirect(f.transpose() * f);  // eigenvalues σi² in increasing order
-  const double small = std::sqrt(std::max(cauchy_green.eigenvalues()(0), 0.0));
   const double large = std::sqrt(std::max(cauchy_green.eigenvalues()(1), 0.0));
+  const double small = f.col(0).cross(f.col(1)).norm() / large;  // NaN when F = 0: eigen-solve
   if (!(small > 1e-6 * large)) return ProjectPsd(h);
   const double sigma[2] = {large, small};
   const Eigen::Vector2d v[2] = {cauchy_green.eigenvectors().col(1), cauchy_green.eigenvectors().col(0)};

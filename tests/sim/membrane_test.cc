@@ -306,6 +306,8 @@ TEST(Membrane, ProjectionIsTheEigenSolvesClampedMatrix) {
       // F = R diag(σ1, σ2) Vᵀ: σ from 0.5 to 1.2, nearly 0 or equal in some trials.
       double s1 = 0.85 + 0.35 * unit(rng), s2 = 0.85 + 0.35 * unit(rng);
       if (trial % 10 == 3) s2 = 1e-3;
+      if (trial % 10 == 5) s2 = trial < 30 ? 1e-5 : 2e-6;  // nearly collapsed
+      if (trial % 10 == 9) s2 = trial < 30 ? 0.0 : 5e-7;   // collapsed: the eigen-solve
       if (trial % 10 == 7) s2 = s1;
       const Eigen::Matrix3d r =
           Eigen::AngleAxisd(3.0 * unit(rng), Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized())

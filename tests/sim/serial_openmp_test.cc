@@ -1,12 +1,19 @@
 #include "serial_openmp.h"
 
+#include <dlfcn.h>
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <dlfcn.h>
 
 namespace textile {
 namespace {
+
+// *largest = max(*largest, value), from any thread.
+void RaiseTo(std::atomic<int>* largest, int value) {
+  int seen = largest->load();
+  while (value > seen && !largest->compare_exchange_weak(seen, value)) {
+  }
+}
 
 // CHOLMOD opens its OpenMP regions with libgomp's GOMP_parallel. While a SerialOpenMp lives, a
 // region (called the way CHOLMOD calls it, through the process's symbol) runs its body once on
@@ -14,8 +21,8 @@ namespace {
 // otherwise the call reaches libgomp, which runs a team of the threads asked for.
 TEST(SerialOpenMp, RegionsRunWithoutATeamWhileSerial) {
   using Body = void (*)(void*);
-  auto parallel =
-      reinterpret_cast<void (*)(Body, void*, unsigned, unsigned)>(dlsym(RTLD_DEFAULT, "GOMP_parallel"));
+  auto parallel = reinterpret_cast<void (*)(Body, void*, unsigned, unsigned)>(
+      dlsym(RTLD_DEFAULT, "GOMP_parallel"));
   auto level = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_level"));
   ASSERT_NE(parallel, nullptr);
   struct Seen {
@@ -26,10 +33,7 @@ TEST(SerialOpenMp, RegionsRunWithoutATeamWhileSerial) {
   const Body body = [](void* data) {
     auto* s = static_cast<Seen*>(data);
     ++s->calls;
-    const int l = s->level != nullptr ? s->level() : 0;
-    int d = s->deepest.load();
-    while (l > d && !s->deepest.compare_exchange_weak(d, l)) {
-    }
+    RaiseTo(&s->deepest, s->level != nullptr ? s->level() : 0);
   };
   {
     const SerialOpenMp serial;
@@ -61,10 +65,7 @@ struct NestedRun {
 void InnerBody(void* data) {
   auto* run = static_cast<NestedRun*>(data);
   ++run->inner;
-  const int n = run->num_threads();
-  int w = run->widest.load();
-  while (n > w && !run->widest.compare_exchange_weak(w, n)) {
-  }
+  RaiseTo(&run->widest, run->num_threads());
 }
 
 void OuterBody(void* data) {
@@ -86,7 +87,8 @@ TEST(SerialOpenMp, RegionsInsideACallersTeamSeeATeamOfOne) {
   EXPECT_EQ(run.widest.load(), 1);                // each a team of one
   // With a team of one the direct call would see one thread too: nothing was checked.
   if (run.outer.load() < 2)
-    GTEST_SKIP() << "libgomp gave a team of one (OMP_THREAD_LIMIT, OMP_DYNAMIC or OMP_MAX_ACTIVE_LEVELS)";
+    GTEST_SKIP()
+        << "libgomp gave a team of one (OMP_THREAD_LIMIT, OMP_DYNAMIC or OMP_MAX_ACTIVE_LEVELS)";
 }
 
 }  // namespace

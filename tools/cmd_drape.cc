@@ -322,8 +322,6 @@ void Run(const DrapeArgs& a) {
                                     rim_if_extrapolating > 0.0 && o.rim_band >= rim_if_extrapolating;
   o.rim_extrapolation = a.extrapolate || (!a.no_extrapolate && extrapolate_possible);
   if (a.rim_mm == "auto") o.rim_element_size = AutoRimElementSize(m, o, o.rim_extrapolation);
-  // The resting mount settles only without the rim band (docs/drapemeter.md, "Limits").
-  if (a.rim_mm == "auto" && o.mount == DrapeMount::kResting) o.rim_element_size = 0.0;
   if (std::string why; !o.Check(&why)) throw InputError("drape: " + why);
   const double rim_size = o.rim_element_size > 0.0 ? o.rim_element_size : o.element_size;
   std::string note;  // reported with the result (a refused run prints its one error line only)
@@ -344,12 +342,6 @@ void Run(const DrapeArgs& a) {
   if (!a.obj.empty()) obj_file.emplace(a.obj);
 
   o.progress = [](const std::string& line) { Info("drape: " + line); };
-  if (o.mount == DrapeMount::kResting) {
-    Info("drape: note: the resting mount is experimental: it settles where friction holds the "
-         "specimen (a material \"friction\" of 3; no rim band, which --rim-mm auto leaves out "
-         "here), not with the samples' 0.3; a run that does not settle ends at --max-seconds or "
-         "the step cap with exit 3 (docs/drapemeter.md, \"Limits\")");
-  }
   DrapeResult r;
   try {
     r = SimulateDrape(m, o);
@@ -433,8 +425,8 @@ void RegisterDrape(CLI::App& app) {
   sub->add_option("--seam-rib", a->seam_rib,
                   "Lengthwise stiffness of the seam band as a factor on S (>= 1; default the "
                   "seam file's rib_factor, 1 for the presets: the paper's model; docs/seams.md)");
-  sub->add_option("--mount", a->mount, "clamped (default: held between two disks) or resting (friction; experimental, "
-                  "settles only with high friction; no rim band by default)");
+  sub->add_option("--mount", a->mount, "clamped (default: held between two disks) or resting (lies on the disk, "
+                  "held by Coulomb friction, the material's friction; one solve, never extrapolated)");
   sub->add_option("--seeds", a->seeds, "Number of perturbations (repeated tests; default 1)");
   sub->add_option("--first-seed", a->first_seed, "First seed (default 1)");
   sub->add_option("--resolution-mm", a->resolution_mm, "Element size away from seams [mm] (default 12)");

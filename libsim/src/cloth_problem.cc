@@ -305,8 +305,15 @@ double ClothProblem::ContactEnergyGradient(const Vertices& x, Vertices* grad) co
     } else if (a.support >= 0) {
       const Eigen::Vector3d d = p - a.point;
       const Eigen::Vector3d dt = d - a.normal * a.normal.dot(d);
-      energy += 0.5 * kt * dt.squaredNorm();
-      if (grad) grad->row(i) += kt * dt.transpose();
+      const double s = dt.norm();
+      const double stick = a.friction_force / kt;  // friction_potential: the spring's reach [m]
+      if (!options_.contact.friction_potential || s <= stick) {
+        energy += 0.5 * kt * dt.squaredNorm();
+        if (grad) grad->row(i) += kt * dt.transpose();
+      } else {
+        energy += a.friction_force * (s - 0.5 * stick);
+        if (grad) grad->row(i) += (a.friction_force / s) * dt.transpose();
+      }
     }
   }
   return energy;
@@ -373,9 +380,18 @@ const Eigen::SparseMatrix<double>& ClothProblem::Hessian(const Vertices& x,
         if (s.SignedDistance(p, &n) < 0.0) block += penalty_(i) * n * n.transpose();
       }
       const Anchor& a = anchors_[i];
-      if (a.support >= 0 && !a.sliding)
-        block += tangential_stiffness_ *
-                 (Eigen::Matrix3d::Identity() - a.normal * a.normal.transpose());
+      if (a.support >= 0 && !a.sliding) {
+        const Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity() - a.normal * a.normal.transpose();
+        const Eigen::Vector3d dt = tangent * (p - a.point);
+        const double s = dt.norm();
+        if (!options_.contact.friction_potential || s * tangential_stiffness_ <= a.friction_force) {
+          block += tangential_stiffness_ * tangent;
+        } else {
+          // μ f̄_n s: the norm's curvature, across the slip only.
+          const Eigen::Vector3d t = dt / s;
+          block += (a.friction_force / s) * (tangent - t * t.transpose());
+        }
+      }
       if (block.isZero(0.0)) continue;
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c) values[diagonal_block_slot_[9 * i + 3 * r + c]] += block(r, c);
@@ -449,6 +465,12 @@ double ClothProblem::UpdateAnchors(const Vertices& x, const Vertices& previous) 
     // A node that stopped sliding must be pulled 5 % past the limit to slide again: without
     // this hysteresis a node at the limit can flip between the two states forever.
     const double margin = a.stopped ? 1.05 : 1.0 + 1e-6;
+    if (options_.contact.friction_potential) {
+      // The anchor stays where the contact began; only the lagged normal force follows.
+      a.friction_force = limit;
+      a.support = s;
+      continue;
+    }
     if (!options_.contact.lagged_slip && tangential > limit * margin && dt.norm() > 0.0) {
       // The spring pulls harder than friction can hold: it slides (Coulomb), from now on
       // against a constant force μ f_n.

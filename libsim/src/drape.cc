@@ -184,8 +184,10 @@ std::unique_ptr<ClothProblem> MakeProblem(const Pattern& p, const Material& mate
                                           const std::vector<Seam>& seams, const DrapeOptions& o) {
   ClothOptions co;
   co.contact.friction = material.friction;
-  // Resting mount: slip between converged stretches (contact.h); per-step switching cycled.
-  co.contact.lagged_slip = o.mount == DrapeMount::kResting;
+  // Resting mount: Coulomb friction as a potential with lagged normal forces (contact.h).
+  // Slip between converged stretches (lagged_slip) settled only with μ = 3 and without the rim
+  // band, per-step stick/slip switching not at all (docs/drapemeter.md, "Limits").
+  co.contact.friction_potential = o.mount == DrapeMount::kResting;
   auto problem = std::make_unique<ClothProblem>(p.pm.mesh, material, seams, co);
   if (o.mount == DrapeMount::kClamped) {
     Vertices held(static_cast<long>(p.clamp.size()), 3);

@@ -305,29 +305,31 @@ TEST(Drape, RimExtrapolationSplitsTheRimAndExtrapolates) {
   EXPECT_EQ(why.rfind("rim_extrapolation: clamped mount only", 0), 0u) << why;
 }
 
-// The resting mount (lagged slip, anchors fixed on the support; contact.h): with friction
-// enough to hold it, the specimen settles close to the clamped drape. Measured on this mesh,
-// μ = 3: DC 0.491 against 0.509 clamped, outline 105.4-139.1 mm, 621 Newton steps. With the
-// per-step stick/slip switching and anchors that crept after their nodes on the rounded rim
-// it never settled (residual 1e-3 after 3000 steps). With μ = 0.3 it still slides
-// (docs/drapemeter.md, "Limits").
-TEST(Drape, RestingSpecimenWithEnoughFrictionSettlesNearTheClampedDrape) {
-  Material grippy = Fig8();
-  grippy.friction = 3.0;
+// The resting mount (ContactOptions::friction_potential: Coulomb friction as a potential from
+// where each node landed, lagged normal forces): with the samples' μ = 0.3 the specimen settles
+// on the disk, and less friction lets more of it slide out over the rim. Measured on this mesh,
+// seed 1: DC 0.564 (μ = 0.3, 72 steps), 0.384 (μ = 0.1), 0.576 (μ = 3); clamped 0.509. Slip
+// between converged stretches (lagged_slip) settled here only with μ = 3 (DC 0.491, 621 steps)
+// and per-step stick/slip switching never (docs/drapemeter.md, "Limits").
+TEST(Drape, RestingSpecimenSettlesWithTheSamplesFrictionAndLessFrictionLetsItSlideOut) {
   DrapeOptions o = Coarse();
   o.mount = DrapeMount::kResting;
-  const DrapeResult r = SimulateDrape(grippy, o);
+  const DrapeResult r = SimulateDrape(Fig8(), o);
   ASSERT_TRUE(r.converged) << r.message;
-  const DrapeResult& clamped = PlainDrape();
-  EXPECT_NEAR(r.drape_coefficient, clamped.drape_coefficient, 0.05);
   EXPECT_GT(r.drape_coefficient, 0.0);
   EXPECT_LT(r.drape_coefficient, 1.0);
   // Nothing slid over the rim: the outline stays outside the support, as the clamped one does.
-  EXPECT_GT(r.min_radius, o.support_radius + 0.005);
+  EXPECT_GT(r.min_radius, o.support_radius + 0.01);
   EXPECT_NEAR(r.mass, 0.2 * r.specimen_area, 1e-9);
   ASSERT_EQ(r.per_seed.size(), 1u);
   EXPECT_GT(r.per_seed[0].summary.contacts, 0);
-  EXPECT_GT(r.per_seed[0].summary.slips, 0);  // the friction did work: some anchors slipped
+  EXPECT_EQ(r.per_seed[0].summary.slips, 0);  // the potential needs no slip moves
+  Material slippery = Fig8();
+  slippery.friction = 0.1;
+  const DrapeResult s = SimulateDrape(slippery, o);
+  ASSERT_TRUE(s.converged) << s.message;
+  EXPECT_LT(s.drape_coefficient, r.drape_coefficient - 0.05);
+  EXPECT_LT(s.min_radius, r.min_radius);
 }
 
 // The drape's Newton doubles full steps that lower the energy (expand_steps, on for drapes)

@@ -294,10 +294,12 @@ struct SheetOnSlope {
   std::unique_ptr<ClothProblem> problem;
   Vertices start;
   Eigen::Vector3d downhill;
-  explicit SheetOnSlope(double degrees, double friction, bool lagged_slip = false) {
+  explicit SheetOnSlope(double degrees, double friction, bool lagged_slip = false,
+                        bool friction_potential = false) {
     ClothOptions options;
     options.contact.friction = friction;
     options.contact.lagged_slip = lagged_slip;
+    options.contact.friction_potential = friction_potential;
     problem = std::make_unique<ClothProblem>(mesh, Cotton(), std::vector<Seam>{}, options);
     const double a = degrees * M_PI / 180.0;
     const Eigen::Vector3d normal(-std::sin(a), 0.0, std::cos(a));
@@ -394,6 +396,40 @@ TEST(StaticSolver, LaggedSlipHoldsBelowTheFrictionAngleAndSlidesAbove) {
     c.slip_excess = bad;
     EXPECT_FALSE(c.Check(&why)) << bad;
     EXPECT_EQ(why, "contact slip_excess must lie in [0, 1]");
+  }
+}
+
+TEST(StaticSolver, FrictionPotentialHoldsBelowTheFrictionAngleAndSlidesAbove) {
+  // ContactOptions::friction_potential: a Huber potential from where each node landed, its
+  // slope capped at the lagged μ f̄_n. Below the friction angle (atan 0.3 = 16.7°) the sheet
+  // has a minimum and stays put; past it the energy falls without bound as it slides.
+  const double mu = 0.3;
+  {
+    SheetOnSlope slope(10.0, mu, false, true);
+    Vertices x = slope.start;
+    const SolveSummary s = SolveStatic(slope.problem.get(), &x, {});
+    ASSERT_TRUE(s.converged) << s.BriefReport();
+    EXPECT_EQ(s.contacts, slope.mesh.num_vertices());
+    EXPECT_EQ(s.slips, 0);  // no slip moves: the potential holds it
+    EXPECT_LT(std::abs(slope.Slid(x)), 1e-4);
+  }
+  for (double degrees : {18.0, 25.0}) {
+    SCOPED_TRACE(std::to_string(degrees) + "°");
+    SheetOnSlope slope(degrees, mu, false, true);
+    Vertices x = slope.start;
+    SolveOptions options;
+    options.max_iterations = 100;
+    const SolveSummary s = SolveStatic(slope.problem.get(), &x, options);
+    EXPECT_FALSE(s.converged) << s.BriefReport();
+    EXPECT_GT(slope.Slid(x), 1e-2) << s.BriefReport();
+  }
+  {  // Without friction the potential is nothing: it slides on any slope.
+    SheetOnSlope slope(5.0, 0.0, false, true);
+    Vertices x = slope.start;
+    SolveOptions options;
+    options.max_iterations = 50;
+    EXPECT_FALSE(SolveStatic(slope.problem.get(), &x, options).converged);
+    EXPECT_GT(slope.Slid(x), 1e-2);
   }
 }
 
@@ -553,6 +589,76 @@ TEST(ClothProblem, GradientAndHessianMatchFiniteDifferencesWithContactAndAnchors
     const Eigen::Map<const Eigen::VectorXd> fp(gp.data(), gp.size()), fm(gm.data(), gm.size());
     const Eigen::VectorXd column = (fp - fm) / (2 * h);
     EXPECT_LT((hess.col(j) - column).cwiseAbs().maxCoeff(), 1e-4 * (1.0 + column.cwiseAbs().maxCoeff()))
+        << "column " << j;
+  }
+}
+
+// The friction potential's terms (ContactOptions::friction_potential) against finite
+// differences, isolated as the difference to the same problem with plain anchor springs (whose
+// terms the test above checks). k_t = 1 N/m makes the stick radius μ f̄_n / k_t 0.1-2 mm here,
+// so the vertices left where they were anchored stick and the ones moved 3.6 mm slide.
+TEST(ClothProblem, FrictionPotentialMatchesFiniteDifferencesStickingAndSliding) {
+  const TriangleMesh mesh = CrissCrossGridMesh(0.05, 0.05, 3, 3);
+  ClothOptions springs;
+  springs.membrane = MembraneModel::kStVK;
+  springs.contact.tangential_ratio = 1e-3;  // k_t = 1 N/m
+  ClothOptions potential = springs;
+  potential.contact.friction_potential = true;
+  ClothProblem quadratic(mesh, Cotton(), {}, springs), huber(mesh, Cotton(), {}, potential);
+  for (ClothProblem* p : {&quadratic, &huber}) p->AddSupport(Support::Plane({0, 0, 0}, {0, 0, 1}));
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Vertices x = mesh.vertices;
+  for (int i = 0; i < x.rows(); ++i) {
+    x.row(i) += 2e-3 * Eigen::RowVector3d(u(rng), u(rng), 0.0);
+    x(i, 2) = -2e-4 * std::abs(u(rng)) - 1e-5;  // every node inside the plane
+  }
+  for (ClothProblem* p : {&quadratic, &huber}) {
+    p->UpdateAnchors(x, x);  // anchors where the nodes are
+    p->UpdateAnchors(x, x);  // the potential's lagged normal forces from x
+    ASSERT_EQ(p->num_anchors(), mesh.num_vertices());
+  }
+  // Where no node has moved from its anchor, the two energies are the same.
+  EXPECT_NEAR(huber.Energy(x), quadratic.Energy(x), 1e-15);
+  Vertices moved = x;
+  for (int i = 0; i < x.rows(); ++i)
+    moved.row(i) += i % 2 == 0 ? Eigen::RowVector3d(3e-3, 2e-3, 0.0) : Eigen::RowVector3d(2e-5, -1e-5, 0.0);
+  const auto difference = [&](const Vertices& y) { return huber.Energy(y) - quadratic.Energy(y); };
+  // Past the stick radius the potential grows linearly, below the spring's parabola.
+  EXPECT_LT(difference(moved), -1e-7);
+  Vertices gh, gq;
+  huber.EnergyGradient(moved, &gh);
+  quadratic.EnergyGradient(moved, &gq);
+  const Vertices grad = gh - gq;
+  const double h = 1e-7;
+  for (int i = 0; i < moved.rows(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      Vertices plus = moved, minus = moved;
+      plus(i, c) += h;
+      minus(i, c) -= h;
+      const double fd = (difference(plus) - difference(minus)) / (2 * h);
+      EXPECT_NEAR(grad(i, c), fd, 1e-8 + 1e-5 * std::abs(fd)) << "vertex " << i << " coord " << c;
+    }
+  }
+  // The sliding nodes pull with μ f̄_n at most: the difference's force on a moved node is the
+  // spring's excess over it, non-zero.
+  EXPECT_GT(grad.row(0).norm(), 1e-6);
+  EXPECT_LT(grad.row(1).norm(), 1e-12);  // a sticking node: the spring itself
+  const Eigen::MatrixXd hess = Eigen::MatrixXd(huber.Hessian(moved, HessianProjection::kNone)) -
+                               Eigen::MatrixXd(quadratic.Hessian(moved, HessianProjection::kNone));
+  for (int j = 0; j < 3 * moved.rows(); ++j) {
+    Vertices plus = moved, minus = moved;
+    plus(j / 3, j % 3) += h;
+    minus(j / 3, j % 3) -= h;
+    Vertices hp, hm, qp, qm;
+    huber.EnergyGradient(plus, &hp);
+    huber.EnergyGradient(minus, &hm);
+    quadratic.EnergyGradient(plus, &qp);
+    quadratic.EnergyGradient(minus, &qm);
+    const Vertices dp = hp - qp, dm = hm - qm;
+    const Eigen::Map<const Eigen::VectorXd> fp(dp.data(), dp.size()), fm(dm.data(), dm.size());
+    const Eigen::VectorXd column = (fp - fm) / (2 * h);
+    EXPECT_LT((hess.col(j) - column).cwiseAbs().maxCoeff(), 1e-6 + 1e-4 * column.cwiseAbs().maxCoeff())
         << "column " << j;
   }
 }

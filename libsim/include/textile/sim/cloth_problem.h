@@ -91,7 +91,9 @@ class ClothProblem {
   // anchor goes where the node was in `previous` (the state before the step that brought it into
   // contact), projected onto the support, so a step cannot slide a landing node for free.
   // Returns the largest slip of a sliding node since `previous` [m] (0 when every node sticks).
-  // With ContactOptions::lagged_slip no node slides here: touching nodes stick.
+  // With ContactOptions::lagged_slip no node slides here: touching nodes stick. With
+  // ContactOptions::friction_potential anchors never move (0 is returned); each touching node's
+  // lagged normal force f̄_n is set from x, which changes the energy (anchor_version).
   double UpdateAnchors(const Vertices& x, const Vertices& previous);
   // ContactOptions::lagged_slip, between converged stretches of a solve: moves the anchor of
   // every node whose spring pulls more than slip_excess of μ f_n past μ f_n (Coulomb) along the
@@ -100,7 +102,8 @@ class ClothProblem {
   // every node holds).
   double SlipAnchors(const Vertices& x);
   bool lagged_slip() const {
-    return options_.contact.lagged_slip && options_.contact.friction > 0.0 && !supports_.empty();
+    return options_.contact.lagged_slip && !options_.contact.friction_potential &&
+           options_.contact.friction > 0.0 && !supports_.empty();
   }
   void ClearAnchors();
   int num_anchors() const;
@@ -140,7 +143,7 @@ class ClothProblem {
     Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
     bool sliding = false;
     Eigen::Vector3d slip = Eigen::Vector3d::Zero();  // sliding: unit slip direction
-    double friction_force = 0.0;                     // sliding: μ f_n [N]
+    double friction_force = 0.0;  // sliding, and friction_potential's μ f̄_n: μ f_n [N]
     bool stopped = false;  // it slid and stopped since contact began (hysteresis)
     Eigen::Vector3d last_slip = Eigen::Vector3d::Zero();  // lagged slip: the last unpaired slip [m]
   };

@@ -78,6 +78,16 @@ struct ContactOptions {
   // (plus 1e-4 of its weight, for nodes with next to no normal force) [-]; 1 % is well inside
   // what μ is known to.
   double slip_excess = 0.01;
+  // Friction as a potential (the drape's resting mount): each touching node is tied to the
+  // point where its contact began by a Huber function of its tangential offset s, ½ k_t s² up
+  // to s = μ f̄_n / k_t and μ f̄_n (s − μ f̄_n / 2 k_t) beyond, so the force it feels is the
+  // stiff anchor spring while it sticks and a constant μ f̄_n back towards its start once it
+  // slides, never more. f̄_n is the node's normal force at the last accepted state (lagged, as
+  // in Li et al. 2020, "Incremental Potential Contact"), so each Newton step sees one convex
+  // potential and the solve needs no slip moves; at convergence f̄_n is the state's own. The
+  // slip is measured from where the contact began, which is the drape's monotone loading.
+  // Overrides lagged_slip.
+  bool friction_potential = false;
 
   bool Check(std::string* why) const;
 };

@@ -426,7 +426,7 @@ void RegisterDrape(CLI::App& app) {
                   "Lengthwise stiffness of the seam band as a factor on S (>= 1; default the "
                   "seam file's rib_factor, 1 for the presets: the paper's model; docs/seams.md)");
   sub->add_option("--mount", a->mount, "clamped (default: held between two disks) or resting (lies on the disk, "
-                  "held by Coulomb friction, the material's friction; one solve, never extrapolated)");
+                  "held by Coulomb friction, the material's friction; one solve unless --extrapolate)");
   sub->add_option("--seeds", a->seeds, "Number of perturbations (repeated tests; default 1)");
   sub->add_option("--first-seed", a->first_seed, "First seed (default 1)");
   sub->add_option("--resolution-mm", a->resolution_mm, "Element size away from seams [mm] (default 12)");

@@ -551,6 +551,34 @@ double ClothProblem::ContactStepLimit(const Vertices& x, const Eigen::VectorXd& 
   return alpha;
 }
 
+void ClothProblem::CarryAnchorsFrom(const ClothProblem& coarse,
+                                    const std::vector<std::array<int, 2>>& parents) {
+  const int old = coarse.num_vertices();
+  if (old + static_cast<long>(parents.size()) != num_vertices() ||
+      coarse.supports_.size() != supports_.size())
+    throw InputError("carried anchors: the mesh is not a refinement of the coarse one (" +
+                     std::to_string(old) + " + " + std::to_string(parents.size()) + " vertices against " +
+                     std::to_string(num_vertices()) + ")");
+  ++anchor_version_;
+  for (int i = 0; i < old; ++i) anchors_[i] = is_fixed_[i] ? Anchor{} : coarse.anchors_[i];
+  for (size_t k = 0; k < parents.size(); ++k) {
+    Anchor& a = anchors_[old + static_cast<int>(k)];
+    a = Anchor{};
+    const auto [i, j] = parents[k];
+    if (i < 0 || j < 0 || i >= old || j >= old)
+      throw InputError("carried anchors: a split point's parent is not a coarse vertex");
+    const Anchor& ai = coarse.anchors_[i];
+    const Anchor& aj = coarse.anchors_[j];
+    if (is_fixed_[old + k] || ai.support < 0 || ai.support != aj.support || ai.sliding || aj.sliding) continue;
+    Eigen::Vector3d n;
+    Eigen::Vector3d point = 0.5 * (ai.point + aj.point);
+    point -= supports_[ai.support].SignedDistance(point, &n) * n;
+    a.support = ai.support;
+    a.point = point;
+    a.normal = n;
+  }
+}
+
 void ClothProblem::ClearAnchors() {
   ++anchor_version_;
   for (Anchor& a : anchors_) a.support = -1;

@@ -288,8 +288,6 @@ bool DrapeOptions::Check(std::string* why) const {
     return Fail(why, "rim_element_size: below 0.1 mm is not a drape mesh");
   if (!Finite(rim_band) || rim_band < 0.0 || rim_band > specimen_radius - support_radius)
     return Fail(why, "rim_band: must be in [0, the overhang]");
-  if (rim_extrapolation && mount != DrapeMount::kClamped)
-    return Fail(why, "rim_extrapolation: clamped mount only (a second solve would restart friction)");
   if (rim_extrapolation && rim_element_size == 0.0)
     return Fail(why, "rim_extrapolation: needs a rim band (rim_element_size > 0)");
   if (rim_extrapolation && rim_band < rim_element_size)
@@ -586,6 +584,8 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
       }
       auto split_problem = MakeProblem(*split, material, seams, o);
       seed.positions = refined.Prolong(seed.positions);
+      // Resting: the friction goes on from where each node landed on the base mesh.
+      if (o.mount == DrapeMount::kResting) split_problem->CarryAnchorsFrom(*fine_problem, refined.parents);
       // The carried-over drape is near the split mesh's equilibrium: the exact Hessian from the
       // first step (taken where it is positive definite) halved the steps (seed 2 of the Fig. 8
       // fabric: 104 → 52; docs/drapemeter.md, "Extrapolated DC").

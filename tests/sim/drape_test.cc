@@ -294,15 +294,16 @@ TEST(Drape, RimExtrapolationSplitsTheRimAndExtrapolates) {
   EXPECT_EQ(why, "rim_extrapolation: needs a rim band (rim_element_size > 0)");
   EXPECT_THROW(SimulateDrape(Fig8(), none), InputError);
   // A band narrower than one rim element would split little beyond the clamp (the DC would
-  // not converge towards anything); a resting specimen would restart its friction.
+  // not converge towards anything).
   none.rim_element_size = 0.005;
   none.rim_band = 0.004;
   EXPECT_FALSE(none.Check(&why));
   EXPECT_EQ(why, "rim_extrapolation: needs a rim band at least one rim element wide");
+  // The resting mount may extrapolate: its friction anchors go over to the split mesh
+  // (Drape.RestingSpecimenCarriesItsFrictionOverToTheSplitRim).
   none.rim_band = 0.02;
   none.mount = DrapeMount::kResting;
-  EXPECT_FALSE(none.Check(&why));
-  EXPECT_EQ(why.rfind("rim_extrapolation: clamped mount only", 0), 0u) << why;
+  EXPECT_TRUE(none.Check(&why)) << why;
 }
 
 // The resting mount (ContactOptions::friction_potential: Coulomb friction as a potential from
@@ -330,6 +331,27 @@ TEST(Drape, RestingSpecimenSettlesWithTheSamplesFrictionAndLessFrictionLetsItSli
   ASSERT_TRUE(s.converged) << s.message;
   EXPECT_LT(s.drape_coefficient, r.drape_coefficient - 0.05);
   EXPECT_LT(s.min_radius, r.min_radius);
+}
+
+// A resting specimen's rim split goes on with the base drape's friction (its anchors where the
+// nodes landed, ClothProblem::CarryAnchorsFrom) and extrapolates as a clamped one does.
+TEST(Drape, RestingSpecimenCarriesItsFrictionOverToTheSplitRim) {
+  DrapeOptions o = Coarse();
+  o.mount = DrapeMount::kResting;
+  o.rim_element_size = 0.006;
+  o.rim_extrapolation = true;
+  const DrapeResult r = SimulateDrape(Fig8(), o);
+  ASSERT_TRUE(r.converged) << r.message;
+  ASSERT_EQ(r.per_seed.size(), 1u);
+  const DrapeSeedResult& s = r.per_seed[0];
+  EXPECT_TRUE(s.split_summary.converged);
+  EXPECT_GT(s.split_summary.contacts, s.summary.contacts);  // the split mesh has more nodes there
+  EXPECT_NEAR(r.drape_coefficient, s.split_drape_coefficient + 0.5 * (s.split_drape_coefficient - s.base_drape_coefficient),
+              1e-12);
+  EXPECT_GT(r.drape_coefficient, 0.0);
+  EXPECT_LT(r.drape_coefficient, 1.0);
+  EXPECT_GT(r.min_radius, o.support_radius + 0.01);  // nothing slid over the rim
+  EXPECT_NEAR(r.mass, 0.2 * r.specimen_area, 1e-9);
 }
 
 // The drape's Newton doubles full steps that lower the energy (expand_steps, on for drapes)

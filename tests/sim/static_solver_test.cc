@@ -663,6 +663,39 @@ TEST(ClothProblem, FrictionPotentialMatchesFiniteDifferencesStickingAndSliding) 
   }
 }
 
+// After a refinement the finer problem takes over the friction anchors: the old vertices'
+// as they were, each split point's between its parents'. A node that has moved since it
+// landed then still pulls back towards where it landed, as on the coarse mesh.
+TEST(ClothProblem, CarriedAnchorsKeepTheFrictionHistoryOverARefinement) {
+  const TriangleMesh mesh = CrissCrossGridMesh(0.05, 0.05, 3, 3);
+  const RefinedMesh refined = RefineTriangles(mesh, std::vector<bool>(mesh.num_triangles(), true));
+  ClothOptions options;
+  options.contact.friction_potential = true;
+  ClothProblem coarse(mesh, Cotton(), {}, options);
+  ClothProblem carried(refined.mesh, Cotton(), {}, options), fresh(refined.mesh, Cotton(), {}, options);
+  for (ClothProblem* p : {&coarse, &carried, &fresh}) p->AddSupport(Support::Plane({0, 0, 0}, {0, 0, 1}));
+  Vertices x = mesh.vertices;
+  x.col(2).setConstant(-5e-5);  // every node pressed into the plane
+  coarse.UpdateAnchors(x, x);
+  ASSERT_EQ(coarse.num_anchors(), mesh.num_vertices());
+  Vertices moved = x;
+  moved.col(0).array() += 1e-3;  // slid 1 mm since landing
+  carried.CarryAnchorsFrom(coarse, refined.parents);
+  EXPECT_EQ(carried.num_anchors(), refined.mesh.num_vertices());
+  const Vertices fine = refined.Prolong(moved);
+  carried.UpdateAnchors(fine, fine);  // the lagged normal forces
+  fresh.UpdateAnchors(fine, fine);    // anchors where the nodes are now
+  fresh.UpdateAnchors(fine, fine);
+  // The carried anchors pull every node back by μ f_n: 1 mm × μ f_n of friction energy.
+  Vertices gc, gf;
+  const double ec = carried.EnergyGradient(fine, &gc), ef = fresh.EnergyGradient(fine, &gf);
+  EXPECT_GT(ec - ef, 0.5e-3 * 0.3 * 0.2 * 0.05 * 0.05 * 9.81 * 5.0);
+  EXPECT_GT((gc - gf).col(0).minCoeff(), 0.0);  // every node: an extra pull towards -x
+  // Sizes that are not this refinement's are refused.
+  std::vector<std::array<int, 2>> short_parents(refined.parents.begin(), refined.parents.end() - 1);
+  EXPECT_THROW(carried.CarryAnchorsFrom(coarse, short_parents), InputError);
+}
+
 TEST(ClothProblem, FixedVerticesHaveIdentityRowsAndZeroForce) {
   HangingSheet sheet;
   Vertices x = sheet.mesh.vertices;

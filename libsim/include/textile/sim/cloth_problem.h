@@ -29,6 +29,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -106,6 +107,13 @@ class ClothProblem {
            options_.contact.friction > 0.0 && !supports_.empty();
   }
   void ClearAnchors();
+  // After a mesh refinement (RefineTriangles), before solving on it: takes over `coarse`'s
+  // friction anchors for the old vertices (ids below coarse's #V); each split point gets the
+  // middle of its parents' anchors, put back on the support, when both have one on the same
+  // support (else its contact starts afresh). The lagged normal forces follow at the next
+  // UpdateAnchors. So the finer mesh goes on with the friction history instead of restarting it
+  // from where it lies. Throws InputError when the sizes do not fit a refinement of coarse.
+  void CarryAnchorsFrom(const ClothProblem& coarse, const std::vector<std::array<int, 2>>& parents);
   int num_anchors() const;
   // Incremented whenever an anchor is created, released or moved: the energy changed.
   long anchor_version() const { return anchor_version_; }

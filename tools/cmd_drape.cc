@@ -433,7 +433,7 @@ void RegisterDrape(CLI::App& app) {
   sub->add_option("--rim-mm", a->rim_mm,
                   "Element size along the support's rim [mm]; auto (the default): half the fabric's "
                   "turn-down length when extrapolating, else a third; 0: no finer rim and no "
-                  "extrapolation (10x faster, DC about 0.1 low; docs/drapemeter.md)");
+                  "extrapolation (10x faster; clamped: DC about 0.1 low; docs/drapemeter.md)");
   sub->add_option("--rim-band-mm", a->rim_band_mm,
                   "Width of that finer band beyond the rim [mm] (default 20)");
   sub->add_option("--specimen-mm", a->specimen_mm, "Specimen radius [mm] (default 150)");

@@ -11,6 +11,15 @@ namespace textile {
 
 // Lagged slip: the part of a node's weight it may pull past μ f_n even with no normal force.
 constexpr double kSlipFloor = 1e-4;
+// Friction potential: the lagged μ f̄_n and tangent plane follow the state after a Newton step
+// only where they are more than kLagTolerance off (relative; in the unit normal), and the k-th
+// update of a node goes 1 / (1 + k / kLagRelaxation) of the way. Set to the state's own after
+// every step, they made Newton chase a potential that moved with it: it cycled between two
+// states, f̄_n flipping by 0.1-0.3 % (15 mm mesh, seed 3); with the tolerance alone one run in
+// 14 still cycled (μ = 3 or μ = 1, depending on whether the plane followed), with the
+// relaxation none (docs/drapemeter.md, "Limits").
+constexpr double kLagTolerance = 0.01;
+constexpr double kLagRelaxation = 8.0;
 
 namespace {
 
@@ -287,6 +296,7 @@ double ClothProblem::ContactEnergyGradient(const Vertices& x, Vertices* grad) co
   if (supports_.empty()) return 0.0;  // a scene without obstacles pays nothing for contact
   double energy = 0.0;
   const double kt = tangential_stiffness_;
+  const bool potential = options_.contact.friction_potential;
   for (int i = 0; i < num_vertices(); ++i) {
     if (is_fixed_[i]) continue;
     const Eigen::Vector3d p = x.row(i).transpose();
@@ -302,12 +312,12 @@ double ClothProblem::ContactEnergyGradient(const Vertices& x, Vertices* grad) co
       // Sliding (Coulomb): a constant force of μ f_n against the slip, potential f t̂·x.
       energy += a.friction_force * a.slip.dot(p - a.point);
       if (grad) grad->row(i) += a.friction_force * a.slip.transpose();
-    } else if (a.support >= 0) {
+    } else if (a.support >= 0 && !(potential && a.friction_force <= 0.0)) {
       const Eigen::Vector3d d = p - a.point;
       const Eigen::Vector3d dt = d - a.normal * a.normal.dot(d);
       const double s = dt.norm();
       const double stick = a.friction_force / kt;  // friction_potential: the spring's reach [m]
-      if (!options_.contact.friction_potential || s <= stick) {
+      if (!potential || s <= stick) {
         energy += 0.5 * kt * dt.squaredNorm();
         if (grad) grad->row(i) += kt * dt.transpose();
       } else {
@@ -380,11 +390,12 @@ const Eigen::SparseMatrix<double>& ClothProblem::Hessian(const Vertices& x,
         if (s.SignedDistance(p, &n) < 0.0) block += penalty_(i) * n * n.transpose();
       }
       const Anchor& a = anchors_[i];
-      if (a.support >= 0 && !a.sliding) {
+      const bool potential = options_.contact.friction_potential;
+      if (a.support >= 0 && !a.sliding && !(potential && a.friction_force <= 0.0)) {
         const Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity() - a.normal * a.normal.transpose();
         const Eigen::Vector3d dt = tangent * (p - a.point);
         const double s = dt.norm();
-        if (!options_.contact.friction_potential || s * tangential_stiffness_ <= a.friction_force) {
+        if (!potential || s * tangential_stiffness_ <= a.friction_force) {
           block += tangential_stiffness_ * tangent;
         } else {
           // μ f̄_n s: the norm's curvature, across the slip only.
@@ -435,6 +446,22 @@ double ClothProblem::UpdateAnchors(const Vertices& x, const Vertices& previous) 
     }
     const Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity() - n * n.transpose();
     const double limit = mu * penalty_(i) * std::max(-phi, 0.0);  // μ f_n
+    if (options_.contact.friction_potential) {
+      if (a.support >= 0 && a.support != s) a.support = -1;  // another support: a new contact
+      if (a.support < 0) {
+        // Contact starts: anchored under where the node came from, its friction at once.
+        const Eigen::Vector3d before = previous.row(i).transpose();
+        Eigen::Vector3d n_before;
+        const double phi_before = supports_[s].SignedDistance(before, &n_before);
+        a = Anchor{s, before - phi_before * n_before, n, false, Eigen::Vector3d::Zero(), limit, false};
+        ++anchor_version_;
+        continue;
+      }
+      // The anchor stays where the contact began. The normal force and the tangent plane follow
+      // the state once they are more than kLagTolerance off.
+      UpdateLaggedFriction(i, -phi, n);
+      continue;
+    }
     ++anchor_version_;
     if (a.support >= 0 && a.support != s) a.support = -1;  // another support: a new contact
     if (a.support < 0) {  // contact starts: sticking, anchored under where the node came from
@@ -465,12 +492,6 @@ double ClothProblem::UpdateAnchors(const Vertices& x, const Vertices& previous) 
     // A node that stopped sliding must be pulled 5 % past the limit to slide again: without
     // this hysteresis a node at the limit can flip between the two states forever.
     const double margin = a.stopped ? 1.05 : 1.0 + 1e-6;
-    if (options_.contact.friction_potential) {
-      // The anchor stays where the contact began; only the lagged normal force follows.
-      a.friction_force = limit;
-      a.support = s;
-      continue;
-    }
     if (!options_.contact.lagged_slip && tangential > limit * margin && dt.norm() > 0.0) {
       // The spring pulls harder than friction can hold: it slides (Coulomb), from now on
       // against a constant force μ f_n.
@@ -489,6 +510,21 @@ double ClothProblem::UpdateAnchors(const Vertices& x, const Vertices& previous) 
     a.support = s;
   }
   return slid;
+}
+
+void ClothProblem::UpdateLaggedFriction(int i, double depth, const Eigen::Vector3d& normal) {
+  Anchor& a = anchors_[i];
+  const double limit = options_.contact.friction * penalty_(i) * std::max(depth, 0.0);  // μ f_n
+  const double larger = std::max(limit, a.friction_force);
+  const bool force_off = larger > 0.0 && std::abs(limit - a.friction_force) > kLagTolerance * larger;
+  const bool plane_off = (normal - a.normal).norm() > kLagTolerance;
+  if (!force_off && !plane_off) return;
+  // Relaxed: the k-th update of a node moves its lagged values 1 / (1 + k/8) of the way.
+  const double w = 1.0 / (1.0 + a.lag_updates / kLagRelaxation);
+  ++a.lag_updates;
+  a.friction_force += w * (limit - a.friction_force);
+  a.normal = (a.normal + w * (normal - a.normal)).normalized();
+  ++anchor_version_;
 }
 
 double ClothProblem::SlipAnchors(const Vertices& x) {

@@ -288,6 +288,8 @@ bool DrapeOptions::Check(std::string* why) const {
     return Fail(why, "rim_element_size: below 0.1 mm is not a drape mesh");
   if (!Finite(rim_band) || rim_band < 0.0 || rim_band > specimen_radius - support_radius)
     return Fail(why, "rim_band: must be in [0, the overhang]");
+  if (coarse_to_fine && mount == DrapeMount::kResting)
+    return Fail(why, "coarse_to_fine: clamped mount only (the fine level would restart the friction)");
   if (rim_extrapolation && rim_element_size == 0.0)
     return Fail(why, "rim_extrapolation: needs a rim band (rim_element_size > 0)");
   if (rim_extrapolation && rim_band < rim_element_size)

@@ -300,16 +300,20 @@ TEST(Drape, RimExtrapolationSplitsTheRimAndExtrapolates) {
   EXPECT_FALSE(none.Check(&why));
   EXPECT_EQ(why, "rim_extrapolation: needs a rim band at least one rim element wide");
   // The resting mount may extrapolate: its friction anchors go over to the split mesh
-  // (Drape.RestingSpecimenCarriesItsFrictionOverToTheSplitRim).
+  // (Drape.RestingSpecimenCarriesItsFrictionOverToTheSplitRim). Not coarse to fine: that fine
+  // level starts its friction afresh (at 15 mm the cloth slid off, DC 0.33 against 0.56).
   none.rim_band = 0.02;
   none.mount = DrapeMount::kResting;
   EXPECT_TRUE(none.Check(&why)) << why;
+  none.coarse_to_fine = true;
+  EXPECT_FALSE(none.Check(&why));
+  EXPECT_EQ(why.rfind("coarse_to_fine: clamped mount only", 0), 0u) << why;
 }
 
 // The resting mount (ContactOptions::friction_potential: Coulomb friction as a potential from
 // where each node landed, lagged normal forces): with the samples' μ = 0.3 the specimen settles
 // on the disk, and less friction lets more of it slide out over the rim. Measured on this mesh,
-// seed 1: DC 0.564 (μ = 0.3, 72 steps), 0.384 (μ = 0.1), 0.576 (μ = 3); clamped 0.509. Slip
+// seed 1: DC 0.545 (μ = 0.3, 170 steps), 0.383 (μ = 0.1), 0.561 (μ = 3); clamped 0.509. Slip
 // between converged stretches (lagged_slip) settled here only with μ = 3 (DC 0.491, 621 steps)
 // and per-step stick/slip switching never (docs/drapemeter.md, "Limits").
 TEST(Drape, RestingSpecimenSettlesWithTheSamplesFrictionAndLessFrictionLetsItSlideOut) {
@@ -324,7 +328,6 @@ TEST(Drape, RestingSpecimenSettlesWithTheSamplesFrictionAndLessFrictionLetsItSli
   EXPECT_NEAR(r.mass, 0.2 * r.specimen_area, 1e-9);
   ASSERT_EQ(r.per_seed.size(), 1u);
   EXPECT_GT(r.per_seed[0].summary.contacts, 0);
-  EXPECT_EQ(r.per_seed[0].summary.slips, 0);  // the potential needs no slip moves
   Material slippery = Fig8();
   slippery.friction = 0.1;
   const DrapeResult s = SimulateDrape(slippery, o);

@@ -426,7 +426,6 @@ TEST(StaticSolver, FrictionPotentialHoldsBelowTheFrictionAngleAndSlidesAbove) {
     const SolveSummary s = SolveStatic(slope.problem.get(), &x, {});
     ASSERT_TRUE(s.converged) << s.BriefReport();
     EXPECT_EQ(s.contacts, slope.mesh.num_vertices());
-    EXPECT_EQ(s.slips, 0);  // no slip moves: the potential holds it
     EXPECT_LT(std::abs(slope.Slid(x)), 1e-4);
   }
   for (double degrees : {18.0, 25.0}) {
@@ -628,6 +627,17 @@ TEST(ClothProblem, FrictionPotentialMatchesFiniteDifferencesStickingAndSliding) 
   }
   // Where no node has moved from its anchor, the two energies are the same.
   EXPECT_NEAR(huber.Energy(x), quadratic.Energy(x), 1e-15);
+  // One node moved twice its stick radius ε = μ f_n / k_t: the potential is
+  // μ f_n (2ε − ε/2) = 1.5 μ f_n ε there, the spring's ½ k_t (2ε)² = 2 μ f_n ε.
+  {
+    const double g = springs.gravity.norm();
+    const double friction = springs.contact.friction * huber.masses()(4) * g / springs.contact.sink_under_own_weight *
+                            -x(4, 2);  // μ f_n of vertex 4 [N]
+    const double stick = friction / (springs.contact.tangential_ratio * Cotton().stretch_stiffness);
+    Vertices one = x;
+    one(4, 0) += 2.0 * stick;
+    EXPECT_NEAR(huber.Energy(one) - quadratic.Energy(one), -0.5 * friction * stick, 1e-6 * friction * stick);
+  }
   Vertices moved = x;
   for (int i = 0; i < x.rows(); ++i)
     moved.row(i) += i % 2 == 0 ? Eigen::RowVector3d(3e-3, 2e-3, 0.0) : Eigen::RowVector3d(2e-5, -1e-5, 0.0);

@@ -249,8 +249,8 @@ TEST(CliDrape, NonConvergenceIsExit3WithOneLineAndNoFiles) {
 }
 
 // The resting mount settles with the samples' friction (contact.h, friction_potential); a run
-// cut short is not converged (exit 3) and writes nothing. `--rim-mm auto` gives it a rim band,
-// never the extrapolation (a second solve would restart friction): tested in bad_inputs.
+// cut short is not converged (exit 3) and writes nothing; `--rim-mm auto` gives it a rim band
+// (more vertices than --rim-mm 0), not the extrapolation (no split reported).
 TEST(CliDrape, RestingMountSettlesAndACutShortRunFailsCleanly) {
   const auto dir = Scratch("CliDrape.Resting");
   const auto r = Textile("drape " + kFig8 + kCoarse + " --mount resting -o " + (dir / "r.json").string());
@@ -267,6 +267,15 @@ TEST(CliDrape, RestingMountSettlesAndACutShortRunFailsCleanly) {
   EXPECT_EQ(cut.exit_code, 3) << cut.err;
   EXPECT_NE(LastError(cut.err).find("not converged"), std::string::npos) << cut.err;
   EXPECT_FALSE(fs::exists(dir / "cut.json"));
+  const auto vertices = [](const std::string& err) {
+    const size_t at = err.find("drape: mesh: ");
+    return at == std::string::npos ? -1 : std::stoi(err.substr(at + 13));
+  };
+  const auto banded = Textile("drape " + kFig8 + kCoarseMesh + " --mount resting --max-seconds 0.001 -o " +
+                              (dir / "band.json").string());
+  EXPECT_EQ(banded.exit_code, 3) << banded.err;
+  EXPECT_GT(vertices(banded.err), vertices(cut.err)) << banded.err << cut.err;
+  EXPECT_EQ(banded.err.find("split at the rim"), std::string::npos) << banded.err;
 }
 
 // Gmsh is loaded when a mesh is needed, not at start-up (libsim/src/gmsh_api.h): without it a

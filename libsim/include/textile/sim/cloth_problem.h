@@ -93,15 +93,19 @@ class ClothProblem {
   // contact), projected onto the support, so a step cannot slide a landing node for free.
   // Returns the largest slip of a sliding node since `previous` [m] (0 when every node sticks).
   // With ContactOptions::lagged_slip no node slides here: touching nodes stick. With
-  // ContactOptions::friction_potential anchors never move (0 is returned); each touching node's
-  // lagged normal force f̄_n is set from x, which changes the energy (anchor_version).
+  // ContactOptions::friction_potential anchors never move (0 is returned); a new contact's
+  // lagged μ f̄_n and tangent plane are taken from x, then left to SlipAnchors.
   double UpdateAnchors(const Vertices& x, const Vertices& previous);
   // ContactOptions::lagged_slip, between converged stretches of a solve: moves the anchor of
   // every node whose spring pulls more than slip_excess of μ f_n past μ f_n (Coulomb) along the
   // pull, to where it pulls μ f_n, or further, by the sum of the geometric series its
   // successive slips form (Aitken, at most 50 slips ahead). Returns the largest move [m] (0:
-  // every node holds).
+  // every node holds). With ContactOptions::friction_potential instead: sets each anchor's
+  // lagged μ f̄_n and tangent plane from x where they are more than 1 % off (relative; in the
+  // unit normal) and returns the largest such change [-] (0: all within 1 %).
   double SlipAnchors(const Vertices& x);
+  // Friction with lagged quantities that SlipAnchors updates between converged stretches
+  // (ContactOptions::lagged_slip or friction_potential).
   bool lagged_slip() const {
     return options_.contact.lagged_slip && !options_.contact.friction_potential &&
            options_.contact.friction > 0.0 && !supports_.empty();
@@ -154,10 +158,14 @@ class ClothProblem {
     double friction_force = 0.0;  // sliding, and friction_potential's μ f̄_n: μ f_n [N]
     bool stopped = false;  // it slid and stopped since contact began (hysteresis)
     Eigen::Vector3d last_slip = Eigen::Vector3d::Zero();  // lagged slip: the last unpaired slip [m]
+    int lag_updates = 0;  // friction potential: updates of the lagged force and plane so far
   };
   // The deepest support node i touches (φ < limit), or -1; *phi and *normal filled.
   int Touching(const Eigen::Vector3d& p, double limit, double* phi, Eigen::Vector3d* normal) const;
   double ContactEnergyGradient(const Vertices& x, Vertices* grad) const;
+  // Friction potential: node i's lagged μ f̄_n and tangent plane from its depth [m] and normal,
+  // where they are more than kLagTolerance off.
+  void UpdateLaggedFriction(int i, double depth, const Eigen::Vector3d& normal);
   void BuildPattern();
   void DropFixedFromPattern();
   // Bending Hessian elements [first, end) of the active discretisation into triplets_.

@@ -71,8 +71,9 @@ struct ContactOptions {
   // sticks to its anchor. Once the residual is below the tolerance, ClothProblem::SlipAnchors
   // moves the anchors of the nodes pulled past μ f_n (return mapping) and the solve goes on,
   // until every node holds (slip_excess). The energy is fixed within each stretch, so Newton
-  // does not cycle on nodes at the limit (the drape's resting mount). Newton only: the kinetic
-  // solver keeps every node in contact sticking under this option.
+  // does not cycle on nodes at the limit (the drape's resting mount until friction_potential
+  // replaced it). Newton only: the kinetic solver keeps every node in contact sticking under
+  // this option.
   bool lagged_slip = false;
   // Lagged slip: a node sticks while its spring pulls at most this fraction of μ f_n past μ f_n
   // (plus 1e-4 of its weight, for nodes with next to no normal force) [-]; 1 % is well inside
@@ -82,11 +83,13 @@ struct ContactOptions {
   // point where its contact began by a Huber function of its tangential offset s, ½ k_t s² up
   // to s = μ f̄_n / k_t and μ f̄_n (s − μ f̄_n / 2 k_t) beyond, so the force it feels is the
   // stiff anchor spring while it sticks and a constant μ f̄_n back towards its start once it
-  // slides, never more. f̄_n is the node's normal force at the last accepted state (lagged, as
-  // in Li et al. 2020, "Incremental Potential Contact"), so each Newton step sees one convex
-  // potential and the solve needs no slip moves; at convergence f̄_n is the state's own. The
-  // slip is measured from where the contact began, which is the drape's monotone loading.
-  // Overrides lagged_slip.
+  // slides, never more. f̄_n and the tangent plane are lagged (as in Li et al. 2020,
+  // "Incremental Potential Contact"): taken from the state when the contact begins and after a
+  // Newton step only where they are more than 1 % off (relaxed; cloth_problem.cc), so within a
+  // step the friction term is one fixed convex function and the solve needs no slip moves. At
+  // convergence |f_t| ≤ 1.01 μ f_n, in a plane within 0.01 of the tangent one. The slip is
+  // measured from where the contact began, which is the drape's monotone loading. Overrides
+  // lagged_slip.
   bool friction_potential = false;
 
   bool Check(std::string* why) const;

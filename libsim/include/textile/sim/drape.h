@@ -19,9 +19,9 @@
 // - clamped (the standard): every vertex within the support circle is held flat at z = 0 (the
 //   specimen is held between two disks); the rest hangs.
 // - resting (the paper's wording): the specimen lies on Support::Disk (top face z = 0, rounded rim)
-//   with penalty contact and Coulomb friction (μ from the material), nothing fixed. With the
-//   current engine Newton stalls on it (friction anchors on the rim; docs/drapemeter.md), so
-//   such runs come back converged = false.
+//   with penalty contact and Coulomb friction (μ from the material) as a potential from where
+//   each node landed (ContactOptions::friction_potential), nothing fixed. Not coarse to fine;
+//   the rim extrapolation carries the friction anchors over (ClothProblem::CarryAnchorsFrom).
 // Start: flat (resting: drop_height above the support) plus a seeded smooth out-of-plane
 // perturbation w(r, θ) = A ((r - R_s) / (R - R_s))² Σ_k c_k cos(k (θ - frame) + φ_k) on the
 // overhang, so that folds can form; the static equilibrium is found by Newton (optionally

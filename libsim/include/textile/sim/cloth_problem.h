@@ -26,6 +26,9 @@
 // drops anchors where contact starts and ends. Between two updates the energy is a fixed,
 // differentiable function, which is what Newton's line search needs; an active set of sliding
 // nodes moves as far as the forces say in one Newton solve (a lagged spring would creep).
+// Under ContactOptions::friction_potential (the drape's resting mount) nothing switches: the
+// spring becomes a Huber function of |P (x_i - a)|, linear with slope μ f̄_n past the stick
+// radius, f̄_n and n lagged (contact.h).
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -93,19 +96,19 @@ class ClothProblem {
   // contact), projected onto the support, so a step cannot slide a landing node for free.
   // Returns the largest slip of a sliding node since `previous` [m] (0 when every node sticks).
   // With ContactOptions::lagged_slip no node slides here: touching nodes stick. With
-  // ContactOptions::friction_potential anchors never move (0 is returned); a new contact's
-  // lagged μ f̄_n and tangent plane are taken from x, then left to SlipAnchors.
+  // ContactOptions::friction_potential anchors never move: a new contact's lagged μ f̄_n and
+  // tangent plane are taken from x, older ones follow x where more than 1 % off (relaxed), and
+  // the largest gap still over 1 % after that is returned [-] (0: all within), which keeps the
+  // solver from declaring convergence (SolveOptions::anchor_tolerance is far below 1 %).
   double UpdateAnchors(const Vertices& x, const Vertices& previous);
   // ContactOptions::lagged_slip, between converged stretches of a solve: moves the anchor of
   // every node whose spring pulls more than slip_excess of μ f_n past μ f_n (Coulomb) along the
   // pull, to where it pulls μ f_n, or further, by the sum of the geometric series its
   // successive slips form (Aitken, at most 50 slips ahead). Returns the largest move [m] (0:
-  // every node holds). With ContactOptions::friction_potential instead: sets each anchor's
-  // lagged μ f̄_n and tangent plane from x where they are more than 1 % off (relative; in the
-  // unit normal) and returns the largest such change [-] (0: all within 1 %).
+  // every node holds). Does nothing under ContactOptions::friction_potential.
   double SlipAnchors(const Vertices& x);
-  // Friction with lagged quantities that SlipAnchors updates between converged stretches
-  // (ContactOptions::lagged_slip or friction_potential).
+  // Slip between converged stretches is on (ContactOptions::lagged_slip, not overridden by
+  // friction_potential).
   bool lagged_slip() const {
     return options_.contact.lagged_slip && !options_.contact.friction_potential &&
            options_.contact.friction > 0.0 && !supports_.empty();
@@ -114,9 +117,11 @@ class ClothProblem {
   // After a mesh refinement (RefineTriangles), before solving on it: takes over `coarse`'s
   // friction anchors for the old vertices (ids below coarse's #V); each split point gets the
   // middle of its parents' anchors, put back on the support, when both have one on the same
-  // support (else its contact starts afresh). The lagged normal forces follow at the next
-  // UpdateAnchors. So the finer mesh goes on with the friction history instead of restarting it
-  // from where it lies. Throws InputError when the sizes do not fit a refinement of coarse.
+  // support (else its contact starts afresh). The old vertices' lagged μ f̄_n is rescaled to
+  // this mesh's penalty (lumped masses change with the split) and their lag starts afresh; the
+  // split points' is set at the next UpdateAnchors. So the finer mesh goes on with the friction
+  // history instead of restarting it from where it lies. Throws InputError when the sizes do
+  // not fit a refinement of coarse or the supports differ in number.
   void CarryAnchorsFrom(const ClothProblem& coarse, const std::vector<std::array<int, 2>>& parents);
   int num_anchors() const;
   // Incremented whenever an anchor is created, released or moved: the energy changed.
@@ -163,9 +168,10 @@ class ClothProblem {
   // The deepest support node i touches (φ < limit), or -1; *phi and *normal filled.
   int Touching(const Eigen::Vector3d& p, double limit, double* phi, Eigen::Vector3d* normal) const;
   double ContactEnergyGradient(const Vertices& x, Vertices* grad) const;
-  // Friction potential: node i's lagged μ f̄_n and tangent plane from its depth [m] and normal,
-  // where they are more than kLagTolerance off.
-  void UpdateLaggedFriction(int i, double depth, const Eigen::Vector3d& normal);
+  // Friction potential: node i's lagged μ f̄_n and tangent plane towards its depth [m] and
+  // normal, where they are more than kLagTolerance off; returns what is still off [-] (0 when
+  // within it, or when the node no longer presses).
+  double UpdateLaggedFriction(int i, double depth, const Eigen::Vector3d& normal);
   void BuildPattern();
   void DropFixedFromPattern();
   // Bending Hessian elements [first, end) of the active discretisation into triplets_.

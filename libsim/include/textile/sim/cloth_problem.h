@@ -113,6 +113,11 @@ class ClothProblem {
     return options_.contact.lagged_slip && !options_.contact.friction_potential &&
            options_.contact.friction > 0.0 && !supports_.empty();
   }
+  // Friction as a lagged potential is on (ContactOptions::friction_potential, with friction and
+  // a support): UpdateAnchors' return is then how far the lagged normal forces still are off.
+  bool friction_potential() const {
+    return options_.contact.friction_potential && options_.contact.friction > 0.0 && !supports_.empty();
+  }
   void ClearAnchors();
   // After a mesh refinement (RefineTriangles), before solving on it: takes over `coarse`'s
   // friction anchors for the old vertices (ids below coarse's #V); each split point gets the

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <numbers>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -26,7 +27,7 @@ namespace {
 constexpr double kDegree = std::numbers::pi / 180.0;
 
 struct DrapeArgs {
-  std::string material, seams = "none", seam_type, seam_file, mount = "clamped", out, png, obj;
+  std::string material, seams = "none", seam_type, seam_file, mount = "clamped", out, png, obj, ply;
   int seeds = 1;
   unsigned first_seed = 1;
   std::optional<double> resolution_mm;
@@ -174,6 +175,24 @@ std::string OutlineCsv(const DrapeSeedResult& s) {
         << units::MToMm(r * std::sin(t)) << "\n";
   }
   return out.str();
+}
+
+// The first seed's draped mesh as PLY, with each vertex's pattern position (to map a scan or a
+// texture onto it) and, with seams, its pattern distance to the nearest seam line [m].
+std::string DrapedPly(const DrapeResult& r, const DrapeSeedResult& s) {
+  TriangleMesh draped = r.mesh;
+  draped.vertices = s.positions;
+  std::vector<VertexScalar> scalars = {{"rest_x", r.mesh.vertices.col(0)}, {"rest_y", r.mesh.vertices.col(1)}};
+  if (!r.seam_lines.empty()) {
+    Eigen::VectorXd d(r.mesh.num_vertices());
+    for (int v = 0; v < r.mesh.num_vertices(); ++v) {
+      d(v) = std::numeric_limits<double>::infinity();
+      for (const SeamLine& line : r.seam_lines)
+        d(v) = std::min(d(v), DistanceToSeamLine(r.mesh.vertices.row(v).head<2>().transpose(), line));
+    }
+    scalars.push_back({"seam_distance", d});
+  }
+  return PlyText(draped, scalars);
 }
 
 // The test's photo: the shadow seen from above, the support and the flat specimen's circles,
@@ -337,9 +356,10 @@ void Run(const DrapeArgs& a) {
   // Check the outputs' folders before computing.
   AtomicFile result_file(a.out);
   AtomicFile outline_file(OutlinePath(a.out));
-  std::optional<AtomicFile> png_file, obj_file;
+  std::optional<AtomicFile> png_file, obj_file, ply_file;
   if (!a.png.empty()) png_file.emplace(a.png);
   if (!a.obj.empty()) obj_file.emplace(a.obj);
+  if (!a.ply.empty()) ply_file.emplace(a.ply);
 
   o.progress = [](const std::string& line) { Info("drape: " + line); };
   DrapeResult r;
@@ -366,6 +386,10 @@ void Run(const DrapeArgs& a) {
     draped.vertices = first.positions;
     WriteText(*obj_file, ObjText(draped));
     j["obj"] = a.obj;
+  }
+  if (ply_file) {
+    WriteText(*ply_file, DrapedPly(r, first));
+    j["ply"] = a.ply;
   }
   WriteText(result_file, j.dump(2) + "\n");
 
@@ -406,6 +430,7 @@ void Run(const DrapeArgs& a) {
             << "\n";
   if (!a.png.empty()) std::cout << "shadow: " << a.png << "\n";
   if (!a.obj.empty()) std::cout << "mesh: " << a.obj << "\n";
+  if (!a.ply.empty()) std::cout << "mesh: " << a.ply << "\n";
 }
 
 }  // namespace
@@ -453,6 +478,9 @@ void RegisterDrape(CLI::App& app) {
   sub->add_option("-o,--output", a->out, "Result JSON file; the outline CSV goes next to it")->required();
   sub->add_option("--png", a->png, "Top-view shadow picture (PNG)");
   sub->add_option("--obj", a->obj, "Draped mesh of the first seed (OBJ)");
+  sub->add_option("--ply", a->ply,
+                  "Draped mesh of the first seed (ASCII PLY, metres) with each vertex's pattern position "
+                  "rest_x, rest_y and, with seams, its distance to the nearest seam line seam_distance [m]");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   sub->callback([a] { Run(*a); });
 }

@@ -6,6 +6,9 @@
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "run_cli.h"
 
@@ -86,6 +89,73 @@ TEST(CliDrape, SeamFromPresetOrFileRaisesDc) {
   EXPECT_NEAR(f["drape_coefficient"].get<double>(), s["drape_coefficient"].get<double>(), 1e-9);
   EXPECT_EQ(s["scene"]["seams"], "weft");
   EXPECT_EQ(s["scene"]["seam_profile"]["type"], "C-plain");
+}
+
+// A PLY's header properties of its vertex element and its vertex rows (ASCII, as PlyText writes).
+struct Ply {
+  std::vector<std::string> properties;
+  std::vector<std::vector<double>> vertices;
+};
+Ply ReadPly(const std::string& text) {
+  Ply ply;
+  std::istringstream in(text);
+  std::string line;
+  int count = 0;
+  bool in_vertex = false;
+  while (std::getline(in, line) && line != "end_header") {
+    std::istringstream words(line);
+    std::string a, b, c;
+    words >> a >> b >> c;
+    if (a == "element") {
+      in_vertex = b == "vertex";
+      if (in_vertex) count = std::stoi(c);
+    } else if (a == "property" && in_vertex) {
+      ply.properties.push_back(c);
+    }
+  }
+  for (int v = 0; v < count && std::getline(in, line); ++v) {
+    std::istringstream words(line);
+    std::vector<double> row;
+    for (double x; words >> x;) row.push_back(x);
+    ply.vertices.push_back(row);
+  }
+  return ply;
+}
+
+TEST(CliDrape, PlyCarriesEachVertexsPatternPositionAndSeamDistance) {
+  // Weft seam: the diameter along the pattern's y axis, so a vertex's distance to it is |rest x|.
+  // Clamped vertices (r <= 90 mm) lie where they were cut; the overhang hangs below.
+  const auto dir = Scratch("CliDrape.Ply");
+  const auto r = Textile("drape " + kFig8 + kCoarse + " --seams weft -o " + (dir / "seam.json").string() +
+                         " --ply " + (dir / "seam.ply").string() + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["ply"], (dir / "seam.ply").string());
+  const Ply ply = ReadPly(ReadAll(dir / "seam.ply"));
+  ASSERT_EQ(ply.properties, (std::vector<std::string>{"x", "y", "z", "rest_x", "rest_y", "seam_distance"}));
+  ASSERT_EQ(static_cast<int>(ply.vertices.size()), j["scene"]["vertices"].get<int>());
+  int clamped = 0, hanging = 0;
+  for (const auto& v : ply.vertices) {
+    ASSERT_EQ(v.size(), 6u);
+    EXPECT_NEAR(v[5], std::abs(v[3]), 1e-12);
+    if (std::hypot(v[3], v[4]) < 0.089) {
+      ++clamped;
+      EXPECT_NEAR(v[0], v[3], 1e-12);
+      EXPECT_NEAR(v[1], v[4], 1e-12);
+      EXPECT_NEAR(v[2], 0.0, 1e-12);
+    } else if (std::hypot(v[3], v[4]) > 0.149) {
+      hanging += v[2] < -0.01;
+    }
+  }
+  EXPECT_GT(clamped, 50);
+  EXPECT_GT(hanging, 20);
+  // Without seams there is no seam distance.
+  const auto plain = Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "plain.json").string() + " --ply " +
+                             (dir / "plain.ply").string());
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_NE(plain.out.find("mesh: " + (dir / "plain.ply").string()), std::string::npos) << plain.out;
+  EXPECT_EQ(ReadPly(ReadAll(dir / "plain.ply")).properties,
+            (std::vector<std::string>{"x", "y", "z", "rest_x", "rest_y"}));
 }
 
 // The vertex count a drape reports before it solves ("drape: mesh: N vertices" on stderr; 0 if

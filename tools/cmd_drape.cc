@@ -266,6 +266,9 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
   j["min_radius_mm"] = NumberOrNull(units::MToMm(r.min_radius));
   j["max_radius_mm"] = NumberOrNull(units::MToMm(r.max_radius));
   j["mean_radius_mm"] = NumberOrNull(units::MToMm(r.mean_radius));
+  j["min_radius_sd_mm"] = NumberOrNull(units::MToMm(r.min_radius_sd));
+  j["max_radius_sd_mm"] = NumberOrNull(units::MToMm(r.max_radius_sd));
+  j["mean_radius_sd_mm"] = NumberOrNull(units::MToMm(r.mean_radius_sd));
   j["seeds"] = nlohmann::json::array();
   for (const DrapeSeedResult& s : r.per_seed) {
     nlohmann::json js = {{"seed", s.seed}, {"converged", s.converged}, {"solver", SummaryJson(s.summary)}};
@@ -424,7 +427,14 @@ void Run(const DrapeArgs& a) {
   std::cout << "drape coefficient: " << Num(r.drape_coefficient, 4);
   if (r.per_seed.size() > 1) std::cout << " ± " << Num(r.drape_coefficient_sd, 3);
   std::cout << "\nnodes: " << Num(r.nodes, 4);
-  if (r.per_seed.size() > 1) std::cout << " ± " << Num(r.nodes_sd, 3);
+  if (r.per_seed.size() > 1) {
+    std::cout << " ± " << Num(r.nodes_sd, 3);
+    const auto radius = [](double mean, double sd) {
+      return Num(units::MToMm(mean), 4) + " ± " + Num(units::MToMm(sd), 2);
+    };
+    std::cout << "\noutline radius [mm]: min " << radius(r.min_radius, r.min_radius_sd) << ", mean "
+              << radius(r.mean_radius, r.mean_radius_sd) << ", max " << radius(r.max_radius, r.max_radius_sd);
+  }
   if (!note.empty()) std::cout << "\nnote: " << note;
   std::cout << "\ntime: " << Num(r.seconds, 3) << " s\nresult: " << a.out << "\noutline: " << outline_file.path()
             << "\n";

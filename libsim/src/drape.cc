@@ -651,10 +651,14 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
     result.min_radius = Mean(mins);
     result.max_radius = Mean(maxs);
     result.mean_radius = Mean(means);
+    result.min_radius_sd = SampleSd(mins);
+    result.max_radius_sd = SampleSd(maxs);
+    result.mean_radius_sd = SampleSd(means);
   } else {
     result.drape_coefficient = result.drape_coefficient_sd = kNaN;
     result.nodes = result.nodes_sd = kNaN;
     result.min_radius = result.max_radius = result.mean_radius = kNaN;
+    result.min_radius_sd = result.max_radius_sd = result.mean_radius_sd = kNaN;
   }
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

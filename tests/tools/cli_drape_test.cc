@@ -48,6 +48,12 @@ TEST(CliDrape, PlainDrapeWritesResultOutlinePngAndObj) {
   EXPECT_NEAR(j["drape_coefficient_sd"].get<double>(), std::abs(a - b) / std::sqrt(2.0), 1e-12);
   EXPECT_TRUE(j["nodes"].is_number());
   EXPECT_TRUE(j["nodes_sd"].is_number());
+  // Every figure's mean and sample sd over the seeds (the outline radii too).
+  for (const std::string figure : {"min_radius", "max_radius", "mean_radius"}) {
+    const double ra = j["seeds"][0][figure + "_mm"], rb = j["seeds"][1][figure + "_mm"];
+    EXPECT_NEAR(j[figure + "_mm"].get<double>(), 0.5 * (ra + rb), 1e-9) << figure;
+    EXPECT_NEAR(j[figure + "_sd_mm"].get<double>(), std::abs(ra - rb) / std::sqrt(2.0), 1e-9) << figure;
+  }
   EXPECT_EQ(j["scene"]["mount"], "clamped");
   // The solver report: a factorisation per Newton step at least, the exact-Hessian steps among
   // them, a residual under the tolerance.

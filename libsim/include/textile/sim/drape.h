@@ -205,6 +205,7 @@ struct DrapeResult {
   double drape_coefficient = 0.0, drape_coefficient_sd = 0.0;
   double nodes = 0.0, nodes_sd = 0.0;
   double mean_radius = 0.0, min_radius = 0.0, max_radius = 0.0;  // means over seeds [m]
+  double mean_radius_sd = 0.0, min_radius_sd = 0.0, max_radius_sd = 0.0;  // their sample sd [m]
   std::vector<DrapeSeedResult> per_seed;
   TriangleMesh mesh;                         // the fine pattern (rest, z = 0); split at the rim
                                              // with rim_extrapolation

@@ -199,17 +199,19 @@ struct Run {
   }
 
   // Whether the friction anchors still move: under lagged slip any move of the last
-  // SlipAnchors (it only moves nodes pulled past the cone), else a slip over anchor_tolerance.
+  // SlipAnchors (it only moves nodes pulled past the cone); under the friction potential any
+  // lag still over its 1 % (a relative gap, not a length); else a slip over anchor_tolerance.
   bool Sliding(double slid) const {
-    return problem->lagged_slip() ? slid > 0.0 : slid > options.anchor_tolerance;
+    return problem->lagged_slip() || problem->friction_potential() ? slid > 0.0
+                                                                   : slid > options.anchor_tolerance;
   }
 
   std::string CapMessage(double slid) const {
     std::string m = "iteration cap of " + std::to_string(options.max_iterations) + " reached";
     if (Sliding(slid))
       m += problem->friction_potential()
-               ? " with the friction's lagged normal forces still settling (over 1 % off): no static "
-                 "equilibrium yet"
+               ? " with the friction's lagged normal forces or tangent planes still settling (over 1 % "
+                 "off): no static equilibrium yet"
                : " with friction anchors still sliding: the cloth slides, no static equilibrium";
     return m;
   }

@@ -114,9 +114,11 @@ class ClothProblem {
            options_.contact.friction > 0.0 && !supports_.empty();
   }
   // Friction as a lagged potential is on (ContactOptions::friction_potential, with friction and
-  // a support): UpdateAnchors' return is then how far the lagged normal forces still are off.
+  // a support): UpdateAnchors' return is then how far the lagged normal forces and tangent
+  // planes still are off.
   bool friction_potential() const {
-    return options_.contact.friction_potential && options_.contact.friction > 0.0 && !supports_.empty();
+    return options_.contact.friction_potential && options_.contact.friction > 0.0 &&
+           !supports_.empty();
   }
   void ClearAnchors();
   // After a mesh refinement (RefineTriangles), before solving on it: takes over `coarse`'s

@@ -151,12 +151,12 @@ DrapeOptions Options(const DrapeArgs& a) {
   return o;
 }
 
-void WriteText(AtomicFile& file, const std::string& text) {
+// Writes an output's temporary file; AtomicFileSet::Commit moves them all into place.
+void WriteTemp(AtomicFile& file, const std::string& text) {
   std::ofstream out(file.temp_path(), std::ios::binary);
   out << text;
   out.close();
   if (!out) throw InputError("cannot write " + file.path());
-  file.Commit();
 }
 
 std::string OutlinePath(const std::string& result) {
@@ -356,13 +356,17 @@ void Run(const DrapeArgs& a) {
            (o.rim_element_size > 0.0 ? std::string("a smaller --rim-mm") : std::string("--rim-mm auto")) +
            " meshes it finer (slower; docs/drapemeter.md)";
   }
-  // Check the outputs' folders before computing.
-  AtomicFile result_file(a.out);
-  AtomicFile outline_file(OutlinePath(a.out));
-  std::optional<AtomicFile> png_file, obj_file, ply_file;
-  if (!a.png.empty()) png_file.emplace(a.png);
-  if (!a.obj.empty()) obj_file.emplace(a.obj);
-  if (!a.ply.empty()) ply_file.emplace(a.ply);
+  // Check the outputs before computing: distinct files in usable folders. They appear together
+  // at the end, or none of them.
+  const std::string outline_path = OutlinePath(a.out);
+  CheckDistinctOutputs({{"-o", a.out}, {"the outline (next to -o)", outline_path}, {"--png", a.png},
+                        {"--obj", a.obj}, {"--ply", a.ply}});
+  AtomicFileSet outputs;
+  AtomicFile& result_file = outputs.Add(a.out);
+  AtomicFile& outline_file = outputs.Add(outline_path);
+  AtomicFile* png_file = a.png.empty() ? nullptr : &outputs.Add(a.png);
+  AtomicFile* obj_file = a.obj.empty() ? nullptr : &outputs.Add(a.obj);
+  AtomicFile* ply_file = a.ply.empty() ? nullptr : &outputs.Add(a.ply);
 
   o.progress = [](const std::string& line) { Info("drape: " + line); };
   DrapeResult r;
@@ -377,24 +381,24 @@ void Run(const DrapeArgs& a) {
   nlohmann::json j = ResultJson(r, o, m, a, turn_down);
   j["note"] = note.empty() ? nlohmann::json() : nlohmann::json(note);
   j["outline_csv"] = outline_file.path();
-  WriteText(outline_file, OutlineCsv(first));
+  WriteTemp(outline_file, OutlineCsv(first));
   if (png_file) {
     if (!cv::imwrite(png_file->temp_path(), ShadowImage(r, first, o)))
       throw InputError("--png: cannot write " + a.png);
-    png_file->Commit();
     j["png"] = a.png;
   }
   if (obj_file) {
     TriangleMesh draped = r.mesh;
     draped.vertices = first.positions;
-    WriteText(*obj_file, ObjText(draped));
+    WriteTemp(*obj_file, ObjText(draped));
     j["obj"] = a.obj;
   }
   if (ply_file) {
-    WriteText(*ply_file, DrapedPly(r, first));
+    WriteTemp(*ply_file, DrapedPly(r, first));
     j["ply"] = a.ply;
   }
-  WriteText(result_file, j.dump(2) + "\n");
+  WriteTemp(result_file, j.dump(2) + "\n");
+  outputs.Commit();
 
   if (a.json) {
     j["output"] = a.out;
@@ -429,8 +433,8 @@ void Run(const DrapeArgs& a) {
   std::cout << "\nnodes: " << Num(r.nodes, 4);
   if (r.per_seed.size() > 1) {
     std::cout << " ± " << Num(r.nodes_sd, 3);
-    const auto radius = [](double mean, double sd) {
-      return Num(units::MToMm(mean), 4) + " ± " + Num(units::MToMm(sd), 2);
+    const auto radius = [](double mean, double sd) {  // sd to 0.01 mm: seeds may agree to round-off
+      return Num(units::MToMm(mean), 4) + " ± " + Num(std::round(units::MToMm(sd) * 100.0) / 100.0);
     };
     std::cout << "\noutline radius [mm]: min " << radius(r.min_radius, r.min_radius_sd) << ", mean "
               << radius(r.mean_radius, r.mean_radius_sd) << ", max " << radius(r.max_radius, r.max_radius_sd);
@@ -440,7 +444,7 @@ void Run(const DrapeArgs& a) {
             << "\n";
   if (!a.png.empty()) std::cout << "shadow: " << a.png << "\n";
   if (!a.obj.empty()) std::cout << "mesh: " << a.obj << "\n";
-  if (!a.ply.empty()) std::cout << "mesh: " << a.ply << "\n";
+  if (!a.ply.empty()) std::cout << "mesh (PLY): " << a.ply << "\n";
 }
 
 }  // namespace

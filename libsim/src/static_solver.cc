@@ -256,8 +256,9 @@ SolveSummary Newton(Run& run) {
   const SolveOptions& o = run.options;
   const double max_step = o.max_step > 0.0 ? o.max_step : 0.1 * run.diagonal;
   LinearSolver linear(o);
-  // What the anchors report at the start counts at the first check too: a friction_potential's
-  // lag carried over more than 1 % off must not pass for converged (lagged slip: see the loop).
+  // What the anchors report at the start counts at the first check too: a slip of the plain
+  // anchors, or a friction_potential's lag carried over more than 1 % off, must not pass for
+  // converged at iteration 0 (lagged slip reports its moves in the loop instead).
   const double start_slid = p.UpdateAnchors(x, x);
   Vertices grad, trial, trial_grad, longer, longer_grad;
   double energy = p.EnergyGradient(x, &grad);

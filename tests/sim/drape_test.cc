@@ -399,6 +399,9 @@ TEST(Drape, NonConvergedRunReportsNoDrapeCoefficient) {
   EXPECT_NE(r.message.find("iteration cap"), std::string::npos) << r.message;
   EXPECT_TRUE(std::isnan(r.drape_coefficient));
   EXPECT_TRUE(std::isnan(r.per_seed.at(0).drape_coefficient));
+  for (double figure : {r.drape_coefficient_sd, r.nodes, r.nodes_sd, r.min_radius, r.max_radius, r.mean_radius,
+                        r.min_radius_sd, r.max_radius_sd, r.mean_radius_sd})
+    EXPECT_TRUE(std::isnan(figure)) << figure;
 }
 
 TEST(Drape, PlainSpecimenDrapesWithFoldsAndConservesMass) {

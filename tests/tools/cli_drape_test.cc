@@ -155,11 +155,30 @@ TEST(CliDrape, PlyCarriesEachVertexsPatternPositionAndSeamDistance) {
   }
   EXPECT_GT(clamped, 50);
   EXPECT_GT(hanging, 20);
-  // Without seams there is no seam distance.
-  const auto plain = Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "plain.json").string() + " --ply " +
-                             (dir / "plain.ply").string());
+  // Weft and warp seams turned by 30°, on the split rim (the result's mesh is the split one): the
+  // distance is to the nearer of the two diameters. Text output, one seed: no radius sd line.
+  const auto cross = Textile("drape " + kFig8 + kCoarseMesh + " --rim-mm 6 --seams weft+warp --frame-deg 30 -o " +
+                             (dir / "cross.json").string() + " --ply " + (dir / "cross.ply").string());
+  ASSERT_EQ(cross.exit_code, 0) << cross.err;
+  EXPECT_NE(cross.out.find("mesh (PLY): " + (dir / "cross.ply").string()), std::string::npos) << cross.out;
+  EXPECT_EQ(cross.out.find("outline radius"), std::string::npos) << cross.out;
+  const auto jc = nlohmann::json::parse(ReadAll(dir / "cross.json"));
+  ASSERT_TRUE(jc["scene"]["extrapolate"].get<bool>());
+  const Ply cp = ReadPly(ReadAll(dir / "cross.ply"));
+  ASSERT_EQ(static_cast<int>(cp.vertices.size()), jc["scene"]["vertices"].get<int>());
+  EXPECT_GT(jc["scene"]["vertices"].get<int>(), jc["scene"]["base_vertices"].get<int>());
+  const double t = 30.0 * M_PI / 180.0;
+  for (const auto& v : cp.vertices) {
+    ASSERT_EQ(v.size(), 6u);
+    const double to_warp = std::abs(-v[3] * std::sin(t) + v[4] * std::cos(t));  // the x axis turned
+    const double to_weft = std::abs(v[3] * std::cos(t) + v[4] * std::sin(t));   // the y axis turned
+    EXPECT_NEAR(v[5], std::min(to_warp, to_weft), 1e-9);
+  }
+  // Without seams there is no seam distance; two seeds print the radii's sd.
+  const auto plain = Textile("drape " + kFig8 + kCoarse + " --seeds 2 -o " + (dir / "plain.json").string() +
+                             " --ply " + (dir / "plain.ply").string());
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
-  EXPECT_NE(plain.out.find("mesh: " + (dir / "plain.ply").string()), std::string::npos) << plain.out;
+  EXPECT_NE(plain.out.find("\noutline radius [mm]: min "), std::string::npos) << plain.out;
   EXPECT_EQ(ReadPly(ReadAll(dir / "plain.ply")).properties,
             (std::vector<std::string>{"x", "y", "z", "rest_x", "rest_y"}));
 }
@@ -309,11 +328,12 @@ TEST(CliDrape, CoarseRimGetsANoteAndAutoMeshesItFiner) {
 
 TEST(CliDrape, NonConvergenceIsExit3WithOneLineAndNoFiles) {
   const auto dir = Scratch("CliDrape.NoConv");
-  const auto r = Textile("drape " + kFig8 + kCoarse + " --max-seconds 0.001 -o " + (dir / "r.json").string());
+  const auto r = Textile("drape " + kFig8 + kCoarse + " --max-seconds 0.001 -o " + (dir / "r.json").string() +
+                         " --png " + (dir / "r.png").string() + " --obj " + (dir / "r.obj").string() + " --ply " +
+                         (dir / "r.ply").string());
   EXPECT_EQ(r.exit_code, 3) << r.err;
   EXPECT_NE(LastError(r.err).find("not converged"), std::string::npos) << r.err;
-  EXPECT_FALSE(fs::exists(dir / "r.json"));
-  EXPECT_FALSE(fs::exists(dir / "r.outline.csv"));
+  EXPECT_TRUE(fs::is_empty(dir)) << "a failed run left a file";
   // The same when a cascade's coarse level stops short ahead of the (default) rim split.
   const auto c = Textile("drape " + kFig8 + " --coarse-to-fine --max-seconds 0.01 -o " +
                          (dir / "c.json").string());

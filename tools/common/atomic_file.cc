@@ -63,6 +63,20 @@ void AtomicFileSet::Commit() {
   for (const auto& f : files_) f->Commit();
 }
 
+void CheckDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
+  std::vector<std::pair<std::string, fs::path>> seen;  // {flag, canonical path}
+  for (const auto& [flag, path] : outputs) {
+    if (path.empty()) continue;
+    std::error_code ec;
+    fs::path canonical = fs::weakly_canonical(fs::path(path), ec);
+    if (ec) canonical = fs::absolute(fs::path(path), ec).lexically_normal();
+    for (const auto& [other_flag, other] : seen)
+      if (other == canonical)
+        throw InputError(other_flag + " and " + flag + " name the same file " + path);
+    seen.emplace_back(flag, canonical);
+  }
+}
+
 void WriteFileAtomically(const std::string& path, std::string_view text) {
   AtomicFile out(path);
   {

@@ -12,6 +12,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace textile {
@@ -56,6 +57,12 @@ class AtomicFileSet {
  private:
   std::vector<std::unique_ptr<AtomicFile>> files_;
 };
+
+// Refuses outputs of one run that name the same file (one would silently replace the other):
+// throws InputError "<flag> and <flag> name the same file <path>". Each entry is {flag, path};
+// empty paths (outputs not asked for) are skipped; paths are compared after
+// std::filesystem::weakly_canonical, so "a.json" and "./a.json" are the same file.
+void CheckDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs);
 
 // Writes text to path atomically. Throws InputError naming the path on failure.
 void WriteFileAtomically(const std::string& path, std::string_view text);

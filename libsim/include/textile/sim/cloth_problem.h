@@ -99,7 +99,8 @@ class ClothProblem {
   // ContactOptions::friction_potential anchors never move: a new contact's lagged μ f̄_n and
   // tangent plane are taken from x, older ones follow x where more than 1 % off (relaxed), and
   // the largest gap still over 1 % after that is returned [-] (0: all within), which keeps the
-  // solver from declaring convergence (SolveOptions::anchor_tolerance is far below 1 %).
+  // solver from declaring convergence (any gap does; SolveOptions::anchor_tolerance, a length,
+  // does not apply to it).
   double UpdateAnchors(const Vertices& x, const Vertices& previous);
   // ContactOptions::lagged_slip, between converged stretches of a solve: moves the anchor of
   // every node whose spring pulls more than slip_excess of μ f_n past μ f_n (Coulomb) along the

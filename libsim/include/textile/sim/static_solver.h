@@ -73,7 +73,8 @@ struct SolveOptions {
   // Conjugate gradients: relative tolerance of each linear solve and its iteration cap.
   double cg_tolerance = 1e-4;
   int cg_max_iterations = 2000;
-  // Anchors that slide less than this in a step count as sticking [m].
+  // Anchors that slide less than this in a step count as sticking [m]. Not used under lagged
+  // slip or the friction potential (ContactOptions), where any slip or lag gap left counts.
   double anchor_tolerance = 1e-7;
   // The run stops ("falls") when the centre of mass sinks more than this many pattern
   // diagonals below where it started: nothing holds the cloth.

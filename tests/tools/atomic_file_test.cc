@@ -5,6 +5,9 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "textile/sim/error.h"
 
@@ -102,6 +105,28 @@ TEST(AtomicFileSet, AllOrNothing) {
   EXPECT_EQ(Slurp(d / "a.csv"), "new a");
   EXPECT_EQ(Slurp(d / "b.png"), "b");
   EXPECT_EQ(count(), 2);
+}
+
+TEST(CheckDistinctOutputs, SameFileUnderAnyNameIsRefusedNamingBothFlags) {
+  // Files that do not exist yet (the usual case), named relatively, with "./", "..", or
+  // absolutely: all the same file. Empty paths are outputs not asked for.
+  const fs::path d = ScratchDir("distinct_outputs");
+  const fs::path cwd = fs::current_path();
+  fs::current_path(d);
+  const std::string abs = (d / "r.json").string();
+  for (const auto& [a, b] : std::vector<std::pair<std::string, std::string>>{
+           {"r.json", "./r.json"}, {"r.json", abs}, {"sub/../r.json", "r.json"}, {abs, "./r.json"}}) {
+    SCOPED_TRACE(a + " / " + b);
+    try {
+      CheckDistinctOutputs({{"-o", a}, {"--png", ""}, {"--ply", b}});
+      ADD_FAILURE() << "not refused";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()), "-o and --ply name the same file " + b);
+    }
+  }
+  EXPECT_NO_THROW(CheckDistinctOutputs({{"-o", "r.json"}, {"--png", ""}, {"--obj", ""}, {"--ply", "r.ply"}}));
+  EXPECT_TRUE(fs::is_empty(d));
+  fs::current_path(cwd);
 }
 
 }  // namespace

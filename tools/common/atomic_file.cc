@@ -67,9 +67,12 @@ void CheckDistinctOutputs(const std::vector<std::pair<std::string, std::string>>
   std::vector<std::pair<std::string, fs::path>> seen;  // {flag, canonical path}
   for (const auto& [flag, path] : outputs) {
     if (path.empty()) continue;
+    // Absolute first: weakly_canonical leaves a relative path relative when its first part does
+    // not exist yet, so "d.json" would not meet "./d.json" before the file is there.
     std::error_code ec;
-    fs::path canonical = fs::weakly_canonical(fs::path(path), ec);
-    if (ec) canonical = fs::absolute(fs::path(path), ec).lexically_normal();
+    const fs::path absolute = fs::absolute(fs::path(path), ec).lexically_normal();
+    fs::path canonical = fs::weakly_canonical(absolute, ec);
+    if (ec) canonical = absolute;
     for (const auto& [other_flag, other] : seen)
       if (other == canonical)
         throw InputError(other_flag + " and " + flag + " name the same file " + path);

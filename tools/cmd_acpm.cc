@@ -61,7 +61,7 @@ AcpmOptions Options(const AcpmArgs& a) {
   return o;
 }
 
-void Plot(const AcpmResult& r, const AcpmOptions& o, const Material& m, const std::string& path) {
+void Plot(const AcpmResult& r, const AcpmOptions& o, const Material& m, AtomicFile& out) {
   namespace chart = textile::chart;
   chart::Panel front{.title = "Front across the width (crossing overhang per ray)",
                      .x_label = "z across the width [mm]",
@@ -150,18 +150,19 @@ void Plot(const AcpmResult& r, const AcpmOptions& o, const Material& m, const st
                    .height_px = 600,
                    .columns = 2,
                    .panels = {front, side}},
-                  path);
+                  out);
 }
 
 void Run(const AcpmArgs& a) {
   const AcpmOptions o = Options(a);
   const Material m = ReadMaterial(a.material);
-  // Check the outputs' folders before computing.
-  AtomicFile result_file(a.out);
-  std::optional<AtomicFile> png_file;
-  if (!a.png.empty()) png_file.emplace(a.png);
-  std::optional<AtomicFile> obj_file;
-  if (!a.obj.empty()) obj_file.emplace(a.obj);
+  // Check the outputs' names and folders before computing; they appear together at the end.
+  CheckDistinctOutputs({{"-o", a.out}, {"--png", a.png}, {"--obj", a.obj}});
+  if (!a.png.empty()) chart::CheckPngPath(a.png);
+  AtomicFileSet outputs;
+  AtomicFile& result_file = outputs.Add(a.out);
+  AtomicFile* png_file = a.png.empty() ? nullptr : &outputs.Add(a.png);
+  AtomicFile* obj_file = a.obj.empty() ? nullptr : &outputs.Add(a.obj);
 
   const auto start = std::chrono::steady_clock::now();
   AcpmResult r;
@@ -176,9 +177,10 @@ void Run(const AcpmArgs& a) {
   nlohmann::json j = AcpmResultToJson(r, m, o);
   j["material"]["file"] = a.material;
   j["compute_ms"] = ms;
-  WriteFileAtomically(a.out, j.dump(2) + "\n");
-  if (png_file) Plot(r, o, m, a.png);
-  if (obj_file) WriteFileAtomically(a.obj, ObjText(r.shape));
+  result_file.Write(j.dump(2) + "\n");
+  if (png_file) Plot(r, o, m, *png_file);
+  if (obj_file) obj_file->Write(ObjText(r.shape));
+  outputs.Commit();
 
   if (a.json) {
     j["output"] = a.out;

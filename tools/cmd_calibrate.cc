@@ -68,22 +68,22 @@ void Run(const CalibrateArgs& a) {
                                                                  : "--board";
     throw InputError(flag + ": " + why);
   }
-  // Outputs checked before the work.
-  AtomicFile rig_file(a.out);
-  std::optional<AtomicFile> overlay_file;
-  if (!a.overlay.empty()) overlay_file.emplace(a.overlay);
+  // Outputs checked before the work; they appear together.
+  CheckDistinctOutputs({{"-o", a.out}, {"--overlay", a.overlay}});
+  AtomicFileSet outputs;
+  AtomicFile& rig_file = outputs.Add(a.out);
+  AtomicFile* overlay_file = a.overlay.empty() ? nullptr : &outputs.Add(a.overlay);
   std::vector<cv::Mat> images;
   for (const auto& path : a.boards) images.push_back(ReadPhotoGray(path));
   const CalibrationSummary c = CalibrateRig(images, a.boards, o);
   if (!c.success) throw ComputeError(c.message);
-  std::ofstream(rig_file.temp_path()) << RigToJson(c.rig);
+  rig_file.Write(RigToJson(c.rig));
   if (overlay_file) {
     if (!cv::imwrite(overlay_file->temp_path(), Overlay(images[0], c.detections[0], o.cols, o.rows))) {
       throw InputError(a.overlay + ": cannot write the overlay");
     }
-    overlay_file->Commit();
   }
-  rig_file.Commit();
+  outputs.Commit();
   if (a.json) {
     nlohmann::json boards = nlohmann::json::array();
     for (const auto& d : c.detections) {

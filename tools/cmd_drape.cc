@@ -151,14 +151,6 @@ DrapeOptions Options(const DrapeArgs& a) {
   return o;
 }
 
-// Writes an output's temporary file; AtomicFileSet::Commit moves them all into place.
-void WriteTemp(AtomicFile& file, const std::string& text) {
-  std::ofstream out(file.temp_path(), std::ios::binary);
-  out << text;
-  out.close();
-  if (!out) throw InputError("cannot write " + file.path());
-}
-
 std::string OutlinePath(const std::string& result) {
   std::filesystem::path p(result);
   if (p.extension() == ".json") p.replace_extension();
@@ -381,7 +373,7 @@ void Run(const DrapeArgs& a) {
   nlohmann::json j = ResultJson(r, o, m, a, turn_down);
   j["note"] = note.empty() ? nlohmann::json() : nlohmann::json(note);
   j["outline_csv"] = outline_file.path();
-  WriteTemp(outline_file, OutlineCsv(first));
+  outline_file.Write(OutlineCsv(first));
   if (png_file) {
     if (!cv::imwrite(png_file->temp_path(), ShadowImage(r, first, o)))
       throw InputError("--png: cannot write " + a.png);
@@ -390,14 +382,14 @@ void Run(const DrapeArgs& a) {
   if (obj_file) {
     TriangleMesh draped = r.mesh;
     draped.vertices = first.positions;
-    WriteTemp(*obj_file, ObjText(draped));
+    obj_file->Write(ObjText(draped));
     j["obj"] = a.obj;
   }
   if (ply_file) {
-    WriteTemp(*ply_file, DrapedPly(r, first));
+    ply_file->Write(DrapedPly(r, first));
     j["ply"] = a.ply;
   }
-  WriteTemp(result_file, j.dump(2) + "\n");
+  result_file.Write(j.dump(2) + "\n");
   outputs.Commit();
 
   if (a.json) {

@@ -147,7 +147,7 @@ void AddClassicOutputs(const BendingLaw& law, double rho, nlohmann::json* report
 }
 
 void Plot(const FitArgs& a, const std::vector<Profile>& profiles, const Outcome& o, double rho,
-          const std::optional<ClappResult>& clapp) {
+          const std::optional<ClappResult>& clapp, AtomicFile& out) {
   namespace chart = textile::chart;
   chart::Panel prof{.title = "Profiles: measured and fitted",
                     .x_label = "x [mm]", .y_label = "y [mm]", .equal_aspect = true};
@@ -200,7 +200,7 @@ void Plot(const FitArgs& a, const std::vector<Profile>& profiles, const Outcome&
               "κ0 = " + Num(units::SiCurvatureToKes(o.law.kappa0()), 4) + " /cm"};
   chart::WritePng({.title = "textile fit (" + a.method + "), " + Num(a.gsm) + " g/m²",
                    .width_px = 1300, .height_px = 600, .columns = 2, .panels = {prof, mk}},
-                  a.plot);
+                  out);
   (void)rho;
 }
 
@@ -233,10 +233,12 @@ void Run(const FitArgs& a) {
       for (const auto& w : r.warnings) std::cout << "  warning: " << w << "\n";
     }
   }
-  // Check outputs before the work, so that a bad path fails fast.
-  AtomicFile material_file(a.out);
-  std::optional<AtomicFile> plot_file;
-  if (!a.plot.empty()) plot_file.emplace(a.plot);
+  // Check the outputs before the work, so that a bad path fails fast; they appear together.
+  CheckDistinctOutputs({{"-o", a.out}, {"--plot", a.plot}});
+  if (!a.plot.empty()) textile::chart::CheckPngPath(a.plot);
+  AtomicFileSet outputs;
+  AtomicFile& material_file = outputs.Add(a.out);
+  AtomicFile* plot_file = a.plot.empty() ? nullptr : &outputs.Add(a.plot);
 
   Outcome o = a.method == "direct" ? RunDirect(a, profiles, rho) : RunClapp(profiles, rho);
   // A fit can only hand out a law that a material file accepts: Clapp's regression, for one,
@@ -262,7 +264,7 @@ void Run(const FitArgs& a) {
     } catch (const InputError&) {
       // Clapp's points are only decoration here; a profile it cannot use is not an error.
     }
-    Plot(a, profiles, o, rho, clapp);
+    Plot(a, profiles, o, rho, clapp, *plot_file);
   }
 
   Material m;
@@ -270,8 +272,8 @@ void Run(const FitArgs& a) {
   m.areal_density = rho;
   m.bending = o.law;
   m.fit = o.report;
-  WriteFileAtomically(a.out, MaterialToJson(m).dump(2) + "\n");
-  (void)material_file;
+  material_file.Write(MaterialToJson(m).dump(2) + "\n");
+  outputs.Commit();
 
   if (a.json) {
     PrintJson({{"material_file", a.out}, {"material", MaterialToJson(m)}});

@@ -92,7 +92,7 @@ nlohmann::json ModelJson(const ModelCheck& k) {
 }
 
 void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles,
-          const BendingLaw& law, double tol_mm, bool pass, const std::string& path) {
+          const BendingLaw& law, double tol_mm, bool pass, AtomicFile& out) {
   namespace chart = textile::chart;
   chart::Panel p{.title = "Measured (dots) and simulated cantilevers: elastica (solid), shell (dashed)",
                  .x_label = "x [mm]", .y_label = "y [mm]", .equal_aspect = true,
@@ -154,7 +154,7 @@ void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles
   p.notes.push_back(std::string("verdict: ") + (pass ? "PASS" : "FAIL") + " (rms ≤ " +
                     Num(tol_mm) + " mm, max and tip ≤ " + Num(kMaxOverRms * tol_mm) + " mm)");
   chart::WritePng({.title = "textile validate", .width_px = 1100, .height_px = 800, .panels = {p}},
-                  path);
+                  out);
 }
 
 void Run(const ValidateArgs& a) {
@@ -171,7 +171,11 @@ void Run(const ValidateArgs& a) {
   const std::string report_path = (std::filesystem::path(a.out_dir) / "validate.json").string();
   const std::string png_path = (std::filesystem::path(a.out_dir) / "validate.png").string();
   const std::string material_path = (std::filesystem::path(a.out_dir) / "fitted.json").string();
-  AtomicFile report_check(report_path);  // fail fast on an unusable folder
+  // Fail fast on an unusable folder; the three files appear together or not at all.
+  AtomicFileSet outputs;
+  AtomicFile& report_file = outputs.Add(report_path);
+  AtomicFile& png_file = outputs.Add(png_path);
+  AtomicFile& material_file = outputs.Add(material_path);
 
   std::vector<Profile> profiles;
   for (const auto& in : loaded) profiles.push_back(in.profile);
@@ -274,9 +278,10 @@ void Run(const ValidateArgs& a) {
       {"material", material_path}};
   if (all_pass || !a.strict) {
     fitted.fit = {{"method", "direct"}, {"rms_mm", units::MToMm(fit.rms)}, {"validate", report_path}};
-    WriteFileAtomically(material_path, MaterialToJson(fitted).dump(2) + "\n");
-    Plot(checks, profiles, law, a.tolerance_mm, all_pass, png_path);
-    WriteFileAtomically(report_path, report.dump(2) + "\n");
+    material_file.Write(MaterialToJson(fitted).dump(2) + "\n");
+    Plot(checks, profiles, law, a.tolerance_mm, all_pass, png_file);
+    report_file.Write(report.dump(2) + "\n");
+    outputs.Commit();
   }
   if (!all_pass && a.strict) {
     std::string why;

@@ -80,14 +80,16 @@ void CheckDistinctOutputs(const std::vector<std::pair<std::string, std::string>>
   }
 }
 
+void AtomicFile::Write(std::string_view text) const {
+  std::ofstream f(temp_, std::ios::binary);
+  f.write(text.data(), static_cast<std::streamsize>(text.size()));
+  f.flush();
+  if (!f) throw InputError(path_ + ": write failed");
+}
+
 void WriteFileAtomically(const std::string& path, std::string_view text) {
   AtomicFile out(path);
-  {
-    std::ofstream f(out.temp_path(), std::ios::binary);
-    f.write(text.data(), static_cast<std::streamsize>(text.size()));
-    f.flush();
-    if (!f) throw InputError(path + ": write failed");
-  }
+  out.Write(text);
   out.Commit();
 }
 

@@ -29,6 +29,8 @@ class AtomicFile {
   // Where to write; same folder and extension as path() so writers that go by the
   // extension (OpenCV, Cairo) pick the right format.
   const std::string& temp_path() const { return temp_; }
+  // Writes text (bytes as they are) to temp_path(); throws InputError naming path() on failure.
+  void Write(std::string_view text) const;
   // Moves the finished temporary file into place. Throws InputError if it is missing/empty.
   void Commit();
   // Throws InputError, as Commit would, if the temporary file is missing or empty.

@@ -855,14 +855,18 @@ Ticks LogTicks(double lo, double hi, int max_count) {
   return t;
 }
 
-void WritePng(const Figure& figure, const std::string& path) {
+void CheckPngPath(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
   if (extension != ".png") throw InputError(path + ": a chart is written as PNG; use a .png name");
+}
+
+void WritePng(const Figure& figure, AtomicFile& out) {
+  const std::string& path = out.path();
+  CheckPngPath(path);
   std::string why;
   if (!figure.Check(&why)) throw InputError(path + ": cannot draw the chart: " + why);
-  AtomicFile out(path);  // checks the folder before any drawing work
 
   const std::unique_ptr<cairo_surface_t, SurfaceDeleter> surface(
       cairo_image_surface_create(CAIRO_FORMAT_RGB24, figure.width_px, figure.height_px));
@@ -877,6 +881,13 @@ void WritePng(const Figure& figure, const std::string& path) {
   if (written != CAIRO_STATUS_SUCCESS) {
     throw InputError(path + ": cannot write PNG: " + cairo_status_to_string(written));
   }
+  out.CheckWritten();
+}
+
+void WritePng(const Figure& figure, const std::string& path) {
+  CheckPngPath(path);
+  AtomicFile out(path);  // checks the folder before any drawing work
+  WritePng(figure, out);
   out.Commit();
 }
 

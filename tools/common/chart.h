@@ -24,6 +24,10 @@
 #include <string>
 #include <vector>
 
+namespace textile {
+class AtomicFile;
+}  // namespace textile
+
 namespace textile::chart {
 
 // A colour; components in [0, 1].
@@ -81,6 +85,12 @@ struct Figure {
 // file is left and an existing one is untouched. Throws InputError naming the path if it
 // cannot be written or the figure fails Check().
 void WritePng(const Figure& figure, const std::string& path);
+// The same into an output staged in an AtomicFileSet (or an AtomicFile the caller commits):
+// the picture goes to out.temp_path(); out.path() must end in .png.
+void WritePng(const Figure& figure, AtomicFile& out);
+// Throws InputError naming the path unless it ends in .png (any case): callers that stage a
+// chart check its name before the work.
+void CheckPngPath(const std::string& path);
 
 // ---- Building blocks, exposed for tests ----
 

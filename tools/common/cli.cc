@@ -59,19 +59,26 @@ std::string BaseTypeName(const CLI::Option& option) {
 }
 }  // namespace
 
-void RefuseEmptyNumbers(CLI::App& app) {
-  static const CLI::Validator kNotEmpty(
+void RefuseEmptyValues(CLI::App& app) {
+  static const CLI::Validator kNotEmptyNumber(
       [](std::string& value) {
         return value.empty() ? std::string("an empty value is not a number") : std::string();
+      },
+      "", "NOT_EMPTY");
+  static const CLI::Validator kNotEmptyText(
+      [](std::string& value) {
+        return value.empty() ? std::string("an empty value is not a file, a name or a choice") : std::string();
       },
       "", "NOT_EMPTY");
   for (CLI::Option* option : app.get_options()) {
     const std::string type = BaseTypeName(*option);  // empty for flags
     if (type == "FLOAT" || type == "INT" || type == "UINT" || type == "NUMBER") {
-      option->check(kNotEmpty);
+      option->check(kNotEmptyNumber);
+    } else if (type == "TEXT") {
+      option->check(kNotEmptyText);
     }
   }
-  for (CLI::App* sub : app.get_subcommands({})) RefuseEmptyNumbers(*sub);
+  for (CLI::App* sub : app.get_subcommands({})) RefuseEmptyValues(*sub);
 }
 
 namespace {
@@ -91,7 +98,7 @@ void RegisterAllCommands(CLI::App& app) {
   std::stable_sort(commands.begin(), commands.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   for (const auto& [order, registrar] : commands) registrar(app);
-  RefuseEmptyNumbers(app);
+  RefuseEmptyValues(app);
 }
 
 }  // namespace textile::cli

@@ -45,15 +45,18 @@ void Progress(const std::string& line, bool always = false);
 // extract 30, render-photo 35, fit 40, fit-seam 45, acpm 50, drape 60, validate 70, bench 90).
 using CommandRegistrar = void (*)(CLI::App& app);
 bool AddCommand(int order, CommandRegistrar registrar);
-// Adds every registered subcommand to app, in order, and makes every number option of theirs
-// refuse an empty value (RefuseEmptyNumbers).
+// Adds every registered subcommand to app, in order, and makes every option and argument of
+// theirs that takes a number or a text refuse an empty value (RefuseEmptyValues).
 void RegisterAllCommands(CLI::App& app);
 
 // CLI11 2.1 reads an empty value of a number option as 0, and of a number list as no value
-// (`textile law --kappa ""` printed the default curvatures): this adds a check to every option
-// of app and its subcommands whose type is a number or a list of numbers, so that such a value
-// is a usage error naming the flag (exit 2).
-void RefuseEmptyNumbers(CLI::App& app);
+// (`textile law --kappa ""` printed the default curvatures); an empty output path read as "not
+// asked for" (`--png ""` exited 0 without the picture), an empty input path failed with
+// "error: : cannot open ...". This adds a check to every option and positional argument of app
+// and its subcommands whose type is a number or a text, or a list of them, so that such a value
+// is a usage error naming the flag (exit 2). No option of textile takes an empty text on
+// purpose: an output not wanted is left out, a name not given gets its default.
+void RefuseEmptyValues(CLI::App& app);
 
 }  // namespace textile::cli
 

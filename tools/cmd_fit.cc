@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iostream>
 #include <optional>
+#include <sstream>
 
 #include "common/atomic_file.h"
 #include "common/chart.h"
@@ -214,8 +215,16 @@ void Run(const FitArgs& a) {
   if (a.thickness_given && a.no_offset)
     throw InputError("--thickness-mm and --no-offset contradict each other (offset t/2 vs 0)");
   const double rho = units::GsmToSi(a.gsm);
+  // Check the outputs before the work (photos included), so that a bad path fails fast; they appear together.
+  CheckDistinctOutputs({{"-o", a.out}, {"--plot", a.plot}});
+  if (!a.plot.empty()) textile::chart::CheckPngPath(a.plot);
+  AtomicFileSet outputs;
+  AtomicFile& material_file = outputs.Add(a.out);
+  AtomicFile* plot_file = a.plot.empty() ? nullptr : &outputs.Add(a.plot);
+
   const std::vector<LoadedProfile> loaded = LoadProfileInputs(a.inputs, a.photo.Options());
   std::vector<Profile> profiles;
+  std::ostringstream extracted;  // printed once the fit has succeeded: a failed run's stdout stays empty
   nlohmann::json photos = nlohmann::json::array();
   for (const auto& in : loaded) {
     profiles.push_back(in.profile);
@@ -227,19 +236,12 @@ void Run(const FitArgs& a) {
                       {"tip_mm", {r.tip_mm.x(), r.tip_mm.y()}}, {"mm_per_px", r.mm_per_px},
                       {"warnings", r.warnings}});
     if (!a.json) {
-      std::cout << "extracted " << in.source << ": " << r.rig_type << " rig, " << r.polarity
+      extracted << "extracted " << in.source << ": " << r.rig_type << " rig, " << r.polarity
                 << " strip, L = " << Num(r.length_mm, 4) << " mm, tip (" << Num(r.tip_mm.x(), 4)
                 << ", " << Num(r.tip_mm.y(), 4) << ") mm, " << r.profile.size() << " points\n";
-      for (const auto& w : r.warnings) std::cout << "  warning: " << w << "\n";
+      for (const auto& w : r.warnings) extracted << "  warning: " << w << "\n";
     }
   }
-  // Check the outputs before the work, so that a bad path fails fast; they appear together.
-  CheckDistinctOutputs({{"-o", a.out}, {"--plot", a.plot}});
-  if (!a.plot.empty()) textile::chart::CheckPngPath(a.plot);
-  AtomicFileSet outputs;
-  AtomicFile& material_file = outputs.Add(a.out);
-  AtomicFile* plot_file = a.plot.empty() ? nullptr : &outputs.Add(a.plot);
-
   Outcome o = a.method == "direct" ? RunDirect(a, profiles, rho) : RunClapp(profiles, rho);
   // A fit can only hand out a law that a material file accepts: Clapp's regression, for one,
   // can wander to constants no fabric has when the polynomial is poor.
@@ -279,7 +281,7 @@ void Run(const FitArgs& a) {
     PrintJson({{"material_file", a.out}, {"material", MaterialToJson(m)}});
     return;
   }
-  std::cout << o.brief << "\n";
+  std::cout << extracted.str() << o.brief << "\n";
   std::cout << "law: b1 = " << Num(o.law.b1_kes(), 5) << " gf·cm, b2 = " << Num(o.law.b2_kes(), 5)
             << " gf·cm, c1 = " << Num(o.law.c1_kes(), 5) << " gf·cm²  (kappa0 = "
             << Num(units::SiCurvatureToKes(o.law.kappa0()), 4) << " /cm)\n";

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -73,6 +74,30 @@ TEST(AtomicFile, CommitWithoutContentThrows) {
   AtomicFile out((d / "x.json").string());
   EXPECT_THROW(out.Commit(), InputError);
   EXPECT_FALSE(fs::exists(d / "x.json"));
+}
+
+TEST(AtomicFile, WriteFillsTheTemporaryFileByteForByte) {
+  const fs::path d = ScratchDir("atomic_write");
+  const std::string p = (d / "a.csv").string();
+  const std::string text("x,y\r\n\0\xff\n", 8);  // bytes as they are: CR, NUL, not UTF-8
+  AtomicFile out(p);
+  out.Write(text);
+  EXPECT_FALSE(fs::exists(p));
+  out.Commit();
+  std::ifstream f(p, std::ios::binary);
+  const std::string back((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(back, text);
+  // A temporary file that cannot be written (its folder gone) is an InputError naming the file.
+  const fs::path gone = d / "gone";
+  fs::create_directories(gone);
+  AtomicFile lost((gone / "b.json").string());
+  fs::remove_all(gone);
+  try {
+    lost.Write("{}");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("b.json"), std::string::npos) << e.what();
+  }
 }
 
 TEST(AtomicFileSet, AllOrNothing) {

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "common/atomic_file.h"
 #include "textile/sim/error.h"
 
 namespace fs = std::filesystem;
@@ -330,6 +331,33 @@ TEST(Chart, BadFigureThrowsInputErrorNamingTheProblem) {
   std::string why;
   EXPECT_FALSE(OnePanel(log_range).Check(&why));
   EXPECT_NE(why.find("positive"), std::string::npos) << why;
+}
+
+TEST(Chart, DrawsIntoAStagedFileThatAppearsOnlyWithItsSet) {
+  const fs::path d = ScratchDir("chart_staged");
+  Panel p;
+  p.series.push_back(Line({0, 1, 2}, {0, 1, 4}, "fit"));
+  const std::string path = (d / "fit.png").string();
+  {
+    // Drawn, but the set is dropped (a later output failed): nothing appears, no temp is left.
+    AtomicFileSet outputs;
+    WritePng(OnePanel(p), outputs.Add(path));
+  }
+  EXPECT_FALSE(fs::exists(path));
+  EXPECT_EQ(std::distance(fs::directory_iterator(d), fs::directory_iterator{}), 0);
+  AtomicFileSet outputs;
+  AtomicFile& staged = outputs.Add(path);
+  WritePng(OnePanel(p), staged);
+  EXPECT_FALSE(fs::exists(path));  // not before the set's Commit
+  outputs.Commit();
+  const Image img(path);
+  ASSERT_TRUE(img.ok());
+  EXPECT_GT(img.Find(PaletteColor(0)).count, 30);
+  // The name is checked as WritePng(figure, path) checks it, before anything is drawn.
+  AtomicFileSet other;
+  EXPECT_THROW(WritePng(OnePanel(p), other.Add((d / "fit.jpg").string())), InputError);
+  EXPECT_THROW(CheckPngPath((d / "fit.svg").string()), InputError);
+  EXPECT_NO_THROW(CheckPngPath((d / "FIT.PNG").string()));
 }
 
 TEST(Chart, InvalidUtf8LabelStillDrawsTheChart) {

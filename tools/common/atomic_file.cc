@@ -83,7 +83,7 @@ void CheckDistinctOutputs(const std::vector<std::pair<std::string, std::string>>
 void AtomicFile::Write(std::string_view text) const {
   std::ofstream f(temp_, std::ios::binary);
   f.write(text.data(), static_cast<std::streamsize>(text.size()));
-  f.flush();
+  f.close();  // some write errors only show when the file is closed
   if (!f) throw InputError(path_ + ": write failed");
 }
 

@@ -67,7 +67,7 @@ void RefuseEmptyValues(CLI::App& app) {
       "", "NOT_EMPTY");
   static const CLI::Validator kNotEmptyText(
       [](std::string& value) {
-        return value.empty() ? std::string("an empty value is not a file, a name or a choice") : std::string();
+        return value.empty() ? std::string("an empty value is not allowed") : std::string();
       },
       "", "NOT_EMPTY");
   for (CLI::Option* option : app.get_options()) {

@@ -73,8 +73,8 @@ void Run(const CalibrateArgs& a) {
   AtomicFileSet outputs;
   AtomicFile& rig_file = outputs.Add(a.out);
   AtomicFile* overlay_file = a.overlay.empty() ? nullptr : &outputs.Add(a.overlay);
-  if (overlay_file && !cv::haveImageWriter(a.overlay))
-    throw InputError("--overlay: " + a.overlay + ": no image format for this name; use .png");
+  if (overlay_file)
+    CheckOutputExtension("--overlay", a.overlay, {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff"});
   std::vector<cv::Mat> images;
   for (const auto& path : a.boards) images.push_back(ReadPhotoGray(path));
   const CalibrationSummary c = CalibrateRig(images, a.boards, o);

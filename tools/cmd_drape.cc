@@ -357,8 +357,7 @@ void Run(const DrapeArgs& a) {
   AtomicFile& result_file = outputs.Add(a.out);
   AtomicFile& outline_file = outputs.Add(outline_path);
   AtomicFile* png_file = a.png.empty() ? nullptr : &outputs.Add(a.png);
-  if (png_file && !cv::haveImageWriter(a.png))
-    throw InputError("--png: " + a.png + ": no image format for this name; use .png");
+  if (png_file) CheckOutputExtension("--png", a.png, {".png"});
   AtomicFile* obj_file = a.obj.empty() ? nullptr : &outputs.Add(a.obj);
   AtomicFile* ply_file = a.ply.empty() ? nullptr : &outputs.Add(a.ply);
 

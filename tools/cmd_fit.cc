@@ -225,6 +225,7 @@ void Run(const FitArgs& a) {
   const std::vector<LoadedProfile> loaded = LoadProfileInputs(a.inputs, a.photo.Options());
   std::vector<Profile> profiles;
   std::ostringstream extracted;  // printed once the fit has succeeded: a failed run's stdout stays empty
+  std::string photo_warnings;    // what may explain a failed fit, for its one error line
   nlohmann::json photos = nlohmann::json::array();
   for (const auto& in : loaded) {
     profiles.push_back(in.profile);
@@ -241,17 +242,24 @@ void Run(const FitArgs& a) {
                 << ", " << Num(r.tip_mm.y(), 4) << ") mm, " << r.profile.size() << " points\n";
       for (const auto& w : r.warnings) extracted << "  warning: " << w << "\n";
     }
+    for (const auto& w : r.warnings) photo_warnings += "; " + in.source + ": " + w;
   }
-  Outcome o = a.method == "direct" ? RunDirect(a, profiles, rho) : RunClapp(profiles, rho);
-  // A fit can only hand out a law that a material file accepts: Clapp's regression, for one,
-  // can wander to constants no fabric has when the polynomial is poor.
+  Outcome o;
   try {
-    Material probe;
-    probe.areal_density = rho;
-    probe.bending = o.law;
-    ParseMaterialJson(MaterialToJson(probe).dump(), "fitted law");
-  } catch (const InputError& e) {
-    throw ComputeError(std::string("fit (") + a.method + ") gave an implausible law: " + e.what());
+    o = a.method == "direct" ? RunDirect(a, profiles, rho) : RunClapp(profiles, rho);
+    // A fit can only hand out a law that a material file accepts: Clapp's regression, for one,
+    // can wander to constants no fabric has when the polynomial is poor.
+    try {
+      Material probe;
+      probe.areal_density = rho;
+      probe.bending = o.law;
+      ParseMaterialJson(MaterialToJson(probe).dump(), "fitted law");
+    } catch (const InputError& e) {
+      throw ComputeError(std::string("fit (") + a.method + ") gave an implausible law: " + e.what());
+    }
+  } catch (const ComputeError& e) {
+    if (photo_warnings.empty()) throw;
+    throw ComputeError(e.what() + std::string(" (extraction warnings") + photo_warnings + ")");
   }
 
   AddClassicOutputs(o.law, rho, &o.report);

@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -85,6 +87,18 @@ void AtomicFile::Write(std::string_view text) const {
   f.write(text.data(), static_cast<std::streamsize>(text.size()));
   f.close();  // some write errors only show when the file is closed
   if (!f) throw InputError(path_ + ": write failed");
+}
+
+void CheckOutputExtension(const std::string& flag, const std::string& path,
+                          const std::vector<std::string>& extensions) {
+  std::string extension = fs::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  if (std::find(extensions.begin(), extensions.end(), extension) != extensions.end()) return;
+  std::string names;
+  for (size_t i = 0; i < extensions.size(); ++i)
+    names += (i == 0 ? "" : i + 1 == extensions.size() ? " or " : ", ") + extensions[i];
+  throw InputError(flag + ": " + path + ": name it " + names);
 }
 
 void WriteFileAtomically(const std::string& path, std::string_view text) {

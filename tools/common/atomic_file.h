@@ -66,6 +66,12 @@ class AtomicFileSet {
 // std::filesystem::weakly_canonical, so "a.json" and "./a.json" are the same file.
 void CheckDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs);
 
+// Refuses an output whose extension (any case) is none of `extensions` (".png", ".jpg", ...):
+// throws InputError "<flag>: <path>: name it .png or .jpg". Image writers go by the name, and
+// one they cannot serve would fail only after the work (OpenCV: with an exception, exit 3).
+void CheckOutputExtension(const std::string& flag, const std::string& path,
+                          const std::vector<std::string>& extensions);
+
 // Writes text to path atomically. Throws InputError naming the path on failure.
 void WriteFileAtomically(const std::string& path, std::string_view text);
 

@@ -55,7 +55,13 @@ AcpmOptions Options(const AcpmArgs& a) {
   } else {
     o.seam.direction = ParseAcpmSeamDirection(a.seam_dir.empty() ? "along" : a.seam_dir);
     o.seam.profile = LoadSeam(a.seam);
-    if (a.seam_at_mm) o.seam.position = units::MmToM(*a.seam_at_mm);
+    if (a.seam_at_mm) {
+      // NaN is the library's "not given" (the middle of the width, along): a NaN typed here
+      // would silently become that.
+      if (!std::isfinite(*a.seam_at_mm))
+        throw InputError("--seam-at: must be a finite number [mm], got " + Num(*a.seam_at_mm));
+      o.seam.position = units::MmToM(*a.seam_at_mm);
+    }
   }
   if (std::string why; !o.Check(&why)) throw InputError("acpm: " + why);
   return o;

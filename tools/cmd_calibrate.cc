@@ -1,9 +1,10 @@
 // textile calibrate: chessboard photos -> a rig file (image -> bending-plane homography, with
 // several boards also the lens distortion), for `textile extract --rig` and `textile fit --rig`.
 
-#include <fstream>
+#include <filesystem>
 #include <iostream>
-#include <optional>
+#include <system_error>
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -75,6 +76,15 @@ void Run(const CalibrateArgs& a) {
   AtomicFile* overlay_file = a.overlay.empty() ? nullptr : &outputs.Add(a.overlay);
   if (overlay_file)
     CheckOutputExtension("--overlay", a.overlay, {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff"});
+  // One photo given twice adds no pose: the lens distortion would be fitted to one view.
+  for (size_t j = 1; j < a.boards.size(); ++j) {
+    for (size_t i = 0; i < j; ++i) {
+      std::error_code ec;
+      if (std::filesystem::equivalent(a.boards[i], a.boards[j], ec))
+        throw InputError(a.boards[j] + ": the same photo as " + a.boards[i] +
+                         " (more boards must show other poses)");
+    }
+  }
   std::vector<cv::Mat> images;
   for (const auto& path : a.boards) images.push_back(ReadPhotoGray(path));
   const CalibrationSummary c = CalibrateRig(images, a.boards, o);

@@ -39,6 +39,7 @@ struct DrapeArgs {
   std::optional<double> tolerance;
   double max_seconds = 600.0;
   bool coarse = false, no_coarse = false;
+  bool progress = false;  // the solver's progress lines on stderr even when it is not a terminal
   bool extrapolate = false, no_extrapolate = false;
   bool json = false;
 };
@@ -96,7 +97,8 @@ DrapeOptions Options(const DrapeArgs& a) {
   };
   o.specimen_radius = units::MmToM(finite(a.specimen_mm, "--specimen-mm"));
   o.support_radius = units::MmToM(finite(a.support_mm, "--support-mm"));
-  if (!(a.specimen_mm > 0.0)) throw InputError("--specimen-mm: must be > 0");
+  if (!(a.specimen_mm > 0.0 && a.specimen_mm <= 2000.0))
+    throw InputError("--specimen-mm: must be in (0, 2000] mm");
   if (!(a.support_mm > 0.0)) throw InputError("--support-mm: must be > 0");
   if (a.specimen_mm <= a.support_mm)
     throw InputError("--specimen-mm: the specimen (" + Num(a.specimen_mm) +
@@ -104,7 +106,8 @@ DrapeOptions Options(const DrapeArgs& a) {
   o.seam_shift = units::MmToM(finite(a.shift_mm, "--shift-mm"));
   if (std::abs(a.shift_mm) >= a.specimen_mm) throw InputError("--shift-mm: the seam must cross the specimen");
   o.perturbation = units::MmToM(finite(a.perturbation_mm, "--perturbation-mm"));
-  if (!(a.perturbation_mm > 0.0)) throw InputError("--perturbation-mm: must be > 0");
+  if (!(a.perturbation_mm > 0.0 && a.perturbation_mm <= a.specimen_mm))
+    throw InputError("--perturbation-mm: must be in (0, the specimen radius " + Num(a.specimen_mm) + " mm]");
   o.frame_angle = finite(a.frame_deg, "--frame-deg") * kDegree;
   if (a.seeds < 1 || a.seeds > 1000) throw InputError("--seeds: must be in 1..1000");
   o.seeds = a.seeds;
@@ -361,7 +364,9 @@ void Run(const DrapeArgs& a) {
   AtomicFile* obj_file = a.obj.empty() ? nullptr : &outputs.Add(a.obj);
   AtomicFile* ply_file = a.ply.empty() ? nullptr : &outputs.Add(a.ply);
 
-  o.progress = [](const std::string& line) { Info("drape: " + line); };
+  // Progress lines (the mesh, each seed's solves) only on a terminal or with --progress: a
+  // failed run's stderr holds its one error line (cli.md).
+  o.progress = [progress = a.progress](const std::string& line) { Progress("drape: " + line, progress); };
   DrapeResult r;
   try {
     r = SimulateDrape(m, o);
@@ -488,6 +493,9 @@ void RegisterDrape(CLI::App& app) {
   sub->add_option("--ply", a->ply,
                   "Draped mesh of the first seed (ASCII PLY, metres) with each vertex's pattern position "
                   "rest_x, rest_y and, with seams, its distance to the nearest seam line seam_distance [m]");
+  sub->add_flag("--progress", a->progress,
+                "Print the progress lines (the mesh, each seed's solves) on stderr even when it is not a "
+                "terminal");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   sub->callback([a] { Run(*a); });
 }

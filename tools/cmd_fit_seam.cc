@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "common/atomic_file.h"
@@ -18,7 +19,7 @@ namespace {
 
 struct FitSeamArgs {
   std::string input, out, name;
-  int layers = 0;  // 0: from the ACPM result's seam, else required
+  std::optional<int> layers;  // not given: from the ACPM result's seam, else required
   double influence_mm = 100.0;
   bool strict = false, json = false;
 };
@@ -44,8 +45,8 @@ void Run(const FitSeamArgs& a) {
   SeamFitOptions o;
   o.name = a.name;
   o.influence_mm = a.influence_mm;
-  o.layers = a.layers != 0 ? a.layers : LayersFromAcpmResult(a.input);
-  if (o.layers == 0)
+  o.layers = a.layers ? *a.layers : LayersFromAcpmResult(a.input);
+  if (!a.layers && o.layers == 0)
     throw InputError("--layers: required for " + a.input +
                      " (the seam's fabric layers, Table 1: A 2, B 3, C 4)");
   if (std::string why; !o.Check(&why)) throw InputError("--layers/--influence-mm: " + why);

@@ -116,10 +116,10 @@ void Run(const RenderArgs& a) {
                          LengthTag(a.overhangs_mm[i]) + ")");
     }
   }
-  if (!(std::isfinite(a.thickness_mm) && a.thickness_mm > 0 && a.thickness_mm <= 20))
-    throw InputError("--thickness-mm must lie in (0, 20] mm");
-  if (!(std::isfinite(a.mm_per_px) && a.mm_per_px > 0 && a.mm_per_px <= 10))
-    throw InputError("--mm-per-px must lie in (0, 10]");
+  if (!(std::isfinite(a.thickness_mm) && a.thickness_mm >= 0.01 && a.thickness_mm <= 20))
+    throw InputError("--thickness-mm must lie in [0.01, 20] mm");
+  if (!(std::isfinite(a.mm_per_px) && a.mm_per_px >= 0.001 && a.mm_per_px <= 10))
+    throw InputError("--mm-per-px must lie in [0.001, 10]");
   if (a.jpeg > 100 || a.jpeg < -1) throw InputError("--jpeg must lie in [0, 100]");
   const bool as_jpeg = IsJpegPath(a.out);
 
@@ -166,7 +166,7 @@ void Run(const RenderArgs& a) {
     o.overhang = lengths[i] * 1e-3;
     const std::string photo_path = several ? WithSuffix(a.out, LengthTag(lengths[i]), ext) : a.out;
     const std::string truth_path = WithSuffix(photo_path, ".truth", ".csv");
-    if (several) Info("rendering " + photo_path + " ...");
+    if (several) Progress("rendering " + photo_path + " ...");  // on a terminal only
     const RenderedPhoto r = RenderPhoto(m.EffectiveLaw(), m.areal_density, o);
     if (k == 0) {
       o.aim_mm = r.aim_mm;

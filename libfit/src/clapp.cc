@@ -265,7 +265,10 @@ ClappResult FitClapp(const std::vector<Profile>& profiles, double areal_density,
     sum_kk += p.kappa * p.kappa;
   }
   const double linear_stiffness = sum_kk > 0.0 ? sum_km / sum_kk : 0.0;  // M ≈ B κ [N·m]
-  if (!(moment_max > 0.0) || !(result.kappa_max > 0.0)) {
+  // A straight strip's curvature is round-off (6e-14 /cm for a vertical one), not zero: below
+  // 1e-4 /m (a radius of 10 km) a strip does not bend.
+  constexpr double kNoCurvature = 1e-4;  // [1/m]
+  if (!(moment_max > 0.0) || !(result.kappa_max > kNoCurvature)) {
     result.message = "Clapp fit: the profiles show no bending; no law fitted";
     return result;
   }

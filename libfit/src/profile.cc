@@ -85,8 +85,7 @@ Profile ParseProfileCsv(const std::string& text, const std::string& source) {
 }
 
 Profile ReadProfileCsv(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError(path + ": cannot open profile");
+  std::ifstream f = OpenInputFile(path, "profile");
   std::stringstream buffer;
   buffer << f.rdbuf();
   if (f.bad()) throw InputError(path + ": cannot read profile");

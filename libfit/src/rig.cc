@@ -206,8 +206,7 @@ Rig ParseRigJson(const std::string& text, const std::string& source) {
 }
 
 Rig ReadRigJson(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open rig file");
+  std::ifstream in = OpenInputFile(path, "rig file");
   std::stringstream buffer;
   buffer << in.rdbuf();
   if (in.bad()) throw InputError(path + ": cannot read rig file");

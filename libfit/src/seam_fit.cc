@@ -145,8 +145,7 @@ std::vector<SeamSample> SeamSamplesFromAcpmJson(const nlohmann::json& result,
 }
 
 std::vector<SeamSample> ReadSeamSamples(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError(path + ": cannot open");
+  std::ifstream f = OpenInputFile(path, "seam measurement file");
   std::stringstream buffer;
   buffer << f.rdbuf();
   if (f.bad()) throw InputError(path + ": cannot read");

@@ -163,8 +163,7 @@ Material ParseMaterialJson(const std::string& text, const std::string& source) {
 }
 
 Material ReadMaterial(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError(path + ": cannot open material file");
+  std::ifstream f = OpenInputFile(path, "material file");
   std::stringstream buffer;
   buffer << f.rdbuf();
   if (f.bad()) throw InputError(path + ": cannot read material file");

@@ -361,8 +361,7 @@ SeamProfile ParseSeamJson(const std::string& text, const std::string& source) {
 }
 
 SeamProfile ReadSeamProfile(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError(path + ": cannot open seam file");
+  std::ifstream f = OpenInputFile(path, "seam file");
   std::stringstream buffer;
   buffer << f.rdbuf();
   if (f.bad()) throw InputError(path + ": cannot read seam file");

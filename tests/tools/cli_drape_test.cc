@@ -31,7 +31,7 @@ TEST(CliDrape, PlainDrapeWritesResultOutlinePngAndObj) {
   const auto dir = Scratch("CliDrape.Plain");
   const auto r = Textile("drape " + kFig8 + kCoarse + " --seeds 2 -o " + (dir / "drape.json").string() +
                          " --png " + (dir / "shadow.png").string() + " --obj " + (dir / "mesh.obj").string() +
-                         " --json");
+                         " --json --progress");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("drape: seed 2"), std::string::npos) << r.err;  // progress on stderr
   const auto out = nlohmann::json::parse(r.out);
@@ -285,7 +285,7 @@ TEST(CliDrape, ExtrapolateReportsBothDrapesAndTheExtrapolatedDc) {
 // mesh is reported before the solve (capped runs: nothing is written).
 TEST(CliDrape, AutoRimIsHalfTheTurnDownWhenExtrapolatingElseAThird) {
   const auto dir = Scratch("CliDrape.AutoRim");
-  const auto capped = kFig8 + kCoarseMesh + " --max-seconds 0.001 -o " + (dir / "r.json").string();
+  const auto capped = kFig8 + kCoarseMesh + " --max-seconds 0.001 --progress -o " + (dir / "r.json").string();
   const auto extrapolating = Textile("drape " + capped);
   const auto single = Textile("drape " + capped + " --no-extrapolate");
   const auto both = Textile("drape " + capped + " --extrapolate --no-extrapolate");
@@ -319,7 +319,7 @@ TEST(CliDrape, CoarseRimGetsANoteAndAutoMeshesItFiner) {
   EXPECT_EQ(j["note"].get<std::string>().rfind(note.substr(6), 0), 0u) << j["note"];
   // No --rim-mm: the default, auto, ℓ/3 = 2.9 mm along the rim, several times the plain 15 mm
   // disk's 442 vertices (a capped run: the mesh is reported before the solve).
-  const auto autorim = Textile("drape " + kFig8 + kCoarseMesh + " --max-seconds 0.001 -o " +
+  const auto autorim = Textile("drape " + kFig8 + kCoarseMesh + " --max-seconds 0.001 --progress -o " +
                                (dir / "auto.json").string());
   EXPECT_EQ(autorim.exit_code, 3) << autorim.err;
   EXPECT_GT(MeshVertices(autorim.err), 4 * 442) << autorim.err;
@@ -333,9 +333,11 @@ TEST(CliDrape, NonConvergenceIsExit3WithOneLineAndNoFiles) {
                          (dir / "r.ply").string());
   EXPECT_EQ(r.exit_code, 3) << r.err;
   EXPECT_NE(LastError(r.err).find("not converged"), std::string::npos) << r.err;
+  EXPECT_EQ(testing::CountLines(r.err), 1) << r.err;  // no progress lines without --progress
+  EXPECT_TRUE(r.out.empty()) << r.out;
   EXPECT_TRUE(fs::is_empty(dir)) << "a failed run left a file";
   // The same when a cascade's coarse level stops short ahead of the (default) rim split.
-  const auto c = Textile("drape " + kFig8 + " --coarse-to-fine --max-seconds 0.01 -o " +
+  const auto c = Textile("drape " + kFig8 + " --coarse-to-fine --max-seconds 0.01 --progress -o " +
                          (dir / "c.json").string());
   EXPECT_EQ(c.exit_code, 3) << c.err;
   EXPECT_NE(c.err.find("split at the rim"), std::string::npos) << c.err;
@@ -358,7 +360,7 @@ TEST(CliDrape, RestingMountSettlesAndACutShortRunFailsCleanly) {
   EXPECT_GT(j["drape_coefficient"].get<double>(), 0.0);
   EXPECT_LT(j["drape_coefficient"].get<double>(), 1.0);
   EXPECT_GT(j["seeds"][0]["solver"]["contacts"].get<int>(), 0) << j["seeds"][0]["solver"].dump();
-  const auto cut = Textile("drape " + kFig8 + kCoarse + " --mount resting --max-seconds 0.001 -o " +
+  const auto cut = Textile("drape " + kFig8 + kCoarse + " --mount resting --max-seconds 0.001 --progress -o " +
                            (dir / "cut.json").string());
   EXPECT_EQ(cut.exit_code, 3) << cut.err;
   EXPECT_NE(LastError(cut.err).find("not converged"), std::string::npos) << cut.err;
@@ -367,7 +369,7 @@ TEST(CliDrape, RestingMountSettlesAndACutShortRunFailsCleanly) {
     const size_t at = err.find("drape: mesh: ");
     return at == std::string::npos ? -1 : std::stoi(err.substr(at + 13));
   };
-  const auto banded = Textile("drape " + kFig8 + kCoarseMesh + " --mount resting --max-seconds 0.001 -o " +
+  const auto banded = Textile("drape " + kFig8 + kCoarseMesh + " --mount resting --max-seconds 0.001 --progress -o " +
                               (dir / "band.json").string());
   EXPECT_EQ(banded.exit_code, 3) << banded.err;
   EXPECT_GT(vertices(banded.err), vertices(cut.err)) << banded.err << cut.err;

@@ -3,8 +3,10 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <sstream>
 #include <utility>
@@ -65,15 +67,36 @@ void RefuseEmptyValues(CLI::App& app) {
         return value.empty() ? std::string("an empty value is not a number") : std::string();
       },
       "", "NOT_EMPTY");
+  // CLI11 2.1 reads a whole number with strtoll/strtoull and keeps their saturated result for a
+  // 64-bit target: `synth-profile --seed 99999999999999999999` ran with 2^63 - 1.
+  const auto in_range = [](bool is_signed) {
+    return CLI::Validator(
+        [is_signed](std::string& value) {
+          errno = 0;
+          if (is_signed) {
+            (void)std::strtoll(value.c_str(), nullptr, 0);
+          } else {
+            (void)std::strtoull(value.c_str(), nullptr, 0);
+          }
+          return errno == ERANGE ? value + " is out of range" : std::string();
+        },
+        "", "IN_RANGE");
+  };
+  static const CLI::Validator kIntInRange = in_range(true), kUintInRange = in_range(false);
   static const CLI::Validator kNotEmptyText(
       [](std::string& value) {
-        return value.empty() ? std::string("an empty value is not allowed") : std::string();
+        if (value.empty()) return std::string("an empty value is not allowed");
+        // Names and paths end up in the JSON results, which must be UTF-8.
+        if (!IsValidUtf8(value)) return std::string("not valid UTF-8 text");
+        return std::string();
       },
       "", "NOT_EMPTY");
   for (CLI::Option* option : app.get_options()) {
     const std::string type = BaseTypeName(*option);  // empty for flags
     if (type == "FLOAT" || type == "INT" || type == "UINT" || type == "NUMBER") {
       option->check(kNotEmptyNumber);
+      if (type == "INT") option->check(kIntInRange);
+      if (type == "UINT") option->check(kUintInRange);
     } else if (type == "TEXT") {
       option->check(kNotEmptyText);
     }

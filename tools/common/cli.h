@@ -55,7 +55,10 @@ void RegisterAllCommands(CLI::App& app);
 // "error: : cannot open ...". This adds a check to every option and positional argument of app
 // and its subcommands whose type is a number or a text, or a list of them, so that such a value
 // is a usage error naming the flag (exit 2). No option of textile takes an empty text on
-// purpose: an output not wanted is left out, a name not given gets its default.
+// purpose: an output not wanted is left out, a name not given gets its default. A text that is
+// not valid UTF-8 is refused the same way: names and paths are stored in JSON results, which a
+// run would otherwise fail to write after its work ("error: internal").
+// A whole number beyond the 64-bit range is refused too (CLI11 kept strtoll's saturated value).
 void RefuseEmptyValues(CLI::App& app);
 
 }  // namespace textile::cli

@@ -1,6 +1,7 @@
 #ifndef TEXTILE_SIM_ERROR_H_
 #define TEXTILE_SIM_ERROR_H_
 
+#include <fstream>
 #include <stdexcept>
 #include <string>
 
@@ -19,6 +20,11 @@ class ComputeError : public std::runtime_error {
  public:
   explicit ComputeError(const std::string& message) : std::runtime_error(message) {}
 };
+
+// Opens an input file for binary reading. Throws InputError "<path>: is a folder, not a <what>"
+// or "<path>: cannot open <what>" (what: "material file", "profile", ...): a folder opens as an
+// empty stream on Linux and would otherwise be reported as an empty file.
+std::ifstream OpenInputFile(const std::string& path, const std::string& what);
 
 }  // namespace textile
 

@@ -80,7 +80,8 @@ void Run(const CalibrateArgs& a) {
   for (size_t j = 1; j < a.boards.size(); ++j) {
     for (size_t i = 0; i < j; ++i) {
       std::error_code ec;
-      if (std::filesystem::equivalent(a.boards[i], a.boards[j], ec))
+      if (std::filesystem::is_regular_file(a.boards[j], ec) &&
+          std::filesystem::equivalent(a.boards[i], a.boards[j], ec))
         throw InputError(a.boards[j] + ": the same photo as " + a.boards[i] +
                          " (more boards must show other poses)");
     }

@@ -3,6 +3,7 @@
 // written as a seam file (libsim seam.h) of type "fitted" with a `fit` report.
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -35,8 +36,13 @@ int LayersFromAcpmResult(const std::string& path) {
   const nlohmann::json j = ParseJsonText(text, path);
   if (j.contains("seam") && j["seam"].is_object() && j["seam"].contains("profile") &&
       j["seam"]["profile"].is_object() && j["seam"]["profile"].contains("layers") &&
-      j["seam"]["profile"]["layers"].is_number_integer())
-    return j["seam"]["profile"]["layers"].get<int>();
+      j["seam"]["profile"]["layers"].is_number_integer()) {
+    // Read wide and checked here: get<int>() would wrap a huge count into the valid range.
+    const std::int64_t layers = j["seam"]["profile"]["layers"].get<std::int64_t>();
+    if (layers < 1 || layers > 20)
+      throw InputError(path + ": seam.profile.layers must be in [1, 20], got " + std::to_string(layers));
+    return static_cast<int>(layers);
+  }
   return 0;
 }
 

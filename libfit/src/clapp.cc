@@ -269,7 +269,8 @@ ClappResult FitClapp(const std::vector<Profile>& profiles, double areal_density,
   // 1e-4 /m (a radius of 10 km) a strip does not bend.
   constexpr double kNoCurvature = 1e-4;  // [1/m]
   if (!(moment_max > 0.0) || !(result.kappa_max > kNoCurvature)) {
-    result.message = "Clapp fit: the profiles show no bending; no law fitted";
+    result.message =
+        "Clapp fit: the profiles have no curvature along them (straight); no law fitted";
     return result;
   }
   if (!(linear_stiffness > 0.0) || !std::isfinite(linear_stiffness)) {

@@ -351,9 +351,11 @@ TEST(CliDrape, NonConvergenceIsExit3WithOneLineAndNoFiles) {
 // (more vertices than --rim-mm 0), not the extrapolation (no split reported).
 TEST(CliDrape, RestingMountSettlesAndACutShortRunFailsCleanly) {
   const auto dir = Scratch("CliDrape.Resting");
-  const auto r = Textile("drape " + kFig8 + kCoarse + " --mount resting -o " + (dir / "r.json").string());
+  const auto r = Textile("drape " + kFig8 + kCoarse + " --mount resting --progress -o " +
+                         (dir / "r.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err.find("experimental"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("experimental"), std::string::npos) << r.out;
   const auto j = nlohmann::json::parse(ReadAll(dir / "r.json"));
   EXPECT_EQ(j["scene"]["mount"], "resting");
   EXPECT_TRUE(j["converged"].get<bool>());

@@ -223,7 +223,7 @@ void Run(const AcpmArgs& a) {
                 units::SiRigidityToMicroNm(ray.rigidity), ray.factor, ray.device_time);
   }
   std::cout << "without seams: L = " << Num(units::MToMm(r.plain_overhang)) << " mm, c = "
-            << Num(units::MToMm(r.plain_overhang) / 2.0) << " mm, G = "
+            << Num(units::MToMm(r.plain_bending_length)) << " mm, G = "
             << Num(units::SiRigidityToMicroNm(r.plain_rigidity)) << " µN·m\n"
             << "device time " << Num(r.device_time, 4) << " s; computed in " << Num(ms, 3)
             << " ms (" << r.solves << " solves)\n"

@@ -345,7 +345,11 @@ void Run(const DrapeArgs& a) {
   // (An extrapolated DC has no first-order shortfall: no note.)
   if (const double shortfall = 0.1 * rim_size / turn_down; shortfall > 0.02 && !o.rim_extrapolation &&
                                                                 o.mount == DrapeMount::kClamped) {
-    note = "DC may be low by up to about " + Num(shortfall, 1) + ": the rim's elements (" +
+    // The estimate is first order in rim / turn-down; past about 0.5 it says only "a lot" (a
+    // limp, heavy fabric printed 4e+03 for a DC that cannot exceed 1).
+    note = (shortfall > 0.5 ? std::string("DC may be far too low")
+                            : "DC may be low by up to about " + Num(shortfall, 1)) +
+           ": the rim's elements (" +
            Num(units::MToMm(rim_size), 3) + " mm) are coarse against this fabric's turn-down length there (" +
            Num(units::MToMm(turn_down), 2) + " mm); " +
            (o.rim_element_size > 0.0 ? std::string("a smaller --rim-mm") : std::string("--rim-mm auto")) +

@@ -209,7 +209,8 @@ void Run(const FitArgs& a) {
   if (!IsValidUtf8(a.name)) throw InputError("--name: not valid UTF-8 text");
   if (!std::isfinite(a.gsm) || a.gsm <= 0.0) throw InputError("--gsm must be a number > 0 (g/m²)");
   if (a.gsm < 1.0 || a.gsm > 1e4) throw InputError("--gsm " + Num(a.gsm) + " g/m² is implausible (1 .. 10000)");
-  if (!std::isfinite(a.robust_mm) || a.robust_mm < 0.0) throw InputError("--robust-mm must be >= 0");
+  if (!(a.robust_mm == 0.0 || (a.robust_mm >= 0.001 && a.robust_mm <= 100.0)))
+    throw InputError("--robust-mm must be 0 (off) or in [0.001, 100] mm");
   if (a.thickness_given && !(a.thickness_mm > 0.0 && a.thickness_mm <= 20.0))
     throw InputError("--thickness-mm must lie in (0, 20] mm, got " + Num(a.thickness_mm));
   if (a.thickness_given && a.no_offset)

@@ -48,8 +48,10 @@ void Run(const SynthArgs& a) {
   // File names carry the overhang to 0.1 mm; two overhangs that share a name are refused.
   std::vector<std::string> names;
   for (double L : a.overhang_mm) {
-    if (!std::isfinite(L) || L <= 0.0 || L > 1000.0) {
-      throw InputError("--overhang-mm: " + Num(L) + " is not a length in (0, 1000] mm");
+    // Below 1 mm the points crowd the CSV's 1 nm digits (0.0001 mm wrote 899 repeated arc
+    // lengths that fit then refused) and every name reads L000mm.
+    if (!std::isfinite(L) || L < 1.0 || L > 1000.0) {
+      throw InputError("--overhang-mm: " + Num(L) + " is not a length in [1, 1000] mm");
     }
     char name[64];
     if (std::abs(L - std::round(L)) < 0.05) std::snprintf(name, sizeof name, "_L%03.0fmm.profile.csv", L);

@@ -64,7 +64,10 @@ bool DirectFitOptions::Check(std::string* why) const {
     return false;
   };
   if (!std::isfinite(offset) || std::abs(offset) > 0.01) return fail("offset must be finite and within ±10 mm");
-  if (!(robust_scale >= 0.0) || !std::isfinite(robust_scale)) return fail("robust_scale must be >= 0");
+  // Ceres squares the Cauchy scale: beyond these bounds the cost over- or underflows (1e200 mm
+  // gave a NaN cost and the start law back, exit 0).
+  if (!(robust_scale == 0.0 || (robust_scale >= 1e-6 && robust_scale <= 0.1)))
+    return fail("robust_scale must be 0 (off) or in [0.001, 100] mm");
   if (curve_samples < 11 || curve_samples > 10001) return fail("curve_samples must lie in [11, 10001]");
   if (!(elastica_tol >= 1e-14 && elastica_tol <= 1e-4)) return fail("elastica_tol must lie in [1e-14, 1e-4]");
   if (max_iterations < 1) return fail("max_iterations must be >= 1");
@@ -87,9 +90,16 @@ std::string DirectFitSummary::BriefReport() const {
   std::ostringstream s;
   s.precision(4);
   if (!converged || !law) return "direct fit failed: " + message;
-  s << "direct fit: b1 = " << law->b1_kes() << " ± " << units::SiStiffnessToKes(b1_sd)
-    << " gf·cm, b2 = " << law->b2_kes() << " ± " << units::SiStiffnessToKes(b2_sd)
-    << " gf·cm, c1 = " << law->c1_kes() << " ± " << units::SiQuadraticToKes(c1_sd)
+  // An sd the covariance could not give is said so, not printed as "nan".
+  const auto sd = [](double v) {
+    std::ostringstream o;
+    o.precision(4);
+    if (std::isfinite(v)) o << v; else o << "(no sd)";
+    return o.str();
+  };
+  s << "direct fit: b1 = " << law->b1_kes() << " ± " << sd(units::SiStiffnessToKes(b1_sd))
+    << " gf·cm, b2 = " << law->b2_kes() << " ± " << sd(units::SiStiffnessToKes(b2_sd))
+    << " gf·cm, c1 = " << law->c1_kes() << " ± " << sd(units::SiQuadraticToKes(c1_sd))
     << " gf·cm²; rms " << Mm(rms) << " over " << profiles.size() << " profile(s), "
     << iterations << " iterations, " << seconds * 1e3 << " ms. " << observability;
   return s.str();

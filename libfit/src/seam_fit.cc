@@ -54,6 +54,10 @@ void CheckSample(const SeamSample& p, const std::string& where) {
                      " must be > 0 (stiffness relative to the plain fabric)");
   if (!std::isnan(p.sd) && !(p.sd > 0.0))
     throw InputError(where + ": sd = " + Num(p.sd) + " must be > 0");
+  // The weights are 1/sd²: below 1e-9 of the factor they overflow the least squares (sd 1e-300
+  // gave NaN coefficients); no measurement of a stiffness ratio is that exact.
+  if (!std::isnan(p.sd) && p.sd < 1e-9 * p.factor)
+    throw InputError(where + ": sd = " + Num(p.sd) + " is below 1e-9 of the factor " + Num(p.factor));
 }
 
 struct GslMatrixDeleter {
@@ -252,7 +256,12 @@ SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,
     fit.max_residual = std::max(fit.max_residual, std::abs(r));
   }
   fit.rms = std::sqrt(ss_res / n);
-  fit.r2 = ss_tot > 0.0 ? 1.0 - ss_res / ss_tot : std::numeric_limits<double>::quiet_NaN();
+  // Factors that do not vary leave no variance to explain: the fit is perfect when it
+  // reproduces them (r² = 1; it was NaN, printed "nan" and flagged as poor), undefined if not.
+  const double round_off = 1e-20 * n * mean * mean;
+  fit.r2 = ss_tot > round_off   ? 1.0 - ss_res / ss_tot
+           : ss_res <= round_off ? 1.0
+                                 : std::numeric_limits<double>::quiet_NaN();
 
   if (fit.weighted && fit.dof > 0 && fit.chi2_probability < options.poor_probability) {
     fit.poor = true;
@@ -320,7 +329,7 @@ std::string SeamFitSummary::BriefReport() const {
   }
   s << " (1-σ" << (weighted ? ", from the given sd" : ", from the scatter") << "); " << num_points
     << " points, d in [" << Num(range_mm[0], 4) << ", " << Num(range_mm[1], 4)
-    << "] mm, rms " << Num(rms, 3) << ", r² " << Num(r2, 5);
+    << "] mm, rms " << Num(rms, 3) << ", r² " << (std::isfinite(r2) ? Num(r2, 5) : std::string("n/a"));
   if (weighted && dof > 0) s << ", chi²/dof " << Num(chi2 / dof, 3);
   if (poor) s << "; POOR FIT: " << poor_reason;
   return s.str();

@@ -322,6 +322,7 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
   const ClassicOutputs plain = ComputeClassicOutputs(material.areal_density, plain_overhang,
                                                      o.barrier_angle);
   result.plain_overhang = plain_overhang;
+  result.plain_bending_length = plain.bending_length;
   result.plain_rigidity = plain.flexural_rigidity;
 
   for (size_t i = 0; i < z.size(); ++i) {
@@ -393,7 +394,7 @@ nlohmann::json AcpmResultToJson(const AcpmResult& r, const Material& material,
   }
   j["rays"] = rays;
   j["plain"] = {{"overhang_mm", units::MToMm(r.plain_overhang)},
-                {"bending_length_mm", units::MToMm(r.plain_overhang / 2.0)},
+                {"bending_length_mm", units::MToMm(r.plain_bending_length)},
                 {"rigidity_uNm", units::SiRigidityToMicroNm(r.plain_rigidity)}};
   j["device_time_s"] = r.device_time;
   json x = json::array(), y = json::array();

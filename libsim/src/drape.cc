@@ -325,8 +325,11 @@ bool DrapeOptions::Check(std::string* why) const {
   return true;
 }
 
-DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double cell, int bins) {
+DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double cell, int bins,
+                          double support_radius) {
   if (!(cell > 0.0) || !Finite(cell)) throw InputError("shadow: raster cell must be > 0");
+  if (!(support_radius >= 0.0) || !Finite(support_radius))
+    throw InputError("shadow: support radius must be >= 0");
   if (bins < 8) throw InputError("shadow: need at least 8 angle bins");
   if (x.rows() == 0 || triangles.rows() == 0) throw InputError("shadow: empty mesh");
   if (!x.allFinite()) throw InputError("shadow: non-finite vertex positions");
@@ -334,8 +337,10 @@ DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double 
     throw InputError("shadow: triangle index out of range");
   DrapeShadow s;
   s.cell = cell;
-  const double lo_x = x.col(0).minCoeff(), hi_x = x.col(0).maxCoeff();
-  const double lo_y = x.col(1).minCoeff(), hi_y = x.col(1).maxCoeff();
+  const double lo_x = std::min(x.col(0).minCoeff(), -support_radius);
+  const double hi_x = std::max(x.col(0).maxCoeff(), support_radius);
+  const double lo_y = std::min(x.col(1).minCoeff(), -support_radius);
+  const double hi_y = std::max(x.col(1).maxCoeff(), support_radius);
   const double cells_x = (hi_x - lo_x) / cell, cells_y = (hi_y - lo_y) / cell;
   if (cells_x * cells_y > 1e8) throw InputError("shadow: the projection spans over 1e8 raster cells");
   // Two empty cells of margin on every side, so the border is outside the shadow.
@@ -367,6 +372,19 @@ DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double 
         const double px = s.origin_x + i * cell;
         if (edge(a, b, px, py) >= 0.0 && edge(b, c, px, py) >= 0.0 && edge(c, a, px, py) >= 0.0)
           at(i, j) = 1;
+      }
+    }
+  }
+  // The support casts its own shadow (the drapemeter's disk is opaque): a specimen that leaves
+  // part of it bare (resting, heavy and stretchy, slid off the edge) still shades all of it, so
+  // A_shadow ≥ A_support and the DC ≥ 0.
+  if (support_radius > 0.0) {
+    const double r2 = support_radius * support_radius;
+    for (int j = 0; j < s.height; ++j) {
+      const double py = s.origin_y + j * cell;
+      for (int i = 0; i < s.width; ++i) {
+        const double px = s.origin_x + i * cell;
+        if (px * px + py * py <= r2) at(i, j) = 1;
       }
     }
   }
@@ -569,7 +587,7 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
     seed.extrapolation_bound = kNaN;
     std::string failure = seed.summary.message;  // why this seed has no DC
     const auto measure = [&](const Vertices& x, const TriangleMesh& mesh) {
-      seed.shadow = MeasureShadow(x, mesh.triangles, o.raster_cell, o.outline_bins);
+      seed.shadow = MeasureShadow(x, mesh.triangles, o.raster_cell, o.outline_bins, o.support_radius);
       return DrapeCoefficient(seed.shadow.area, result.specimen_area, result.support_area);
     };
     // #V of the split mesh (a failed coarse level of a cascade leaves no positions).

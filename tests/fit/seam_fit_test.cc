@@ -128,6 +128,16 @@ TEST(SeamFit, ThreePointsWithoutSdHaveNoCovariance) {
   EXPECT_TRUE(fit.Report()["coefficients_sd"][0].is_null());
 }
 
+// Factors that do not vary (a seam that changes nothing) are fitted exactly: r² = 1, not NaN
+// and a "poor" fit; a factor that varies with no trend the quadratic can follow is still poor.
+TEST(SeamFit, ConstantFactorsAreAPerfectFitNotAPoorOne) {
+  const SeamFitSummary flat = FitSeamFactor({{0, 1.0}, {10, 1.0}, {20, 1.0}, {40, 1.0}, {60, 1.0}});
+  EXPECT_DOUBLE_EQ(flat.r2, 1.0);
+  EXPECT_FALSE(flat.poor) << flat.poor_reason;
+  EXPECT_NEAR(flat.profile.StiffnessFactor(30.0), 1.0, 1e-9);
+  EXPECT_EQ(flat.BriefReport().find("nan"), std::string::npos) << flat.BriefReport();
+}
+
 TEST(SeamFit, ReportsAPoorFit) {
   // A step in the factor is no quadratic: r² well below 0.9 without sd ...
   std::vector<SeamSample> step;

@@ -90,6 +90,27 @@ TEST(DrapeShadow, HolesAreFilledAndTiltDoesNotMatterButProjectionDoes) {
   EXPECT_NEAR(half.area, 0.5 * full.area, 0.5 * cell * 2.0 * kPi * 0.15);
 }
 
+// The support's disk casts its own shadow: fabric that left part of it bare (a resting specimen
+// slid off the edge) cannot give a shadow smaller than the support, nor a negative DC.
+TEST(DrapeShadow, TheSupportShadesItselfSoTheDcIsNeverNegative) {
+  PatternMeshOptions mo;
+  mo.element_size = 0.01;
+  TriangleMesh patch = MeshDisk(0.05, {}, mo).mesh;
+  patch.vertices.col(0).array() += 0.08;  // a 50 mm patch from r = 30 to 130 mm
+  const double cell = 0.0005, support = 0.09;
+  const double patch_area = TriangleAreas(patch).sum(), support_area = kPi * support * support;
+  const DrapeShadow bare = MeasureShadow(patch.vertices, patch.triangles, cell, 360);
+  EXPECT_NEAR(bare.area, patch_area, 0.5 * cell * 2.0 * kPi * 0.05);
+  const DrapeShadow s = MeasureShadow(patch.vertices, patch.triangles, cell, 360, support);
+  // The union of the two disks: the support plus the patch's part beyond it.
+  EXPECT_GT(s.area, support_area);
+  EXPECT_LT(s.area, support_area + patch_area);
+  EXPECT_GE(DrapeCoefficient(s.area, kPi * 0.15 * 0.15, support_area), 0.0);
+  EXPECT_GE(s.radii.minCoeff(), support - 1.5 * cell);
+  EXPECT_NEAR(s.radii.maxCoeff(), 0.13, 1.5 * cell);
+  EXPECT_THROW(MeasureShadow(patch.vertices, patch.triangles, cell, 360, -0.01), InputError);
+}
+
 TEST(DrapeNodes, AnOutlineWithKLobesHasKNodesAtTheLobes) {
   std::mt19937 rng(3);
   std::normal_distribution<double> noise(0.0, 2e-4);  // 0.2 mm: raster-level jitter

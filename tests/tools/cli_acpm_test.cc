@@ -46,6 +46,28 @@ TEST(CliAcpm, PlainSamplePrintsTheRayTableAndWritesJsonAndPng) {
   EXPECT_GT(fs::file_size(dir / "front.png"), 10000u);
 }
 
+// Away from 41.5° the bending length is not L/2: the plain figures use the barrier's angle as
+// the rays do (they printed L/2 whatever the angle: 7.56 mm against the rays' 17.0 at 5°).
+TEST(CliAcpm, PlainFiguresFollowTheBarrierAngle) {
+  const auto dir = Scratch("CliAcpm.Barrier");
+  for (const char* angle : {"41.5", "5"}) {
+    const auto r = Textile("acpm " + kFig8 + " --barrier-deg " + angle + " --rays 1 --json -o " +
+                           (dir / "r.json").string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    const double c = j["plain"]["bending_length_mm"].get<double>();
+    const double ray_c = j["rays"][0]["bending_length_mm"].get<double>();
+    EXPECT_NEAR(c, ray_c, 1e-9 * ray_c) << angle;
+    EXPECT_NEAR(j["rays"][0]["factor"].get<double>(), 1.0, 1e-12) << angle;
+    const double overhang = j["plain"]["overhang_mm"].get<double>();
+    if (std::string(angle) == "5") {
+      EXPECT_GT(c, overhang) << c;  // a 5° tilt is reached early: c is over twice L/2
+    } else {
+      EXPECT_NEAR(c, overhang / 2.0, 1e-3 * overhang);
+    }
+  }
+}
+
 TEST(CliAcpm, SeamAcrossIsAnsweredByTheElastica) {
   const auto dir = Scratch("CliAcpm.Across");
   const auto r = Textile("acpm " + kFig8 + " --seam C-plain --seam-dir across --seam-at 10 --json -o " +

@@ -124,7 +124,7 @@ struct AcpmRay {
                           // (along: |z - z_s|; across: the seam's distance behind the front;
                           // NaN for a plain sample)
   double overhang = 0.0;  // L_i [m]
-  double bending_length = 0.0;  // c_i = L_i / 2 [m]
+  double bending_length = 0.0;  // c_i from L_i at the barrier angle (L_i / 2 at 41.5°) [m]
   double rigidity = 0.0;        // G_i = ρ g c_i³ [N·m], ρ the plain fabric's density
   double factor = 1.0;          // G_i / G of the same fabric without seams [-]
   double device_time = 0.0;     // L_i / push speed [s]
@@ -135,6 +135,7 @@ struct AcpmResult {
   std::string model_reason;                        // why that model (auto), or "requested"
   std::vector<AcpmRay> rays;
   double plain_overhang = 0.0;   // L* of the same fabric without seams [m]
+  double plain_bending_length = 0.0;  // its c, as the rays' (L* / 2 at 41.5° only) [m]
   double plain_rigidity = 0.0;   // its G [N·m]
   double device_time = 0.0;      // until the last ray is cut [s]
   int profile_ray = 0;           // the ray of the side profile

@@ -162,8 +162,11 @@ struct DrapeShadow {
 };
 
 // Projects the triangles of x (#V×3 [m]; triangles #F×3) on z = 0 and measures the shadow
-// about the origin. cell [m] > 0, bins ≥ 8. Throws InputError for bad sizes or non-finite x.
-DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double cell, int bins);
+// about the origin, with the support's own shadow (a disk of support_radius [m] about the
+// origin; 0: none) added as the drapemeter's opaque disk casts it. cell [m] > 0, bins ≥ 8.
+// Throws InputError for bad sizes or non-finite x.
+DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double cell, int bins,
+                          double support_radius = 0.0);
 
 struct DrapeNodes {
   std::vector<double> angles;       // [rad], ascending

@@ -49,9 +49,9 @@ void CheckSample(const SeamSample& p, const std::string& where) {
     throw InputError(where + ": values must be finite numbers");
   if (p.d_mm < 0.0)
     throw InputError(where + ": d_mm = " + Num(p.d_mm) + " is negative (distance from the seam line)");
-  if (!(p.factor > 0.0))
+  if (!(p.factor >= 1e-6 && p.factor <= 1e6))
     throw InputError(where + ": factor = " + Num(p.factor) +
-                     " must be > 0 (stiffness relative to the plain fabric)");
+                     " must be in [1e-6, 1e6] (stiffness relative to the plain fabric)");
   if (!std::isnan(p.sd) && !(p.sd > 0.0))
     throw InputError(where + ": sd = " + Num(p.sd) + " must be > 0");
   // The weights are 1/sd²: below 1e-9 of the factor they overflow the least squares (sd 1e-300

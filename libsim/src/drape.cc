@@ -384,7 +384,9 @@ DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double 
       const double py = s.origin_y + j * cell;
       for (int i = 0; i < s.width; ++i) {
         const double px = s.origin_x + i * cell;
-        if (px * px + py * py <= r2) at(i, j) = 1;
+        if (px * px + py * py > r2) continue;
+        if (at(i, j) == 0) s.bare_support_area += cell * cell;
+        at(i, j) = 1;
       }
     }
   }

@@ -107,6 +107,10 @@ TEST(DrapeShadow, TheSupportShadesItselfSoTheDcIsNeverNegative) {
   EXPECT_LT(s.area, support_area + patch_area);
   EXPECT_GE(DrapeCoefficient(s.area, kPi * 0.15 * 0.15, support_area), 0.0);
   EXPECT_GE(s.radii.minCoeff(), support - 1.5 * cell);
+  // The support's part the patch leaves bare: the support less the lens where the two overlap.
+  EXPECT_NEAR(s.bare_support_area, s.area - bare.area, 4.0 * cell * 2.0 * kPi * 0.09);
+  EXPECT_GT(s.bare_support_area, 0.5 * support_area);
+  EXPECT_DOUBLE_EQ(bare.bare_support_area, 0.0);
   EXPECT_NEAR(s.radii.maxCoeff(), 0.13, 1.5 * cell);
   EXPECT_THROW(MeasureShadow(patch.vertices, patch.triangles, cell, 360, -0.01), InputError);
 }

@@ -29,8 +29,8 @@
 //
 // Measurement (MeasureShadow): the draped mesh's triangles are projected on the plane z = 0 and
 // rasterised on a square grid (cell centres sampled); holes are filled (cells not reachable
-// from the grid's border through empty cells count as shadow); A_shadow = shadow cells × cell
-// area. DC = (A_shadow - A_support) / (A_specimen - A_support), with A_specimen the area of the
+// from the grid's border through empty cells count as shadow); the support disk is shadow too
+// (its own, as the opaque disk casts it), so r(θ) ≥ R_s; A_shadow = shadow cells × cell area. DC = (A_shadow - A_support) / (A_specimen - A_support), with A_specimen the area of the
 // meshed pattern (so a flat specimen gives DC = 1 on any mesh) and A_support = π R_s².
 // The outline r(θ) is the largest radius of a shadow cell centre in each of `outline_bins`
 // equal angle bins (the shadow is star-shaped about the centre in every drape we have seen; a
@@ -159,6 +159,9 @@ struct DrapeShadow {
   std::vector<std::uint8_t> mask;  // height × width, row-major (row = y), 1 = shadow
   Eigen::VectorXd angles;          // #B bin centres θ_b ∈ [0, 2π) [rad]
   Eigen::VectorXd radii;           // #B outline radius r(θ_b) [m]
+  // Support cells no fabric covers (a specimen slid off the disk) × cell area [m²]; 0 without
+  // a support radius.
+  double bare_support_area = 0.0;
 };
 
 // Projects the triangles of x (#V×3 [m]; triangles #F×3) on z = 0 and measures the shadow

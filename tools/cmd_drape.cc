@@ -2,7 +2,6 @@
 // nodes of a disk of fabric on a smaller disk, over N seeded perturbations; result JSON, outline
 // CSV, top-view shadow PNG, draped mesh OBJ.
 
-#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -380,15 +379,6 @@ void Run(const DrapeArgs& a) {
   }
   if (!r.converged) throw ComputeError("drape: not converged (" + r.message + "); no drape coefficient");
 
-  // The support shades itself (MeasureShadow), so a specimen that slid off part of it still
-  // gives DC ≥ 0: say so when it happened, since the DC then measures little of the fabric.
-  double bare = 0.0;
-  for (const DrapeSeedResult& seed : r.per_seed) bare = std::max(bare, seed.shadow.bare_support_area);
-  if (bare > 0.01 * r.support_area) {
-    note += std::string(note.empty() ? "" : "; ") + "the specimen left " +
-            Num(100.0 * bare / r.support_area, 2) +
-            " % of the support bare (slid off its edge); the DC counts the support's own shadow there";
-  }
   const DrapeSeedResult& first = r.per_seed.front();
   nlohmann::json j = ResultJson(r, o, m, a, turn_down);
   j["note"] = note.empty() ? nlohmann::json() : nlohmann::json(note);

@@ -71,7 +71,7 @@ void Plot(const AcpmResult& r, const AcpmOptions& o, const Material& m, AtomicFi
   namespace chart = textile::chart;
   chart::Panel front{.title = "Front across the width (crossing overhang per ray)",
                      .x_label = "z across the width [mm]",
-                     .y_label = "overhang L at the " + Num(o.barrier_angle / kDegree, 4) + "° barrier [mm]"};
+                     .y_label = "overhang L at the " + Num(o.barrier_angle / kDegree) + "° barrier [mm]"};
   chart::Series rays{.label = "rays", .style = chart::Series::Style::kLineAndMarkers};
   double lo = 1e300, hi = -1e300;
   for (const auto& ray : r.rays) {
@@ -119,7 +119,7 @@ void Plot(const AcpmResult& r, const AcpmOptions& o, const Material& m, AtomicFi
   }
   const double reach = 1.15 * units::MToMm(r.rays.empty() ? 0.0 : r.rays[r.profile_ray].overhang);
   side.series.push_back(strip);
-  side.series.push_back({.label = Num(o.barrier_angle / kDegree, 4) + "° barrier",
+  side.series.push_back({.label = Num(o.barrier_angle / kDegree) + "° barrier",
                          .x = {0.0, reach * std::cos(o.barrier_angle)},
                          .y = {0.0, -reach * std::sin(o.barrier_angle)},
                          .color = chart::Rgb{0.8, 0.1, 0.1},

@@ -49,15 +49,17 @@ void CheckSample(const SeamSample& p, const std::string& where) {
     throw InputError(where + ": values must be finite numbers");
   if (p.d_mm < 0.0)
     throw InputError(where + ": d_mm = " + Num(p.d_mm) + " is negative (distance from the seam line)");
-  if (!(p.factor >= 1e-6 && p.factor <= 1e6))
-    throw InputError(where + ": factor = " + Num(p.factor) +
-                     " must be in [1e-6, 1e6] (stiffness relative to the plain fabric)");
+  if (!(p.factor >= 1e-6 && p.factor <= kMaxSeamFactor))
+    throw InputError(where + ": factor = " + Num(p.factor) + " must be in [1e-6, " + Num(kMaxSeamFactor) +
+                     "] (stiffness relative to the plain fabric; more is likely a unit mix-up)");
   if (!std::isnan(p.sd) && !(p.sd > 0.0))
     throw InputError(where + ": sd = " + Num(p.sd) + " must be > 0");
   // The weights are 1/sd²: below 1e-9 of the factor they overflow the least squares (sd 1e-300
   // gave NaN coefficients); no measurement of a stiffness ratio is that exact.
   if (!std::isnan(p.sd) && p.sd < 1e-9 * p.factor)
     throw InputError(where + ": sd = " + Num(p.sd) + " is below 1e-9 of the factor " + Num(p.factor));
+  if (!std::isnan(p.sd) && p.sd > 1e6 * p.factor)  // weights underflowed: B_f = 0
+    throw InputError(where + ": sd = " + Num(p.sd) + " is over 1e6 times the factor " + Num(p.factor));
 }
 
 struct GslMatrixDeleter {

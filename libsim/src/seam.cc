@@ -21,7 +21,7 @@ using nlohmann::json;
 // Plausibility bounds. Outside them a value is far more likely a unit mix-up (metres for mm,
 // coefficients fitted against d in m) than a seam. Table 2's stiffest seam reaches 9.07.
 constexpr int kMaxLayers = 20;
-constexpr double kMaxFactor = 100.0;       // largest plausible B_f [-]
+constexpr double kMaxFactor = kMaxSeamFactor;  // largest plausible B_f [-] (seam.h)
 constexpr double kMaxRangeMm = 1000.0;     // fit range, influence range, fade [mm]
 constexpr double kMinInfluenceMm = 1.0;    // below this d_max is surely in metres [mm]
 constexpr double kMaxAllowanceMm = 200.0;  // seam allowance [mm]

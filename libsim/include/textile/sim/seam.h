@@ -38,6 +38,11 @@ enum class SeamMultiplierReading {
   kPaperLiteral,  // S = 1 + B_f(d) (B_f(0) - 1), eq. 6 as printed
 };
 
+// The largest plausible stiffness factor B_f [-] (Table 2's stiffest seam reaches 9.07):
+// above it a value is far more likely a unit mix-up than a seam. Seam files and measurements
+// are checked against it.
+inline constexpr double kMaxSeamFactor = 100.0;
+
 // The stiffness profile of one seam type: B_f(d) = a2 d² + a1 d + a0, d in mm from the seam
 // line, plus this project's settings (influence range, fade, allowance, reading).
 // Invariants are stated by Check(); ParseSeamJson and SeamPreset only return profiles that pass.

@@ -2,7 +2,9 @@
 // nodes of a disk of fabric on a smaller disk, over N seeded perturbations; result JSON, outline
 // CSV, top-view shadow PNG, draped mesh OBJ.
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -379,6 +381,19 @@ void Run(const DrapeArgs& a) {
   }
   if (!r.converged) throw ComputeError("drape: not converged (" + r.message + "); no drape coefficient");
 
+  // A resting fabric that left part of the disk's top bare slid off it or, with contact on the
+  // nodes only, passed through it (docs/drapemeter.md, "Fabric through the support"): the
+  // support's own shadow keeps the DC ≥ 0, but the drape needs a look.
+  double bare = 0.0;
+  for (const DrapeSeedResult& seed : r.per_seed) bare = std::max(bare, seed.shadow.bare_support_area);
+  if (bare > 0.02 * r.support_area) {  // a coarse rim polygon leaves slivers of up to ~1 %
+    char percent[32];
+    std::snprintf(percent, sizeof percent, "%.0f", 100.0 * bare / r.support_area);
+    note += std::string(note.empty() ? "" : "; ") + "the fabric left " + percent +
+            " % of the support's top bare: it slid off the disk or, as contact holds the nodes "
+            "only, passed through it (a coarse mesh); look at the mesh (--obj) before trusting "
+            "this DC";
+  }
   const DrapeSeedResult& first = r.per_seed.front();
   nlohmann::json j = ResultJson(r, o, m, a, turn_down);
   j["note"] = note.empty() ? nlohmann::json() : nlohmann::json(note);

@@ -325,21 +325,6 @@ bool DrapeOptions::Check(std::string* why) const {
   return true;
 }
 
-namespace {
-// The resting mount's contact acts on the nodes (contact.h): an element of a heavy, stretchy
-// fabric can pass through the support disk with its nodes outside it, and the fabric then
-// hangs through (a 10 000 g/m², 100 N/m fabric on 15, 10 and 6 mm meshes: half the nodes
-// under the disk). Counts the nodes below the disk's underside well inside its rim (r < 0.9
-// R_s), where a fabric can only get through the disk. (Straight edges that cut the rim's
-// corner, a coarse mesh's chord over the rounding, are normal and not counted.)
-int NodesUnderSupport(const Vertices& x, const DrapeOptions& o) {
-  int count = 0;
-  for (int v = 0; v < x.rows(); ++v)
-    if (x(v, 2) < -o.support_thickness && x.row(v).head<2>().norm() < 0.9 * o.support_radius) ++count;
-  return count;
-}
-}  // namespace
-
 DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double cell, int bins,
                           double support_radius) {
   if (!(cell > 0.0) || !Finite(cell)) throw InputError("shadow: raster cell must be > 0");
@@ -391,7 +376,7 @@ DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double 
     }
   }
   // The support casts its own shadow (the drapemeter's disk is opaque): a specimen that leaves
-  // part of it bare (resting, heavy and stretchy, slid off the edge) still shades all of it, so
+  // part of it bare (a resting fabric that passed through it, drape.h) still shades all of it, so
   // A_shadow ≥ A_support and the DC ≥ 0.
   if (support_radius > 0.0) {
     const double r2 = support_radius * support_radius;
@@ -632,16 +617,6 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
       seed.converged = seed.split_summary.converged;
       if (!seed.converged) {
         failure = "rim split: " + seed.split_summary.message;
-        seed.shadow = DrapeShadow{};
-        seed.base_drape_coefficient = kNaN;
-      }
-    }
-    if (seed.converged && o.mount == DrapeMount::kResting) {
-      if (const int under = NodesUnderSupport(seed.positions, o); under > 0) {
-        seed.converged = false;
-        failure = "the fabric passed through the support disk: " + std::to_string(under) +
-                  " nodes ended under it (contact holds the nodes only, and this fabric is too "
-                  "heavy or stretchy for that)";
         seed.shadow = DrapeShadow{};
         seed.base_drape_coefficient = kNaN;
       }

@@ -349,6 +349,26 @@ TEST(CliDrape, NonConvergenceIsExit3WithOneLineAndNoFiles) {
 // The resting mount settles with the samples' friction (contact.h, friction_potential); a run
 // cut short is not converged (exit 3) and writes nothing; `--rim-mm auto` gives it a rim band
 // (more vertices than --rim-mm 0), not the extrapolation (no split reported).
+// A heavy, stretchy fabric resting on the disk passes through it on a coarse mesh (contact
+// holds the nodes only) and leaves part of its top bare: the support's own shadow keeps the DC
+// at or above 0 (it was -0.05), and the run warns not to trust it.
+TEST(CliDrape, AFabricThroughTheSupportGetsAWarningAndNoNegativeDc) {
+  const auto dir = Scratch("CliDrape.Through");
+  const auto r = Textile("drape --material tests/bad_inputs/files/material-heavy-stretchy.json" + kCoarse +
+                         " --mount resting -o " + (dir / "r.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(ReadAll(dir / "r.json"));
+  EXPECT_GE(j["drape_coefficient"].get<double>(), -1e-3);
+  EXPECT_GE(j["min_radius_mm"].get<double>(), 90.0 - 1.0);
+  ASSERT_TRUE(j["note"].is_string()) << j.dump();
+  EXPECT_NE(j["note"].get<std::string>().find("of the support's top bare"), std::string::npos) << j["note"];
+  EXPECT_NE(r.out.find("before trusting this DC"), std::string::npos) << r.out;
+  // The sample fabric on the same mount and mesh covers the disk's top: no such warning.
+  const auto plain = Textile("drape " + kFig8 + kCoarse + " --mount resting -o " + (dir / "p.json").string());
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_EQ(plain.out.find("of the support's top bare"), std::string::npos) << plain.out;
+}
+
 TEST(CliDrape, RestingMountSettlesAndACutShortRunFailsCleanly) {
   const auto dir = Scratch("CliDrape.Resting");
   const auto r = Textile("drape " + kFig8 + kCoarse + " --mount resting --progress -o " +

@@ -159,7 +159,7 @@ struct DrapeShadow {
   std::vector<std::uint8_t> mask;  // height × width, row-major (row = y), 1 = shadow
   Eigen::VectorXd angles;          // #B bin centres θ_b ∈ [0, 2π) [rad]
   Eigen::VectorXd radii;           // #B outline radius r(θ_b) [m]
-  // Support cells no fabric covers (a specimen slid off the disk) × cell area [m²]; 0 without
+  // Support cells no fabric covers (a specimen that left the disk's top) × cell area [m²]; 0 without
   // a support radius.
   double bare_support_area = 0.0;
 };

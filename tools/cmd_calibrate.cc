@@ -3,16 +3,15 @@
 
 #include <filesystem>
 #include <iostream>
-#include <system_error>
-
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <system_error>
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
 #include "textile/fit/calibrate.h"
 #include "textile/fit/extract.h"
+#include "textile/fit/image_codecs.h"
 #include "textile/sim/error.h"
 
 namespace textile::cli {
@@ -92,7 +91,8 @@ void Run(const CalibrateArgs& a) {
   if (!c.success) throw ComputeError(c.message);
   rig_file.Write(RigToJson(c.rig));
   if (overlay_file) {
-    if (!cv::imwrite(overlay_file->temp_path(), Overlay(images[0], c.detections[0], o.cols, o.rows))) {
+    if (!image_codecs::Write(overlay_file->temp_path(),
+                             Overlay(images[0], c.detections[0], o.cols, o.rows))) {
       throw InputError(a.overlay + ": cannot write the overlay");
     }
   }

@@ -10,13 +10,13 @@
 #include <iostream>
 #include <limits>
 #include <numbers>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <sstream>
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
+#include "textile/fit/image_codecs.h"
 #include "textile/sim/drape.h"
 #include "textile/sim/error.h"
 #include "textile/sim/material.h"
@@ -366,7 +366,10 @@ void Run(const DrapeArgs& a) {
   AtomicFile& result_file = outputs.Add(a.out);
   AtomicFile& outline_file = outputs.Add(outline_path);
   AtomicFile* png_file = a.png.empty() ? nullptr : &outputs.Add(a.png);
-  if (png_file) CheckOutputExtension("--png", a.png, {".png"});
+  if (png_file) {
+    CheckOutputExtension("--png", a.png, {".png"});
+    image_codecs::Load();  // opened now: a missing library fails before the drape
+  }
   AtomicFile* obj_file = a.obj.empty() ? nullptr : &outputs.Add(a.obj);
   AtomicFile* ply_file = a.ply.empty() ? nullptr : &outputs.Add(a.ply);
 
@@ -400,7 +403,7 @@ void Run(const DrapeArgs& a) {
   j["outline_csv"] = outline_file.path();
   outline_file.Write(OutlineCsv(first));
   if (png_file) {
-    if (!cv::imwrite(png_file->temp_path(), ShadowImage(r, first, o)))
+    if (!image_codecs::Write(png_file->temp_path(), ShadowImage(r, first, o)))
       throw InputError("--png: cannot write " + a.png);
     j["png"] = a.png;
   }

@@ -5,13 +5,13 @@
 #include <fstream>
 #include <iostream>
 #include <map>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/profile_inputs.h"
 #include "textile/fit/extract.h"
+#include "textile/fit/image_codecs.h"
 #include "textile/fit/profile.h"
 #include "textile/fit/rig.h"
 #include "textile/sim/error.h"
@@ -70,7 +70,8 @@ void Run(const ExtractArgs& a) {
       AtomicFile& profile_file = outputs.Add(csv);
       AtomicFile& overlay_file = outputs.Add(png);
       std::ofstream(profile_file.temp_path(), std::ios::binary) << ProfileToCsv(r.profile);
-      if (!cv::imwrite(overlay_file.temp_path(), DrawExtractionOverlay(gray, r, a.overlay_px))) {
+      if (!image_codecs::Write(overlay_file.temp_path(),
+                               DrawExtractionOverlay(gray, r, a.overlay_px))) {
         throw InputError(png + ": cannot write the overlay");
       }
     }

@@ -6,11 +6,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
+#include "textile/fit/image_codecs.h"
 #include "textile/fit/render_photo.h"
 #include "textile/sim/error.h"
 #include "textile/sim/material.h"
@@ -86,7 +86,8 @@ void WriteImage(const AtomicFile& f, const cv::Mat& image, const std::vector<uns
   }
   std::vector<int> params;
   if (as_jpeg) params = {cv::IMWRITE_JPEG_QUALITY, 95};
-  if (!cv::imwrite(f.temp_path(), image, params)) throw InputError(f.path() + ": cannot write the image");
+  if (!image_codecs::Write(f.temp_path(), image, params))
+    throw InputError(f.path() + ": cannot write the image");
 }
 
 // The suffix of an overhang's photo when several are rendered: "_L040mm".
@@ -143,6 +144,7 @@ void Run(const RenderArgs& a) {
   if (a.direction != "auto") o.overhang_left = a.direction == "left";
   std::string why;
   if (!o.Check(&why)) throw InputError("render-photo: " + why);
+  image_codecs::Load();  // opened now: a missing library fails before any rendering
 
   // One camera for every overhang: framed on the longest strip.
   std::vector<double> lengths = a.overhangs_mm;
@@ -172,7 +174,8 @@ void Run(const RenderArgs& a) {
       o.aim_mm = r.aim_mm;
       std::vector<int> params;
       if (as_jpeg) params = {cv::IMWRITE_JPEG_QUALITY, 95};
-      if (!cv::imwrite(files[0]->temp_path(), r.board, params)) throw InputError(board_path + ": cannot write");
+      if (!image_codecs::Write(files[0]->temp_path(), r.board, params))
+        throw InputError(board_path + ": cannot write");
       std::ofstream(files[1]->temp_path()) << RigToJson(r.rig);
     }
     files.push_back(std::make_unique<AtomicFile>(photo_path));

@@ -8,11 +8,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <vector>
 
 #include "textile/fit/extract.h"
+#include "textile/fit/image_codecs.h"
 #include "textile/sim/error.h"
 
 namespace textile {
@@ -200,8 +200,8 @@ cv::Mat ReadPhotoGray(const std::string& path) {
 
   cv::Mat gray;
   try {
-    gray = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, bytes.data()),
-                        cv::IMREAD_GRAYSCALE);
+    gray = image_codecs::Decode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, bytes.data()),
+                                cv::IMREAD_GRAYSCALE);
   } catch (const cv::Exception& e) {
     throw InputError(path + ": cannot decode " + h.format + ": " + e.err);
   }

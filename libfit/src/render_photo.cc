@@ -9,11 +9,11 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <sstream>
 
+#include "textile/fit/image_codecs.h"
 #include "textile/sim/elastica.h"
 #include "textile/sim/error.h"
 #include "textile/sim/polyline.h"
@@ -573,8 +573,8 @@ RenderedPhoto RenderPhoto(const BendingLaw& law, double areal_density,
 
   r.photo = RenderScene(sc, o, o.seed);
   if (o.jpeg_quality > 0) {
-    cv::imencode(".jpg", r.photo, r.encoded, {cv::IMWRITE_JPEG_QUALITY, o.jpeg_quality});
-    r.photo = cv::imdecode(r.encoded, cv::IMREAD_GRAYSCALE);
+    image_codecs::Encode(".jpg", r.photo, &r.encoded, {cv::IMWRITE_JPEG_QUALITY, o.jpeg_quality});
+    r.photo = image_codecs::Decode(cv::Mat(r.encoded), cv::IMREAD_GRAYSCALE);
   }
 
   // The chessboard in the bending plane, centred on the aim point, on a white card.

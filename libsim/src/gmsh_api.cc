@@ -1,7 +1,5 @@
 #include "gmsh_api.h"
 
-#include <dlfcn.h>
-
 #include <cstdlib>
 #include <mutex>
 #include <optional>
@@ -9,6 +7,7 @@
 #include <vector>
 
 #include "textile/sim/error.h"
+#include "textile/sim/shared_library.h"
 
 #ifndef TEXTILE_GMSH_LIBRARY
 #define TEXTILE_GMSH_LIBRARY ""
@@ -22,7 +21,7 @@ namespace {
 
 template <class F>
 void Resolve(void* handle, const std::string& file, const char* name, F* f) {
-  *f = reinterpret_cast<F>(dlsym(handle, name));
+  *f = reinterpret_cast<F>(FindSymbol(handle, name));
   if (!*f) {
     throw ComputeError("pattern mesh: " + file + " is not a Gmsh library with the C API (no " +
                        name + ")");
@@ -32,20 +31,14 @@ void Resolve(void* handle, const std::string& file, const char* name, F* f) {
 }  // namespace
 
 Api Open(const std::vector<std::string>& files) {
-  std::string tried, why = "no file to try", file;
+  std::string file;
   void* handle = nullptr;
-  for (const std::string& name : files) {
-    if (name.empty()) continue;
-    handle = dlopen(name.c_str(), RTLD_NOW | RTLD_LOCAL);
-    file = name;
-    if (handle) break;
-    const char* e = dlerror();
-    tried += (tried.empty() ? "" : ", ") + name;
-    why = e ? e : "unknown error";
-  }
-  if (!handle) {
-    throw ComputeError("pattern mesh: cannot load Gmsh (tried " + tried + "): " + why +
-                       "; install the libgmsh package or set TEXTILE_GMSH to its library file");
+  try {
+    handle = OpenFirstLibrary(files, "Gmsh",
+                              "install the libgmsh package or set TEXTILE_GMSH to its library file",
+                              &file);
+  } catch (const ComputeError& e) {
+    throw ComputeError(std::string("pattern mesh: ") + e.what());
   }
   Api api;
   try {
@@ -70,7 +63,7 @@ Api Open(const std::vector<std::string>& files) {
     Resolve(handle, file, "gmshModelMeshGetNodes", &api.mesh_get_nodes);
     Resolve(handle, file, "gmshModelMeshGetElements", &api.mesh_get_elements);
   } catch (...) {
-    dlclose(handle);
+    CloseLibrary(handle);
     throw;
   }
   return api;  // the handle stays open for the life of the process

@@ -1,0 +1,32 @@
+#ifndef TEXTILE_SIM_SHARED_LIBRARY_H_
+#define TEXTILE_SIM_SHARED_LIBRARY_H_
+
+// Libraries opened at run time instead of linked (Gmsh, OpenCV's image codecs): each brings
+// dozens of libraries of its own whose relocation would cost every `textile` command at
+// start-up, whether it needs them or not (docs/meshing-and-membrane.md, "Start-up").
+//
+//   std::string file;
+//   void* handle = textile::OpenFirstLibrary({"/usr/lib/x/libfoo.so.1", "libfoo.so"},
+//                                            "foo", "install libfoo", &file);
+//   auto* f = reinterpret_cast<int (*)(int)>(textile::FindSymbol(handle, "foo_twice"));
+
+#include <string>
+#include <vector>
+
+namespace textile {
+
+// Opens the first of `files` (paths or library names; empty ones skipped) that dlopen can load
+// (RTLD_NOW | RTLD_LOCAL); *opened (if not null) gets its name. The handle is the caller's to
+// close or keep. Throws ComputeError "cannot load <what> (tried a, b): <dlerror>; <hint>", or
+// with "no file to try" when `files` names none.
+void* OpenFirstLibrary(const std::vector<std::string>& files, const std::string& what,
+                       const std::string& hint, std::string* opened);
+
+// The address of `name` in the library, or null.
+void* FindSymbol(void* handle, const char* name);
+
+void CloseLibrary(void* handle);
+
+}  // namespace textile
+
+#endif  // TEXTILE_SIM_SHARED_LIBRARY_H_

@@ -1,0 +1,84 @@
+// What `textile` loads at start-up: neither Gmsh nor OpenCV's image codecs, each of which brings
+// dozens of libraries of its own (textile/sim/shared_library.h); a command opens them when it
+// needs them, and without them fails with one line and no files while the rest still run.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "run_cli.h"
+
+namespace textile {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::Scratch;
+using testing::Textile;
+
+const std::string kNoCodecs = "TEXTILE_IMGCODECS=/nonexistent/libopencv_imgcodecs.so.406";
+const std::string kFig8 = "--material samples/materials/pabst-fig8.json";
+const std::string kCoarse = " --resolution-mm 15 --no-coarse-to-fine --rim-mm 0";
+
+void ExpectNoCodecsError(const testing::CliResult& r) {
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_EQ(r.err.rfind("error: cannot load OpenCV's image codecs (tried "
+                        "/nonexistent/libopencv_imgcodecs.so.406)",
+                        0),
+            0u)
+      << r.err;
+  EXPECT_EQ(testing::CountLines(r.err), 1) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+TEST(CliStartup, TheExecutableLinksNeitherGmshNorTheImageCodecs) {
+  const fs::path listing = Scratch("CliStartup.Ldd") / "ldd.txt";
+  const std::string cmd =
+      std::string("ldd '") + TEXTILE_EXE + "' > '" + listing.string() + "' 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  const std::string libraries = testing::ReadAll(listing);
+  ASSERT_NE(libraries.find("libopencv_core"), std::string::npos) << libraries;  // ldd worked
+  EXPECT_EQ(libraries.find("imgcodecs"), std::string::npos) << libraries;
+  EXPECT_EQ(libraries.find("gmsh"), std::string::npos) << libraries;
+  EXPECT_EQ(libraries.find("gdal"), std::string::npos) << libraries;
+}
+
+TEST(CliStartup, WithoutTheImageCodecsPhotoCommandsFailWithOneLineAndNoFiles) {
+  const fs::path dir = Scratch("CliStartup.NoCodecs");
+  const std::string photo = "samples/photos/pabst-fig8_L040mm.jpg";
+  const std::string rig = " --rig samples/photos/pabst-fig8.rig-truth.json";
+  ExpectNoCodecsError(
+      Textile("extract " + photo + rig + " -o " + (dir / "extract").string(), kNoCodecs));
+  ExpectNoCodecsError(
+      Textile("fit " + photo + rig + " --gsm 200 -o " + (dir / "fit.json").string(), kNoCodecs));
+  ExpectNoCodecsError(
+      Textile("calibrate samples/photos/pabst-fig8.board.jpg --board 9x6 "
+              "--square-mm 8.5 -o " +
+                  (dir / "rig.json").string(),
+              kNoCodecs));
+  ExpectNoCodecsError(Textile(
+      "render-photo " + kFig8 + " --overhang-mm 40 -o " + (dir / "strip.jpg").string(), kNoCodecs));
+  // The drape's picture is asked for before the drape is computed: it fails at once.
+  ExpectNoCodecsError(Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "d.json").string() +
+                                  " --png " + (dir / "d.png").string(),
+                              kNoCodecs));
+  for (const auto& entry : fs::recursive_directory_iterator(dir))
+    EXPECT_TRUE(entry.is_directory()) << entry.path();  // no file written
+}
+
+TEST(CliStartup, WithoutTheImageCodecsTheOtherCommandsRun) {
+  const fs::path dir = Scratch("CliStartup.OthersRun");
+  const auto law = Textile("law " + kFig8, kNoCodecs);
+  EXPECT_EQ(law.exit_code, 0) << law.err;
+  const auto fit = Textile(
+      "fit samples/profiles/pabst-fig8_L0*.profile.csv --gsm 200 -o " + (dir / "fit.json").string(),
+      kNoCodecs);
+  EXPECT_EQ(fit.exit_code, 0) << fit.err;
+  const auto drape =
+      Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "d.json").string(), kNoCodecs);
+  EXPECT_EQ(drape.exit_code, 0) << drape.err;
+  EXPECT_TRUE(fs::exists(dir / "d.json"));
+}
+
+}  // namespace
+}  // namespace textile

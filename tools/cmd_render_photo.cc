@@ -144,7 +144,6 @@ void Run(const RenderArgs& a) {
   if (a.direction != "auto") o.overhang_left = a.direction == "left";
   std::string why;
   if (!o.Check(&why)) throw InputError("render-photo: " + why);
-  image_codecs::Load();  // opened now: a missing library fails before any rendering
 
   // One camera for every overhang: framed on the longest strip.
   std::vector<double> lengths = a.overhangs_mm;
@@ -160,6 +159,7 @@ void Run(const RenderArgs& a) {
   std::vector<std::unique_ptr<AtomicFile>> files;
   files.push_back(std::make_unique<AtomicFile>(board_path));
   files.push_back(std::make_unique<AtomicFile>(rig_path));
+  image_codecs::Load();  // opened now: a missing library fails before any rendering
   nlohmann::json photos = nlohmann::json::array();
   std::vector<nlohmann::json> by_input(lengths.size());
   std::string text;

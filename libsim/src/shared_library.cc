@@ -22,6 +22,7 @@ void* OpenFirstLibrary(const std::vector<std::string>& files, const std::string&
     tried += (tried.empty() ? "" : ", ") + name;
     why = e ? e : "unknown error";
   }
+  if (tried.empty()) throw ComputeError("cannot load " + what + ": no file to try; " + hint);
   throw ComputeError("cannot load " + what + " (tried " + tried + "): " + why + "; " + hint);
 }
 

@@ -74,11 +74,35 @@ TEST(ImageCodecs, ALibraryThatIsNotTheCodecsIsRefusedByName) {
       << why;
 }
 
+TEST(ImageCodecs, CodecsOfAnotherOpenCvAreRefused) {
+  const std::string why = OpenError({TEXTILE_FAKE_IMGCODECS});
+  EXPECT_NE(why.find(std::string(TEXTILE_FAKE_IMGCODECS) +
+                     " belongs to another OpenCV than the one textile was built with (" +
+                     CV_VERSION + ")"),
+            std::string::npos)
+      << why;
+}
+
 TEST(ImageCodecs, TheLoadedFunctionsAreTheLinkedOnes) {
   // This test links the codecs (for its own images elsewhere): dlopen hands back that library.
   const image_codecs::Api& api = image_codecs::Load();
   EXPECT_EQ(api.imread, static_cast<decltype(api.imread)>(&cv::imread));
+  EXPECT_EQ(api.imwrite, static_cast<decltype(api.imwrite)>(&cv::imwrite));
   EXPECT_EQ(api.imdecode, static_cast<decltype(api.imdecode)>(&cv::imdecode));
+  EXPECT_EQ(api.imencode, static_cast<decltype(api.imencode)>(&cv::imencode));
+}
+
+TEST(ImageCodecs, EachDefaultFileLoadsOnItsOwn) {
+  // The build-time path and the soname: the second is what remains when OpenCV is updated in
+  // place or textile runs on another machine, so it must be a name the dynamic linker finds.
+  const std::vector<std::string> files = image_codecs::DefaultFiles();
+  ASSERT_EQ(files.size(), 2u);
+  EXPECT_EQ(files[0].front(), '/') << files[0];
+  EXPECT_EQ(files[1].find('/'), std::string::npos) << files[1];
+  for (const std::string& file : files) {
+    SCOPED_TRACE(file);
+    EXPECT_EQ(OpenError({file}), "");
+  }
 }
 
 }  // namespace

@@ -13,7 +13,7 @@
 //       textile::PhotoDifficulty::kMedium, /*seed=*/7);
 //   o.overhang = 0.06;                                     // [m]
 //   textile::RenderedPhoto r = textile::RenderPhoto(law, 0.2, o);   // law [SI], ρ [kg/m²]
-//   cv::imwrite("strip.png", r.photo);                      // or r.encoded (JPEG bytes)
+//   textile::image_codecs::Write("strip.png", r.photo);     // or r.encoded (JPEG bytes)
 //   // r.truth: the mid-line in the frame of cantilever.md [m]; r.rig: image -> plane [mm];
 //   // r.board: the chessboard photo; r.board_corners_px: its inner corners' true positions.
 //

@@ -1,7 +1,8 @@
 #ifndef TEXTILE_SIM_SHARED_LIBRARY_H_
 #define TEXTILE_SIM_SHARED_LIBRARY_H_
 
-// Libraries opened at run time instead of linked (Gmsh, OpenCV's image codecs): each brings
+// Internal to textile (its loaders of Gmsh and OpenCV's image codecs), not part of the physics
+// API. Libraries opened at run time instead of linked: each brings
 // dozens of libraries of its own whose relocation would cost every `textile` command at
 // start-up, whether it needs them or not (docs/meshing-and-membrane.md, "Start-up").
 //
@@ -17,8 +18,8 @@ namespace textile {
 
 // Opens the first of `files` (paths or library names; empty ones skipped) that dlopen can load
 // (RTLD_NOW | RTLD_LOCAL); *opened (if not null) gets its name. The handle is the caller's to
-// close or keep. Throws ComputeError "cannot load <what> (tried a, b): <dlerror>; <hint>", or
-// with "no file to try" when `files` names none.
+// close or keep. Throws ComputeError "cannot load <what> (tried a, b): <the last dlerror>;
+// <hint>", or "cannot load <what>: no file to try; <hint>" when `files` names none.
 void* OpenFirstLibrary(const std::vector<std::string>& files, const std::string& what,
                        const std::string& hint, std::string* opened);
 

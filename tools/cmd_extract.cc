@@ -48,7 +48,7 @@ void Run(const ExtractArgs& a) {
     }
     stems[stem] = photo;
   }
-  EnsureDirectory(a.out_dir);
+  const OutputFolder folder(a.out_dir);  // removed again if the run fails before writing
 
   // All or nothing: every photo's profile and overlay wait in temporary files until the last
   // photo has succeeded, so a photo that cannot be read or extracted leaves no output of the

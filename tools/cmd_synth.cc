@@ -62,7 +62,7 @@ void Run(const SynthArgs& a) {
     }
     names.push_back(name);
   }
-  EnsureDirectory(a.out_dir);
+  const OutputFolder folder(a.out_dir);  // removed again if the run fails before writing
   const std::string stem = std::filesystem::path(a.material).stem().string();
   nlohmann::json files = nlohmann::json::array();
   int k = 0;

@@ -167,7 +167,7 @@ void Run(const ValidateArgs& a) {
   const bool run_elastica = a.model != "shell", run_shell = a.model != "elastica";
   const double rho = units::GsmToSi(a.gsm);
   const std::vector<LoadedProfile> loaded = LoadProfileInputs(a.inputs, a.photo.Options());
-  EnsureDirectory(a.out_dir);
+  const OutputFolder folder(a.out_dir);  // removed again if the run fails before writing
   const std::string report_path = (std::filesystem::path(a.out_dir) / "validate.json").string();
   const std::string png_path = (std::filesystem::path(a.out_dir) / "validate.png").string();
   const std::string material_path = (std::filesystem::path(a.out_dir) / "fitted.json").string();

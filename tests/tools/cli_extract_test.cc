@@ -210,8 +210,15 @@ TEST(CliExtract, BadInputExitsTwoWithOneLineAndNoOutput) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.args);
     ExpectOneLineError(Textile("extract " + c.args + out), 2, c.words);
-    EXPECT_TRUE(Listing(dir / "out").empty());
+    EXPECT_FALSE(fs::exists(dir / "out"));  // the folder it made is gone again
   }
+  // A folder that was there stays, empty; missing parents made for the run go with it.
+  fs::create_directory(dir / "kept");
+  ExpectOneLineError(Textile("extract " + Quote(dir / "text.jpg") + scale + " -o " +
+                             Quote(dir / "kept" / "a" / "b")),
+                     2, "not a supported image");
+  EXPECT_TRUE(fs::is_directory(dir / "kept"));
+  EXPECT_FALSE(fs::exists(dir / "kept" / "a"));
 }
 
 TEST(CliExtract, DetectionFailuresExitThreeAndKeepGoodOutputs) {

@@ -118,4 +118,23 @@ void EnsureDirectory(const std::string& dir) {
   if (ec) throw InputError(dir + ": cannot create output folder: " + ec.message());
 }
 
+OutputFolder::OutputFolder(const std::string& dir) {
+  std::error_code ec;
+  if (!dir.empty() && !fs::is_directory(dir, ec)) {
+    for (fs::path p = fs::absolute(dir, ec).lexically_normal(); !p.empty() && !fs::exists(p, ec);
+         p = p.parent_path()) {
+      if (p.has_filename()) created_.push_back(p);  // "a/b/" ends in an empty name
+      if (p == p.parent_path()) break;
+    }
+  }
+  EnsureDirectory(dir);
+}
+
+OutputFolder::~OutputFolder() {
+  for (const fs::path& p : created_) {
+    std::error_code ec;
+    if (!fs::is_empty(p, ec) || ec || !fs::remove(p, ec)) break;
+  }
+}
+
 }  // namespace textile

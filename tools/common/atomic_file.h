@@ -9,6 +9,7 @@
 //   std::ofstream(out.temp_path()) << text;      // or let a library write to temp_path()
 //   out.Commit();                                // rename; without it the temp file is removed
 
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -77,6 +78,21 @@ void WriteFileAtomically(const std::string& path, std::string_view text);
 
 // Creates a directory (and parents) for outputs; throws InputError naming it on failure.
 void EnsureDirectory(const std::string& dir);
+
+// The output folder of a command whose outputs are files in it (extract, synth-profile,
+// validate): made as EnsureDirectory does, and what it made (the folder and missing parents)
+// removed again on destruction when left empty, as by a failed run whose staged files are gone,
+// so that a failure leaves no trace. Declare it before the outputs' AtomicFileSet.
+class OutputFolder {
+ public:
+  explicit OutputFolder(const std::string& dir);
+  ~OutputFolder();
+  OutputFolder(const OutputFolder&) = delete;
+  OutputFolder& operator=(const OutputFolder&) = delete;
+
+ private:
+  std::vector<std::filesystem::path> created_;  // deepest first
+};
 
 }  // namespace textile
 

@@ -14,7 +14,7 @@ namespace {
 struct BenchArgs {
   std::vector<std::string> names;
   std::string out = "out/bench";
-  bool quick = false, json = false, list = false;
+  bool quick = false, json = false, list = false, progress = false;
 };
 
 void Run(const BenchArgs& a) {
@@ -38,8 +38,9 @@ void Run(const BenchArgs& a) {
   EnsureDirectory(a.out);
   const nlohmann::json machine = bench::MachineInfo();
   for (const auto* b : chosen) {
-    bench::Context ctx{.out_dir = a.out, .quick = a.quick, .print = !a.json};
-    Info("bench: running " + b->name + (a.quick ? " (quick)" : ""));
+    bench::Context ctx{
+        .out_dir = a.out, .quick = a.quick, .print = !a.json, .progress = ShowProgress(a.progress)};
+    Progress("bench: running " + b->name + (a.quick ? " (quick)" : ""), a.progress);
     const bench::Result r = b->run(ctx);
     bench::WriteCsv(a.out + "/" + b->name + ".csv", r);
     if (a.json) {
@@ -70,6 +71,8 @@ void RegisterBench(CLI::App& app) {
   sub->add_flag("--quick", a->quick, "CI-sized run (minutes become seconds)");
   sub->add_flag("--list", a->list, "List the benchmarks and exit");
   sub->add_flag("--json", a->json, "One JSON object per benchmark on stdout");
+  sub->add_flag("--progress", a->progress,
+                "Print a progress line per case on stderr even when it is not a terminal");
   sub->callback([a] { Run(*a); });
 }
 

@@ -217,12 +217,21 @@ void RunQuickBench(const std::string& name, Csv* csv) {
   const auto d = Scratch("CliBench." + name);
   const auto r = RunTextile("bench " + name + " --quick -o '" + d.string() + "'", "bench_" + name);
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;  // progress lines only on a terminal or with --progress
   ASSERT_TRUE(fs::exists(d / (name + ".csv"))) << r.out;
   ExpectPng(d / (name + ".png"));
   *csv = ReadCsv(d / (name + ".csv"));
 }
 
 const std::set<std::string> kBendingModels = {"volino", "bridson", "isometric", "pabst"};
+
+TEST(CliBench, ProgressLinesWithTheFlag) {
+  const auto d = Scratch("CliBench.Progress");
+  const auto r =
+      RunTextile("bench hinge-curve --quick --progress -o '" + d.string() + "'", "bench_progress");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.rfind("bench: running hinge-curve (quick)\n", 0), 0u) << r.err;
+}
 
 // Pabst Fig. 10 (docs/bending.md, "hinge-curve"): one curve per fabric and model, and the shapes
 // the paper describes. Physics only: no timing.

@@ -137,7 +137,7 @@ Benchmark AcpmAccuracyBenchmark() {
                     sum << f.name << " " << v.label << " " << mm << " mm: " << shell.message << "\n";
                   }
                   res.rows.push_back(row);
-                  if (ctx.print)
+                  if (ctx.progress)
                     std::fprintf(stderr, "acpm-accuracy %s %s %g mm done\n", f.name.c_str(),
                                  v.label.c_str(), mm);
                 }

@@ -17,6 +17,7 @@ struct Context {
   std::string out_dir;  // CSV + PNG go here
   bool quick = false;   // CI-sized run
   bool print = true;    // human-readable table on stdout
+  bool progress = false;  // a line on stderr per case (a terminal, or bench --progress)
 };
 
 struct Result {

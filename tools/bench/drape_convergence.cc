@@ -110,7 +110,7 @@ Benchmark DrapeConvergenceBenchmark() {
                               {"nodes", std::isfinite(r.nodes) ? nlohmann::json(r.nodes) : nlohmann::json()},
                               {"split_iterations", r.split_iterations >= 0 ? nlohmann::json(r.split_iterations) : nlohmann::json()},
                               {"split_seconds", std::isfinite(r.split_seconds) ? nlohmann::json(r.split_seconds) : nlohmann::json()}});
-          if (ctx.print)
+          if (ctx.progress)
             std::fprintf(stderr, "drape-convergence: %s h=%.1f mm rim=%.1f mm tol=%.0e %s%s: %.2f s, DC %.4f, %g nodes\n",
                          DrapeSeamsName(seams).c_str(), h * 1e3, rim * 1e3, tol, cascadic ? "cascadic" : "direct",
                          extrapolate ? ", extrapolated" : "", r.seconds, r.dc, r.nodes);

@@ -156,7 +156,7 @@ Benchmark ExtractAccuracyBenchmark() {
                   row["tip_err_mm"] = std::hypot(x.tip_mm.x() - r.tip_x_mm, x.tip_mm.y() - r.tip_y_mm);
                   row["length_err_mm"] = x.length_mm - fab.overhang_mm;
                 }
-                if (ctx.print) {
+                if (ctx.progress) {
                   std::cerr << "extract-accuracy: " << ToString(plan.difficulty) << " "
                             << row["megapixels"].get<double>() << " MP seed " << seed << ": "
                             << (x.success ? "rms " + std::to_string(row["rms_mm"].get<double>()) + " mm"

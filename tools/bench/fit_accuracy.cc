@@ -159,7 +159,7 @@ Benchmark FitAccuracyBenchmark() {
                   }
                 }
               }
-              if (ctx.print) std::cerr << "fit-accuracy: " << fab.name << " done\n";
+              if (ctx.progress) std::cerr << "fit-accuracy: " << fab.name << " done\n";
             }
             // Summary: per method and noise, at 3 overhangs (the setting) when present.
             std::ostringstream sum;

@@ -156,7 +156,7 @@ Benchmark StabilityBenchmark() {
               seconds.push_back(s.seconds);
               series.x.push_back(start);
               series.y.push_back(s.seconds);
-              if (ctx.print)
+              if (ctx.progress)
                 std::fprintf(stderr, "stability %s start %d: %s\n", scene.name.c_str(), start,
                              s.BriefReport().c_str());
             }

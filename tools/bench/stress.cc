@@ -129,7 +129,8 @@ Benchmark StressBenchmark() {
               sum << c.name << ": " << o.outcome << " in " << Num(o.seconds, 3) << " s ("
                   << o.iterations << " it, " << o.triangles << " triangles)"
                   << (o.outcome == "converged" ? "" : ": " + o.message) << "\n";
-              if (ctx.print) std::fprintf(stderr, "stress %s: %s\n", c.name.c_str(), o.outcome.c_str());
+              if (ctx.progress)
+                std::fprintf(stderr, "stress %s: %s\n", c.name.c_str(), o.outcome.c_str());
             }
             sum << (other == 0 ? "no run ended in an unclean state\n"
                                : std::to_string(other) + " run(s) ended in an unclean state\n");

@@ -46,8 +46,10 @@ std::string Num(double v, int digits) {
 
 void Info(const std::string& line) { std::cerr << line << std::endl; }
 
+bool ShowProgress(bool always) { return always || ::isatty(STDERR_FILENO) == 1; }
+
 void Progress(const std::string& line, bool always) {
-  if (always || ::isatty(STDERR_FILENO) == 1) std::cerr << line << std::endl;
+  if (ShowProgress(always)) std::cerr << line << std::endl;
 }
 
 namespace {

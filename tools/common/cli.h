@@ -38,6 +38,8 @@ void Info(const std::string& line);
 // does: a script or a test reading stderr sees nothing there but the one `error: ...` line of a
 // failed run. Warnings and notes the user must see go through Info.
 void Progress(const std::string& line, bool always = false);
+// Whether Progress prints: stderr is a terminal, or `always`.
+bool ShowProgress(bool always = false);
 
 // Subcommands register themselves, one file each (tools/cmd_<name>.cc), with a namespace-scope
 //   const bool kRegistered = AddCommand(40, RegisterFit);

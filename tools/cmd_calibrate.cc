@@ -126,7 +126,8 @@ void RegisterCalibrate(CLI::App& app) {
   CLI::App* sub = AddSubcommand(
       app, "calibrate",
       "Chessboard photo(s) in the bending plane -> rig file (homography, lens distortion)",
-      "textile calibrate samples/photos/pabst-fig8.board.jpg --board 9x6 --square-mm 13 -o rig.json");
+      "textile calibrate samples/photos/pabst-fig8.board.jpg --board 9x6 --square-mm 8.5 -o "
+      "rig.json");
   sub->add_option("boards", a->boards,
                   "Board photos (PNG, JPEG, TIFF, BMP); the first lies in the bending plane, more "
                   "(other poses) also give the lens distortion")

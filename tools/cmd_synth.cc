@@ -22,7 +22,7 @@ struct SynthArgs {
   double noise_mm = 0.0, offset_mm = 0.0, rotation_deg = 0.0;
   int points = 100;
   int64_t seed = 1;
-  bool chord = true, json = false;
+  bool exact_arc_length = false, json = false;
 };
 
 void Run(const SynthArgs& a) {
@@ -32,7 +32,7 @@ void Run(const SynthArgs& a) {
   o.noise_sigma = units::MmToM(a.noise_mm);
   o.vertical_offset = units::MmToM(a.offset_mm);
   o.rotation = a.rotation_deg * M_PI / 180.0;
-  o.chord_arc_length = a.chord;
+  o.chord_arc_length = !a.exact_arc_length;
   std::string why;
   if (!std::isfinite(a.noise_mm) || a.noise_mm < 0.0 || a.noise_mm > 5.0)
     throw InputError("--noise-mm must lie in [0, 5] mm");
@@ -98,7 +98,7 @@ void RegisterSynth(CLI::App& app) {
   sub->add_option("--rotation-deg", a->rotation_deg, "Rig rotation [deg] (default 0)");
   sub->add_option("--points", a->points, "Points per profile (default 100)");
   sub->add_option("--seed", a->seed, "Random seed (default 1; profile i uses seed + i)");
-  sub->add_flag("!--exact-arc-length", a->chord,
+  sub->add_flag("--exact-arc-length", a->exact_arc_length,
                 "Keep the exact arc lengths (default: recompute s from the noisy points, as an "
                 "extractor does)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");

@@ -1,10 +1,12 @@
 // textile: the command line. Each subcommand lives in tools/cmd_<name>.cc; this file only
 // wires them up and maps failures to the exit codes of cli.md.
 
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <new>
 #include <string>
+#include <vector>
 
 #include "common/blas_kernels.h"
 #include "common/cli.h"
@@ -33,6 +35,25 @@ int main(int argc, char** argv) {
   app.footer("\nRun 'textile SUBCOMMAND --help' for the flags and an example of each.\n"
              "Exit codes: 0 ok, 2 bad input or usage, 3 computation failed.");
   cli::RegisterAllCommands(app);
+  // CLI11 calls a missing or unknown command, or an unknown option before it, "A subcommand is
+  // required", and with --help after an unknown command prints the top-level help and exits 0:
+  // say what is wrong instead.
+  const std::vector<CLI::App*> commands = app.get_subcommands([](CLI::App*) { return true; });
+  const std::string first = argc > 1 ? argv[1] : "";
+  if (first != "-h" && first != "--help" && first != "--version" &&
+      std::none_of(commands.begin(), commands.end(),
+                   [&](CLI::App* command) { return command->check_name(first); })) {
+    std::string names;
+    for (const CLI::App* command : commands)
+      names += (names.empty() ? "" : ", ") + command->get_name();
+    const std::string quoted =
+        cli::IsValidUtf8(first) ? "'" + OneLine(first.c_str()) + "'" : "(not valid UTF-8 text)";
+    const std::string what = argc == 1                  ? "no command given"
+                             : first.rfind('-', 0) == 0 ? "unknown option " + quoted
+                                                        : "unknown command " + quoted;
+    std::fprintf(stderr, "error: %s (the commands: %s)\n", what.c_str(), names.c_str());
+    return cli::kExitBadInput;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

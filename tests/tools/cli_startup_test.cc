@@ -81,5 +81,15 @@ TEST(CliStartup, WithoutTheImageCodecsTheOtherCommandsRun) {
   EXPECT_TRUE(fs::exists(dir / "d.json"));
 }
 
+TEST(CliStartup, NoCommandIsOneLineNamingTheCommands) {
+  const auto r = Textile("");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("error: no command given (the commands: law, synth-profile, ", 0), 0u)
+      << r.err;
+  EXPECT_NE(r.err.find(", bench)"), std::string::npos) << r.err;
+  EXPECT_EQ(testing::CountLines(r.err), 1) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
 }  // namespace
 }  // namespace textile

@@ -117,6 +117,22 @@ TEST(CliSynth, SameSeedIsByteIdenticalOtherSeedDiffers) {
   }
 }
 
+// The last point's s: the exact arc length ends at the overhang; recomputed from noisy points (the
+// default, as an extractor measures it) the polyline is longer.
+TEST(CliSynth, ExactArcLengthKeepsTheTrueS) {
+  const auto root = Scratch("cli_synth_exact");
+  const auto last_s = [&](const std::string& sub, const std::string& flag) {
+    const auto r = Textile("synth-profile --material " + kFig8 +
+                           " --overhang-mm 40 --noise-mm 0.1 -o " + Quote(root / sub) + flag);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    const std::string csv = ReadAll(root / sub / "pabst-fig8_L040mm.profile.csv");
+    const size_t line = csv.rfind('\n', csv.size() - 2);
+    return std::stod(csv.substr(line + 1));
+  };
+  EXPECT_DOUBLE_EQ(last_s("exact", " --exact-arc-length"), 40.0);
+  EXPECT_GT(last_s("chord", ""), 40.5);
+}
+
 TEST(CliSynth, JsonListsTheFiles) {
   const auto dir = Scratch("cli_synth_json");
   const auto r = Textile("synth-profile --material " + kFig8 +

@@ -180,10 +180,17 @@ Vertices StartState(const TriangleMesh& mesh, const DrapeOptions& o, unsigned se
   return x;
 }
 
+// The resting mount's disk: its top face at z = 0, centred on the specimen.
+Support RestingSupport(const DrapeOptions& o) {
+  return Support::Disk(Eigen::Vector3d::Zero(), o.support_radius, o.support_thickness,
+                       o.rim_rounding);
+}
+
 std::unique_ptr<ClothProblem> MakeProblem(const Pattern& p, const Material& material,
                                           const std::vector<Seam>& seams, const DrapeOptions& o) {
   ClothOptions co;
   co.contact.friction = material.friction;
+  co.contact.sink_under_own_weight = o.contact_sink;
   // Resting mount: Coulomb friction as a potential with lagged normal forces (contact.h).
   // Slip between converged stretches (lagged_slip) settled only with μ = 3 and without the rim
   // band, per-step stick/slip switching not at all (docs/drapemeter.md, "Limits").
@@ -197,8 +204,7 @@ std::unique_ptr<ClothProblem> MakeProblem(const Pattern& p, const Material& mate
     }
     problem->FixVertices(p.clamp, held);
   } else {
-    problem->AddSupport(Support::Disk(Eigen::Vector3d::Zero(), o.support_radius,
-                                      o.support_thickness, o.rim_rounding));
+    problem->AddSupport(RestingSupport(o));
   }
   return problem;
 }
@@ -270,6 +276,8 @@ bool DrapeOptions::Check(std::string* why) const {
   if (!Finite(rim_rounding) || rim_rounding <= 0.0 || rim_rounding > 0.5 * support_thickness)
     return Fail(why, "rim_rounding: must be in (0, support_thickness / 2]");
   if (!Finite(drop_height) || drop_height < 0.0) return Fail(why, "drop_height: must be ≥ 0");
+  if (!Finite(contact_sink) || contact_sink < 1e-9 || contact_sink > 1e-4)
+    return Fail(why, "contact_sink: must be in [1e-9, 1e-4] m");
   if (seeds < 1 || seeds > 1000) return Fail(why, "seeds: must be in 1..1000");
   if (!Finite(perturbation) || perturbation <= 0.0 || perturbation > specimen_radius)
     return Fail(why, "perturbation: must be in (0, specimen_radius]");
@@ -632,6 +640,14 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
       }
       seed.nodes = FindNodes(seed.shadow.radii, o.smoothing_bins, o.node_prominence,
                              o.node_prominence_relative);
+      if (o.mount == DrapeMount::kResting) {
+        const Support disk = RestingSupport(o);
+        for (int i = 0; i < seed.positions.rows(); ++i) {
+          seed.max_penetration =
+              std::max(seed.max_penetration,
+                       -disk.SignedDistance(seed.positions.row(i).transpose(), nullptr));
+        }
+      }
       seed.min_radius = seed.shadow.radii.minCoeff();
       seed.max_radius = seed.shadow.radii.maxCoeff();
       seed.mean_radius = seed.shadow.radii.mean();

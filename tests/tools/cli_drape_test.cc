@@ -369,6 +369,37 @@ TEST(CliDrape, AFabricThroughTheSupportGetsAWarningAndNoNegativeDc) {
   EXPECT_EQ(plain.out.find("of the support's top bare"), std::string::npos) << plain.out;
 }
 
+// The resting contact's penalty lets the skirt sink into the disk's side under the rim's load:
+// past 0.2 mm the run says how deep and that the DC may be low; a stiffer contact
+// (--contact-sink-mm) sinks it less, and says nothing (docs/drapemeter.md, "Contact stiffness").
+// Measured on this mesh, seed 1: 0.57 mm at the default 0.01 (DC 0.517), 0.11 mm at 0.001 (0.544).
+TEST(CliDrape, ASkirtSunkIntoTheSupportGetsANoteAndAStifferContactSinksItLess) {
+  const auto dir = Scratch("CliDrape.Sink");
+  const std::string mesh = " --resolution-mm 12 --rim-mm 0";  // 0.001 cycles at 15 mm (docs)
+  const auto soft =
+      Textile("drape " + kFig8 + mesh + " --mount resting -o " + (dir / "s.json").string());
+  ASSERT_EQ(soft.exit_code, 0) << soft.err;
+  EXPECT_NE(soft.out.find("note: the skirt sank up to 0."), std::string::npos) << soft.out;
+  EXPECT_NE(soft.out.find("(--contact-sink-mm 0.01)"), std::string::npos) << soft.out;
+  const auto s = nlohmann::json::parse(ReadAll(dir / "s.json"));
+  EXPECT_EQ(s["scene"]["contact_sink_mm"].get<double>(), 0.01);
+  const double soft_depth = s["seeds"][0]["max_penetration_mm"].get<double>();
+  EXPECT_GT(soft_depth, 0.2);
+  const auto stiff =
+      Textile("drape " + kFig8 + mesh + " --mount resting --contact-sink-mm 0.001 -o " +
+              (dir / "t.json").string());
+  ASSERT_EQ(stiff.exit_code, 0) << stiff.err;
+  EXPECT_EQ(stiff.out.find("the skirt sank"), std::string::npos) << stiff.out;
+  const auto t = nlohmann::json::parse(ReadAll(dir / "t.json"));
+  EXPECT_LT(t["seeds"][0]["max_penetration_mm"].get<double>(), 0.5 * soft_depth);
+  // Clamped: no support, no such figure.
+  const auto clamped = Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "c.json").string());
+  ASSERT_EQ(clamped.exit_code, 0) << clamped.err;
+  const auto c = nlohmann::json::parse(ReadAll(dir / "c.json"));
+  EXPECT_TRUE(c["scene"]["contact_sink_mm"].is_null());
+  EXPECT_FALSE(c["seeds"][0].contains("max_penetration_mm"));
+}
+
 TEST(CliDrape, RestingMountSettlesAndACutShortRunFailsCleanly) {
   const auto dir = Scratch("CliDrape.Resting");
   const auto r = Textile("drape " + kFig8 + kCoarse + " --mount resting --progress -o " +

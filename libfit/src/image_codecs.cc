@@ -1,8 +1,5 @@
 #include "textile/fit/image_codecs.h"
 
-#include <cstdlib>
-#include <mutex>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -84,16 +81,7 @@ std::vector<std::string> DefaultFiles() {
   return {TEXTILE_IMGCODECS_LIBRARY, TEXTILE_IMGCODECS_SONAME};
 }
 
-const Api& Load() {
-  static std::mutex mutex;
-  static std::optional<Api> api;
-  std::lock_guard<std::mutex> lock(mutex);
-  if (!api) {
-    const char* chosen = std::getenv("TEXTILE_IMGCODECS");
-    api = chosen && *chosen ? Open({chosen}) : Open(DefaultFiles());
-  }
-  return *api;
-}
+const Api& Load() { return LoadOnce<Api>("TEXTILE_IMGCODECS", DefaultFiles(), &Open); }
 
 cv::Mat Read(const std::string& path, int flags) { return Load().imread(path, flags); }
 

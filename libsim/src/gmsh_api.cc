@@ -1,8 +1,5 @@
 #include "gmsh_api.h"
 
-#include <cstdlib>
-#include <mutex>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -70,14 +67,7 @@ Api Open(const std::vector<std::string>& files) {
 }
 
 const Api& Load() {
-  static std::mutex mutex;
-  static std::optional<Api> api;
-  std::lock_guard<std::mutex> lock(mutex);
-  if (!api) {
-    const char* chosen = std::getenv("TEXTILE_GMSH");
-    api = chosen && *chosen ? Open({chosen}) : Open({TEXTILE_GMSH_LIBRARY, TEXTILE_GMSH_LINK_NAME});
-  }
-  return *api;
+  return LoadOnce<Api>("TEXTILE_GMSH", {TEXTILE_GMSH_LIBRARY, TEXTILE_GMSH_LINK_NAME}, &Open);
 }
 
 }  // namespace textile::gmsh_api

@@ -11,6 +11,9 @@
 //                                            "foo", "install libfoo", &file);
 //   auto* f = reinterpret_cast<int (*)(int)>(textile::FindSymbol(handle, "foo_twice"));
 
+#include <cstdlib>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +30,22 @@ void* OpenFirstLibrary(const std::vector<std::string>& files, const std::string&
 void* FindSymbol(void* handle, const char* name);
 
 void CloseLibrary(void* handle);
+
+// open(files) made once per Api type (thread-safe) and kept: with the file named by the
+// environment variable `env` when it is set, else with `defaults`. Throws what open throws;
+// after a failure the next call tries again.
+template <class Api>
+const Api& LoadOnce(const char* env, const std::vector<std::string>& defaults,
+                    Api (*open)(const std::vector<std::string>&)) {
+  static std::mutex mutex;
+  static std::optional<Api> api;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (!api) {
+    const char* chosen = std::getenv(env);
+    api = chosen && *chosen ? open({chosen}) : open(defaults);
+  }
+  return *api;
+}
 
 }  // namespace textile
 

@@ -206,7 +206,6 @@ void Plot(const FitArgs& a, const std::vector<Profile>& profiles, const Outcome&
 }
 
 void Run(const FitArgs& a) {
-  if (!IsValidUtf8(a.name)) throw InputError("--name: not valid UTF-8 text");
   if (!std::isfinite(a.gsm) || a.gsm <= 0.0) throw InputError("--gsm must be a number > 0 (g/m²)");
   if (a.gsm < 1.0 || a.gsm > 1e4) throw InputError("--gsm " + Num(a.gsm) + " g/m² is implausible (1 .. 10000)");
   if (!(a.robust_mm == 0.0 || (a.robust_mm >= 0.001 && a.robust_mm <= 100.0)))

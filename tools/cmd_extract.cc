@@ -48,7 +48,7 @@ void Run(const ExtractArgs& a) {
     }
     stems[stem] = photo;
   }
-  const OutputFolder folder(a.out_dir);  // removed again if the run fails before writing
+  const OutputFolder folder(a.out_dir);  // made when the files are committed
 
   // All or nothing: every photo's profile and overlay wait in temporary files until the last
   // photo has succeeded, so a photo that cannot be read or extracted leaves no output of the
@@ -67,8 +67,8 @@ void Run(const ExtractArgs& a) {
     const std::string csv = (std::filesystem::path(a.out_dir) / (stem + ".profile.csv")).string();
     const std::string png = (std::filesystem::path(a.out_dir) / (stem + ".overlay.png")).string();
     {
-      AtomicFile& profile_file = outputs.Add(csv);
-      AtomicFile& overlay_file = outputs.Add(png);
+      AtomicFile& profile_file = outputs.Add(csv, folder.stage_dir());
+      AtomicFile& overlay_file = outputs.Add(png, folder.stage_dir());
       std::ofstream(profile_file.temp_path(), std::ios::binary) << ProfileToCsv(r.profile);
       if (!image_codecs::Write(overlay_file.temp_path(),
                                DrawExtractionOverlay(gray, r, a.overlay_px))) {

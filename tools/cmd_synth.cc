@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
@@ -62,18 +63,23 @@ void Run(const SynthArgs& a) {
     }
     names.push_back(name);
   }
-  const OutputFolder folder(a.out_dir);  // removed again if the run fails before writing
+  const OutputFolder folder(a.out_dir);  // made when the files are committed
   const std::string stem = std::filesystem::path(a.material).stem().string();
   nlohmann::json files = nlohmann::json::array();
+  // All or nothing: the profiles and the report wait until the last one is made.
+  AtomicFileSet outputs;
+  std::ostringstream report;
   int k = 0;
   for (double L : a.overhang_mm) {
     o.seed = static_cast<uint64_t>(a.seed) + static_cast<uint64_t>(k);  // independent noise per profile
     const Profile p = SyntheticProfile(m.EffectiveLaw(), m.areal_density, units::MmToM(L), o);
     const std::string path = (std::filesystem::path(a.out_dir) / (stem + names[k++])).string();
-    WriteFileAtomically(path, "# " + p.source + "\n" + ProfileToCsv(p));
+    outputs.Add(path, folder.stage_dir()).Write("# " + p.source + "\n" + ProfileToCsv(p));
     files.push_back({{"path", path}, {"overhang_mm", L}, {"points", p.size()}});
-    if (!a.json) std::cout << path << "  (" << Num(L) << " mm overhang, " << p.size() << " points)\n";
+    report << path << "  (" << Num(L) << " mm overhang, " << p.size() << " points)\n";
   }
+  outputs.Commit();
+  if (!a.json) std::cout << report.str();
   if (a.json) {
     PrintJson({{"material", a.material}, {"noise_mm", a.noise_mm}, {"offset_mm", a.offset_mm},
                {"seed", a.seed}, {"profiles", files}});

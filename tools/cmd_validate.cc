@@ -167,15 +167,15 @@ void Run(const ValidateArgs& a) {
   const bool run_elastica = a.model != "shell", run_shell = a.model != "elastica";
   const double rho = units::GsmToSi(a.gsm);
   const std::vector<LoadedProfile> loaded = LoadProfileInputs(a.inputs, a.photo.Options());
-  const OutputFolder folder(a.out_dir);  // removed again if the run fails before writing
+  const OutputFolder folder(a.out_dir);  // made when the files are committed
   const std::string report_path = (std::filesystem::path(a.out_dir) / "validate.json").string();
   const std::string png_path = (std::filesystem::path(a.out_dir) / "validate.png").string();
   const std::string material_path = (std::filesystem::path(a.out_dir) / "fitted.json").string();
   // Fail fast on an unusable folder; the three files appear together or not at all.
   AtomicFileSet outputs;
-  AtomicFile& report_file = outputs.Add(report_path);
-  AtomicFile& png_file = outputs.Add(png_path);
-  AtomicFile& material_file = outputs.Add(material_path);
+  AtomicFile& report_file = outputs.Add(report_path, folder.stage_dir());
+  AtomicFile& png_file = outputs.Add(png_path, folder.stage_dir());
+  AtomicFile& material_file = outputs.Add(material_path, folder.stage_dir());
 
   std::vector<Profile> profiles;
   for (const auto& in : loaded) profiles.push_back(in.profile);

@@ -393,7 +393,7 @@ TEST(Drape, AStifferRestingContactSinksTheSkirtLess) {
   o.contact_sink = 0.0;
   std::string why;
   EXPECT_FALSE(o.Check(&why));
-  EXPECT_EQ(why, "contact_sink: must be in [1e-9, 1e-4] m");
+  EXPECT_EQ(why, "contact_sink: must be in [1e-9, 3e-5] m");
 }
 
 // A resting specimen's rim split goes on with the base drape's friction (its anchors where the

@@ -156,3 +156,51 @@ TEST(CheckDistinctOutputs, SameFileUnderAnyNameIsRefusedNamingBothFlags) {
 
 }  // namespace
 }  // namespace textile
+
+namespace textile {
+namespace {
+
+// An output folder is made only when its files are committed; until then they wait in its
+// nearest existing ancestor, so a failed run leaves nothing and removes nothing.
+TEST(OutputFolder, IsMadeOnlyWhenItsFilesAreCommitted) {
+  const fs::path d = ScratchDir("output_folder");
+  const fs::path dir = d / "a" / "b";
+  {
+    const OutputFolder folder(dir.string());
+    EXPECT_EQ(fs::path(folder.stage_dir()), fs::absolute(d));
+    AtomicFileSet failed;
+    failed.Add((dir / "x.csv").string(), folder.stage_dir()).Write("abandoned");
+    EXPECT_FALSE(fs::exists(d / "a"));  // staged beside it, not in it
+  }
+  EXPECT_TRUE(fs::is_empty(d));  // the failed set took its temporary file with it
+  {
+    const OutputFolder folder(dir.string() + "/");
+    AtomicFileSet outputs;
+    outputs.Add((dir / "x.csv").string(), folder.stage_dir()).Write("kept");
+    outputs.Commit();
+  }
+  EXPECT_EQ(Slurp(dir / "x.csv"), "kept");
+  EXPECT_EQ(std::distance(fs::directory_iterator(d), fs::directory_iterator{}), 1);  // just a/
+  // An existing folder stages in itself.
+  EXPECT_EQ(fs::path(OutputFolder(dir.string()).stage_dir()), fs::absolute(dir));
+}
+
+TEST(OutputFolder, RefusesAFileInTheWay) {
+  const fs::path d = ScratchDir("output_folder_file");
+  std::ofstream(d / "plain") << "keep me";
+  for (const fs::path& dir : {d / "plain", d / "plain" / "sub"}) {
+    try {
+      OutputFolder folder(dir.string());
+      ADD_FAILURE() << dir << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(dir.string() + ": cannot create output folder: ", 0),
+                0u)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find("plain is not a folder"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(Slurp(d / "plain"), "keep me");
+}
+
+}  // namespace
+}  // namespace textile

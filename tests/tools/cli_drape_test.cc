@@ -370,7 +370,7 @@ TEST(CliDrape, AFabricThroughTheSupportGetsAWarningAndNoNegativeDc) {
 }
 
 // The resting contact's penalty lets the skirt sink into the disk's side under the rim's load:
-// past 0.2 mm the run says how deep and that the DC may be low; a stiffer contact
+// past 0.3 mm the run says how deep and what that cost on the default mesh; a stiffer contact
 // (--contact-sink-mm) sinks it less, and says nothing (docs/drapemeter.md, "Contact stiffness").
 // Measured on this mesh, seed 1: 0.57 mm at the default 0.01 (DC 0.517), 0.11 mm at 0.001 (0.544).
 TEST(CliDrape, ASkirtSunkIntoTheSupportGetsANoteAndAStifferContactSinksItLess) {

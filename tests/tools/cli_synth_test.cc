@@ -240,6 +240,18 @@ TEST(CliSynth, UnwritableOutputFolderExit2) {
   EXPECT_FALSE(fs::exists("/proc/forbidden"));
 }
 
+// All or nothing: a profile that cannot be written (a folder has its name) stops the run before
+// any other profile or the folder appears, and stdout stays empty.
+TEST(CliSynth, AProfileThatCannotBeWrittenLeavesNothing) {
+  const auto root = Scratch("cli_synth_nothing");
+  fs::create_directories(root / "out" / "pabst-fig8_L060mm.profile.csv");
+  const auto r = Textile("synth-profile --material " + kFig8 + " --overhang-mm 40 60 -o " +
+                         Quote(root / "out"));
+  testing::ExpectRefused(r, "pabst-fig8_L060mm.profile.csv", "a folder in the way");
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  EXPECT_EQ(Listing(root / "out"), std::set<std::string>{"pabst-fig8_L060mm.profile.csv"});
+}
+
 TEST(CliSynth, RefusedRunLeavesAnExistingFolderAlone) {
   const auto dir = Scratch("cli_synth_keep");
   const auto good =

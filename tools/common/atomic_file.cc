@@ -14,17 +14,18 @@ namespace fs = std::filesystem;
 
 namespace textile {
 
-AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
+AtomicFile::AtomicFile(std::string path, const std::string& stage_dir) : path_(std::move(path)) {
   if (path_.empty()) throw InputError("output path is empty");
   const fs::path target(path_);
   fs::path dir = target.parent_path();
   if (dir.empty()) dir = ".";
   std::error_code ec;
   if (fs::is_directory(target, ec)) throw InputError(path_ + ": is a directory, expected a file");
-  if (!fs::is_directory(dir, ec)) {
+  if (!stage_dir.empty()) {
+    dir = stage_dir;  // an OutputFolder's, checked there
+  } else if (!fs::is_directory(dir, ec)) {
     throw InputError(path_ + ": output folder " + dir.string() + " does not exist");
-  }
-  if (::access(dir.c_str(), W_OK) != 0) {
+  } else if (::access(dir.c_str(), W_OK) != 0) {
     throw InputError(path_ + ": output folder " + dir.string() + " is not writable");
   }
   std::random_device rd;
@@ -50,13 +51,18 @@ void AtomicFile::CheckWritten() const {
 void AtomicFile::Commit() {
   CheckWritten();
   std::error_code ec;
+  const fs::path dir = fs::path(path_).parent_path();
+  if (!dir.empty() && !fs::is_directory(dir, ec)) {  // an OutputFolder's, made now
+    fs::create_directories(dir, ec);
+    if (ec) throw InputError(dir.string() + ": cannot create output folder: " + ec.message());
+  }
   fs::rename(temp_, path_, ec);
   if (ec) throw InputError(path_ + ": cannot move output into place: " + ec.message());
   committed_ = true;
 }
 
-AtomicFile& AtomicFileSet::Add(std::string path) {
-  files_.push_back(std::make_unique<AtomicFile>(std::move(path)));
+AtomicFile& AtomicFileSet::Add(std::string path, const std::string& stage_dir) {
+  files_.push_back(std::make_unique<AtomicFile>(std::move(path), stage_dir));
   return *files_.back();
 }
 
@@ -119,22 +125,25 @@ void EnsureDirectory(const std::string& dir) {
 }
 
 OutputFolder::OutputFolder(const std::string& dir) {
+  if (dir.empty()) throw InputError("output folder is empty");
   std::error_code ec;
-  if (!dir.empty() && !fs::is_directory(dir, ec)) {
-    for (fs::path p = fs::absolute(dir, ec).lexically_normal(); !p.empty() && !fs::exists(p, ec);
-         p = p.parent_path()) {
-      if (p.has_filename()) created_.push_back(p);  // "a/b/" ends in an empty name
-      if (p == p.parent_path()) break;
-    }
+  fs::path stage = fs::absolute(dir, ec);
+  while (!fs::exists(stage, ec) && stage.has_parent_path() && stage != stage.parent_path())
+    stage = stage.parent_path();
+  if (!fs::is_directory(stage, ec)) {
+    throw InputError(dir + ": cannot create output folder: " + stage.string() +
+                     (fs::exists(stage, ec) ? " is not a folder" : " does not exist"));
   }
-  EnsureDirectory(dir);
-}
-
-OutputFolder::~OutputFolder() {
-  for (const fs::path& p : created_) {
-    std::error_code ec;
-    if (!fs::is_empty(p, ec) || ec || !fs::remove(p, ec)) break;
+  // A file made and removed: access() says yes to root even where nothing can be made (/proc).
+  const fs::path probe = stage / (".textile-probe-" + std::to_string(::getpid()));
+  if (!std::ofstream(probe).good()) {
+    throw InputError(
+        dir + (stage == fs::absolute(dir, ec)
+                   ? ": output folder is not writable"
+                   : ": cannot create output folder: " + stage.string() + " is not writable"));
   }
+  fs::remove(probe, ec);
+  stage_dir_ = stage.string();
 }
 
 }  // namespace textile

@@ -20,8 +20,10 @@ namespace textile {
 
 class AtomicFile {
  public:
-  // path: the final file. Checks that its folder exists and is writable.
-  explicit AtomicFile(std::string path);
+  // path: the final file. Checks that its folder exists and is writable; with a stage_dir (an
+  // OutputFolder's) the folder may be missing: the temporary file goes there, and Commit makes
+  // the folder.
+  explicit AtomicFile(std::string path, const std::string& stage_dir = "");
   ~AtomicFile();  // removes the temporary file unless committed
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
@@ -54,7 +56,7 @@ class AtomicFile {
 class AtomicFileSet {
  public:
   // Stages one more output; throws InputError like AtomicFile.
-  AtomicFile& Add(std::string path);
+  AtomicFile& Add(std::string path, const std::string& stage_dir = "");
   void Commit();
 
  private:
@@ -80,18 +82,17 @@ void WriteFileAtomically(const std::string& path, std::string_view text);
 void EnsureDirectory(const std::string& dir);
 
 // The output folder of a command whose outputs are files in it (extract, synth-profile,
-// validate): made as EnsureDirectory does, and what it made (the folder and missing parents)
-// removed again on destruction when left empty, as by a failed run whose staged files are gone,
-// so that a failure leaves no trace. Declare it before the outputs' AtomicFileSet.
+// validate), made only when its files are committed: they are staged in its nearest existing
+// ancestor (AtomicFile's stage_dir), so a failed run leaves no folder behind and never takes one
+// away from another run writing there. Throws InputError naming the folder when it exists and is
+// not one, or when its nearest existing ancestor is not a folder one can write in.
 class OutputFolder {
  public:
   explicit OutputFolder(const std::string& dir);
-  ~OutputFolder();
-  OutputFolder(const OutputFolder&) = delete;
-  OutputFolder& operator=(const OutputFolder&) = delete;
+  const std::string& stage_dir() const { return stage_dir_; }
 
  private:
-  std::vector<std::filesystem::path> created_;  // deepest first
+  std::string stage_dir_;
 };
 
 }  // namespace textile

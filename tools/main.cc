@@ -2,6 +2,7 @@
 // wires them up and maps failures to the exit codes of cli.md.
 
 #include <algorithm>
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <new>
@@ -23,6 +24,9 @@ std::string OneLine(const char* what) {
 
 int main(int argc, char** argv) {
   namespace cli = textile::cli;
+  // A reader that goes away (`textile ... 2>&1 | head -1`) makes writes fail instead of killing
+  // the process, so that its staged files are still cleaned up.
+  std::signal(SIGPIPE, SIG_IGN);
   cli::ChooseBlasKernels();
   CLI::App app{
       "textile: textile bending characterisation.\n"

@@ -167,12 +167,14 @@ TEST(OutputFolder, IsMadeOnlyWhenItsFilesAreCommitted) {
   const fs::path dir = d / "a" / "b";
   {
     const OutputFolder folder(dir.string());
-    EXPECT_EQ(fs::path(folder.stage_dir()), fs::absolute(d));
+    // A private folder in the nearest existing ancestor.
+    EXPECT_EQ(fs::path(folder.stage_dir()).parent_path(), fs::canonical(d));
+    EXPECT_EQ(fs::status(folder.stage_dir()).permissions(), fs::perms::owner_all);
     AtomicFileSet failed;
     failed.Add((dir / "x.csv").string(), folder.stage_dir()).Write("abandoned");
     EXPECT_FALSE(fs::exists(d / "a"));  // staged beside it, not in it
   }
-  EXPECT_TRUE(fs::is_empty(d));  // the failed set took its temporary file with it
+  EXPECT_TRUE(fs::is_empty(d));  // the failed run's files and private folder are gone
   {
     const OutputFolder folder(dir.string() + "/");
     AtomicFileSet outputs;
@@ -181,8 +183,11 @@ TEST(OutputFolder, IsMadeOnlyWhenItsFilesAreCommitted) {
   }
   EXPECT_EQ(Slurp(dir / "x.csv"), "kept");
   EXPECT_EQ(std::distance(fs::directory_iterator(d), fs::directory_iterator{}), 1);  // just a/
-  // An existing folder stages in itself.
-  EXPECT_EQ(fs::path(OutputFolder(dir.string()).stage_dir()), fs::absolute(dir));
+  // An existing folder stages in itself; a broken link in the way is refused before any work.
+  EXPECT_EQ(fs::path(OutputFolder(dir.string()).stage_dir()).parent_path(), fs::canonical(dir));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}), 1);  // x.csv
+  fs::create_symlink(d / "nowhere", d / "broken");
+  EXPECT_THROW(OutputFolder((d / "broken" / "new").string()), InputError);
 }
 
 TEST(OutputFolder, RefusesAFileInTheWay) {

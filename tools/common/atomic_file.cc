@@ -1,5 +1,6 @@
 #include "common/atomic_file.h"
 
+#include <stdlib.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -57,6 +58,14 @@ void AtomicFile::Commit() {
     if (ec) throw InputError(dir.string() + ": cannot create output folder: " + ec.message());
   }
   fs::rename(temp_, path_, ec);
+  if (ec == std::errc::cross_device_link) {  // staged on another filesystem: copy over first
+    const fs::path near = fs::path(path_).parent_path() / fs::path(temp_).filename();
+    ec.clear();
+    fs::copy_file(temp_, near, fs::copy_options::overwrite_existing, ec);
+    if (!ec) fs::rename(near, path_, ec);
+    std::error_code ignored;
+    fs::remove(ec ? near : fs::path(temp_), ignored);
+  }
   if (ec) throw InputError(path_ + ": cannot move output into place: " + ec.message());
   committed_ = true;
 }
@@ -127,23 +136,33 @@ void EnsureDirectory(const std::string& dir) {
 OutputFolder::OutputFolder(const std::string& dir) {
   if (dir.empty()) throw InputError("output folder is empty");
   std::error_code ec;
-  fs::path stage = fs::absolute(dir, ec);
-  while (!fs::exists(stage, ec) && stage.has_parent_path() && stage != stage.parent_path())
+  // Resolved as the kernel will make it (links and "..", then the missing rest), so that the
+  // staging folder sits on the final folder's filesystem.
+  fs::path stage = fs::weakly_canonical(fs::absolute(dir, ec), ec);
+  if (ec) stage = fs::absolute(dir, ec);
+  const fs::path target = stage;
+  while (!fs::exists(stage, ec) && stage.has_parent_path() && stage != stage.parent_path()) {
+    if (fs::is_symlink(fs::symlink_status(stage, ec)))
+      throw InputError(dir + ": cannot create output folder: " + stage.string() +
+                       " is a broken link");
     stage = stage.parent_path();
+  }
   if (!fs::is_directory(stage, ec)) {
     throw InputError(dir + ": cannot create output folder: " + stage.string() +
                      (fs::exists(stage, ec) ? " is not a folder" : " does not exist"));
   }
-  // A file made and removed: access() says yes to root even where nothing can be made (/proc).
-  const fs::path probe = stage / (".textile-probe-" + std::to_string(::getpid()));
-  if (!std::ofstream(probe).good()) {
-    throw InputError(
-        dir + (stage == fs::absolute(dir, ec)
-                   ? ": output folder is not writable"
-                   : ": cannot create output folder: " + stage.string() + " is not writable"));
+  std::string pattern = (stage / ".textile-stage-XXXXXX").string();
+  if (::mkdtemp(pattern.data()) == nullptr) {
+    throw InputError(dir + (stage == target ? ": output folder is not writable"
+                                            : ": cannot create output folder: " + stage.string() +
+                                                  " is not writable"));
   }
-  fs::remove(probe, ec);
-  stage_dir_ = stage.string();
+  stage_dir_ = pattern;
+}
+
+OutputFolder::~OutputFolder() {
+  std::error_code ec;
+  fs::remove_all(stage_dir_, ec);  // empty after a commit; a failed run's temporary files
 }
 
 }  // namespace textile

@@ -82,13 +82,18 @@ void WriteFileAtomically(const std::string& path, std::string_view text);
 void EnsureDirectory(const std::string& dir);
 
 // The output folder of a command whose outputs are files in it (extract, synth-profile,
-// validate), made only when its files are committed: they are staged in its nearest existing
-// ancestor (AtomicFile's stage_dir), so a failed run leaves no folder behind and never takes one
-// away from another run writing there. Throws InputError naming the folder when it exists and is
-// not one, or when its nearest existing ancestor is not a folder one can write in.
+// validate), made only when its files are committed: until then they wait in a private folder
+// (mkdtemp, mode 0700) made in its nearest existing ancestor, on the same filesystem, so a failed
+// run leaves no folder behind and never takes one away from another run writing there. The
+// private folder goes with the OutputFolder: declare it before the outputs' AtomicFileSet.
+// Throws InputError naming the folder when it exists and is not one, when a broken link is in
+// its way, or when its nearest existing ancestor is not a folder one can write in.
 class OutputFolder {
  public:
   explicit OutputFolder(const std::string& dir);
+  ~OutputFolder();
+  OutputFolder(const OutputFolder&) = delete;
+  OutputFolder& operator=(const OutputFolder&) = delete;
   const std::string& stage_dir() const { return stage_dir_; }
 
  private:

@@ -5,6 +5,7 @@
 #include <csignal>
 #include <cstdio>
 #include <exception>
+#include <iostream>
 #include <new>
 #include <string>
 #include <vector>
@@ -81,6 +82,13 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: internal: %s\n", OneLine(e.what()).c_str());
     return cli::kExitComputeFailed;
+  }
+  // A report that did not reach stdout (a full disk, a reader gone) is no success; as for the
+  // files a run could not write, exit 2.
+  std::cout.flush();
+  if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    std::fprintf(stderr, "error: cannot write the report to stdout\n");
+    return cli::kExitBadInput;
   }
   return cli::kExitOk;
 }

@@ -3,6 +3,7 @@
 // needs them, and without them fails with one line and no files while the rest still run.
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -79,6 +80,18 @@ TEST(CliStartup, WithoutTheImageCodecsTheOtherCommandsRun) {
       Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "d.json").string(), kNoCodecs);
   EXPECT_EQ(drape.exit_code, 0) << drape.err;
   EXPECT_TRUE(fs::exists(dir / "d.json"));
+}
+
+// A report that cannot reach stdout (here a full disk) fails the run instead of passing for a
+// success; its files were committed before it was printed.
+TEST(CliStartup, AReportThatCannotBeWrittenIsAFailure) {
+  const fs::path err = Scratch("CliStartup.Full") / "err.txt";
+  const std::string cmd = std::string("cd '") + TEXTILE_SOURCE_DIR + "' && '" + TEXTILE_EXE +
+                          "' law " + kFig8 + " > /dev/full 2> '" + err.string() + "'";
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_EQ(testing::ReadAll(err), "error: cannot write the report to stdout\n");
 }
 
 TEST(CliStartup, NoCommandIsOneLineNamingTheCommands) {

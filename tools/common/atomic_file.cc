@@ -58,14 +58,6 @@ void AtomicFile::Commit() {
     if (ec) throw InputError(dir.string() + ": cannot create output folder: " + ec.message());
   }
   fs::rename(temp_, path_, ec);
-  if (ec == std::errc::cross_device_link) {  // staged on another filesystem: copy over first
-    const fs::path near = fs::path(path_).parent_path() / fs::path(temp_).filename();
-    ec.clear();
-    fs::copy_file(temp_, near, fs::copy_options::overwrite_existing, ec);
-    if (!ec) fs::rename(near, path_, ec);
-    std::error_code ignored;
-    fs::remove(ec ? near : fs::path(temp_), ignored);
-  }
   if (ec) throw InputError(path_ + ": cannot move output into place: " + ec.message());
   committed_ = true;
 }

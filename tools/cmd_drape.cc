@@ -35,6 +35,7 @@ struct DrapeArgs {
   std::optional<double> resolution_mm;
   std::optional<double> seam_rib;
   std::optional<double> contact_sink_mm;
+  std::optional<double> seam_refine_mm;
   std::string rim_mm = "auto";  // a length [mm], 0 (off) or "auto" (the default)
   double rim_band_mm = 20.0;
   double specimen_mm = 150.0, support_mm = 90.0, shift_mm = 50.0, perturbation_mm = 2.0;
@@ -94,6 +95,14 @@ DrapeOptions Options(const DrapeArgs& a) {
   if (o.seams == DrapeSeams::kNone && (!a.seam_type.empty() || !a.seam_file.empty() || a.seam_rib))
     throw InputError("--seam-type/--seam-file/--seam-rib: need --seams weft, weft+warp or shifted");
   o.seam_profile = SeamProfileWithRib(a);
+  if (a.seam_refine_mm) {
+    if (o.seams == DrapeSeams::kNone)
+      throw InputError("--seam-refine-mm: needs --seams weft, weft+warp or shifted");
+    if (!(std::isfinite(*a.seam_refine_mm) && *a.seam_refine_mm >= 0.0 &&
+          *a.seam_refine_mm <= 300.0))
+      throw InputError("--seam-refine-mm: must be between 0 (off) and 300 mm");
+    o.seam_refinement_range = units::MmToM(*a.seam_refine_mm);
+  }
   auto finite = [](double v, const char* flag) {
     if (!std::isfinite(v)) throw InputError(std::string(flag) + ": must be a finite number");
     return v;
@@ -311,6 +320,9 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
                 {"resolution_mm", units::MToMm(o.element_size)},
                 {"rim_mm", units::MToMm(o.rim_element_size)},
                 {"rim_band_mm", units::MToMm(o.rim_band)},
+                {"seam_refine_mm", o.seams != DrapeSeams::kNone
+                                       ? nlohmann::json(units::MToMm(o.seam_refinement_range))
+                                       : nlohmann::json()},
                 {"contact_sink_mm", o.mount == DrapeMount::kResting
                                         ? nlohmann::json(units::MToMm(o.contact_sink))
                                         : nlohmann::json()},
@@ -530,6 +542,10 @@ void RegisterDrape(CLI::App& app) {
                   "docs/drapemeter.md, \"Contact stiffness\")");
   sub->add_option("--specimen-mm", a->specimen_mm, "Specimen radius [mm] (default 150)");
   sub->add_option("--support-mm", a->support_mm, "Support radius [mm] (default 90)");
+  sub->add_option(
+      "--seam-refine-mm", a->seam_refine_mm,
+      "Refine the mesh within this distance of the seam lines [mm]: element area / ceil(S(d)) "
+      "(Pabst 4.3; default 0: off; docs/drapemeter.md, \"Seam refinement\")");
   sub->add_option("--shift-mm", a->shift_mm, "Offset of the shifted seam from the centre [mm] (default 50)");
   sub->add_option("--perturbation-mm", a->perturbation_mm, "Start perturbation at the rim [mm] (default 2)");
   sub->add_option("--frame-deg", a->frame_deg, "Rotate seams and perturbation about the centre [deg]");

@@ -99,6 +99,7 @@ Pattern MeshPattern(const DrapeOptions& o, const std::vector<Seam>& seams, doubl
     for (const Seam& s : seams) profiles.push_back(s.profile);
     mo.area_factor = SeamAreaFactor(profiles);
     mo.refinement_range = o.seam_refinement_range;
+    mo.refining_lines = static_cast<int>(seams.size());  // not near the support circle
   }
   Pattern p;
   p.pm = MeshDisk(o.specimen_radius, lines, mo);

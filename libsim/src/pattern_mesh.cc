@@ -228,7 +228,12 @@ class SizeField {
  public:
   SizeField(const std::vector<Polyline2>& seams, const PatternMeshOptions& options)
       : options_(options) {
-    for (const Polyline2& s : seams) {
+    const size_t refining =
+        options.refining_lines < 0
+            ? seams.size()
+            : std::min(seams.size(), static_cast<size_t>(options.refining_lines));
+    for (size_t k = 0; k < refining; ++k) {
+      const Polyline2& s = seams[k];
       for (int i = 0; i + 1 < s.rows(); ++i)
         segments_.push_back({s.row(i).transpose(), s.row(i + 1).transpose()});
     }
@@ -649,6 +654,8 @@ bool PatternMeshOptions::Check(std::string* why) const {
   }
   if (!(refinement_range >= 0))
     return fail("refinement_range must be >= 0, got " + Num(refinement_range));
+  if (refining_lines < -1)
+    return fail("refining_lines must be >= -1, got " + std::to_string(refining_lines));
   if (max_triangles < 1)
     return fail("max_triangles must be >= 1, got " + std::to_string(max_triangles));
   if (gmsh_algorithm != 1 && gmsh_algorithm != 2 && gmsh_algorithm != 5 && gmsh_algorithm != 6) {

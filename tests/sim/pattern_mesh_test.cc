@@ -206,6 +206,52 @@ TEST(PatternMesh, RefinesNearSeamsByTheAreaFactor) {
   EXPECT_LT(none.mesh.num_triangles(), 0.6 * all.mesh.num_triangles());
 }
 
+TEST(PatternMesh, RefinesNearTheRefiningLinesOnly) {
+  // A diameter seam y = 0 and a circle of radius 90 mm (the drapemeter's support) on a 150 mm
+  // disk, factor 4 within 20 mm of a refining line. With both refining the ring about the
+  // circle is refined too; with only the seam refining (refining_lines = 1) the ring keeps the
+  // plain size away from the seam, and the seam's own band stays refined.
+  PatternMeshOptions o = Options(0.012);
+  o.area_factor = [](double d) { return d < 0.02 ? 4.0 : 1.0; };
+  Polyline2 circle(48, 2);  // segments of about h, its points off the seam, as the drapemeter's
+  for (int k = 0; k < 48; ++k) {
+    const double angle = 2 * std::numbers::pi * (k + 0.5) / 48 + 0.0123;
+    circle.row(k) << 0.09 * std::cos(angle), 0.09 * std::sin(angle);
+  }
+  const std::vector<Polyline2> lines = {Line({{-0.15, 0}, {0.15, 0}}), circle};
+  const PatternMesh both = MeshDisk(0.15, lines, o);
+  o.refining_lines = 1;
+  const PatternMesh seam_only = MeshDisk(0.15, lines, o);
+  ExpectFlatCcw(seam_only.mesh);
+  ExpectSeamPathsAreEdgePaths(seam_only, lines);
+  // Mean triangle area about the circle (|y| > 40 mm, so away from the seam) and along the seam
+  // (|y| < 8 mm, 20-60 mm from the centre, inside the circle's ring).
+  auto mean_area = [](const TriangleMesh& m, auto inside) {
+    const Eigen::VectorXd areas = TriangleAreas(m);
+    double sum = 0;
+    int n = 0;
+    for (int f = 0; f < m.num_triangles(); ++f) {
+      Eigen::Vector2d c = Eigen::Vector2d::Zero();
+      for (int k = 0; k < 3; ++k)
+        c += m.vertices.row(m.triangles(f, k)).transpose().template head<2>() / 3;
+      if (inside(c)) sum += areas(f), ++n;
+    }
+    return sum / n;
+  };
+  auto ring = [](const Eigen::Vector2d& c) {
+    return std::abs(c.norm() - 0.09) < 0.006 && std::abs(c.y()) > 0.04;
+  };
+  auto band = [](const Eigen::Vector2d& c) {
+    return std::abs(c.y()) < 0.004 && std::abs(c.x()) > 0.02 && std::abs(c.x()) < 0.06;
+  };
+  EXPECT_GT(mean_area(seam_only.mesh, ring) / mean_area(both.mesh, ring), 2.5);
+  EXPECT_NEAR(mean_area(seam_only.mesh, band) / mean_area(both.mesh, band), 1.0, 0.3);
+  EXPECT_LT(seam_only.mesh.num_triangles(), both.mesh.num_triangles());
+  o.refining_lines = 0;  // none refines: the plain mesh
+  const PatternMesh none = MeshDisk(0.15, lines, o);
+  EXPECT_GT(mean_area(none.mesh, band) / mean_area(seam_only.mesh, band), 2.5);
+}
+
 TEST(PatternMesh, MaxSizeRefinesWhereItIsSmallerOnly) {
   // 12 mm disk mesh with edges of at most 4 mm in the ring 90 mm < r < 110 mm: triangles in the
   // ring have about a ninth of the area of those near the centre, which keep theirs.
@@ -266,6 +312,10 @@ TEST(PatternMesh, OptionsCheckNamesTheField) {
   o.gmsh_algorithm = 3;
   EXPECT_FALSE(o.Check(&why));
   EXPECT_EQ(why, "gmsh_algorithm must be 1, 2, 5 or 6, got 3");
+  o = PatternMeshOptions();
+  o.refining_lines = -2;
+  EXPECT_FALSE(o.Check(&why));
+  EXPECT_EQ(why, "refining_lines must be >= -1, got -2");
 }
 
 TEST(PatternMesh, BadOutlinesAreRefusedByName) {

@@ -255,6 +255,36 @@ TEST(CliDrape, RimBandIsMeshedReportedAndRecorded) {
   EXPECT_TRUE(j["converged"].get<bool>());
 }
 
+// --seam-refine-mm: the mesh refined near the seam lines only (Pabst 4.3), recorded in the scene;
+// the DC moves little (docs/drapemeter.md, "Seam refinement": at most 0.003 on the default mesh).
+TEST(CliDrape, SeamRefinementMeshesTheSeamBandFinerAndKeepsTheDrape) {
+  const auto dir = Scratch("CliDrape.SeamRefine");
+  const std::string weft = "drape " + kFig8 + kCoarse + " --seams weft -o ";
+  const auto plain = Textile(weft + (dir / "plain.json").string());
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  const auto refined = Textile(weft + (dir / "refined.json").string() + " --seam-refine-mm 20");
+  ASSERT_EQ(refined.exit_code, 0) << refined.err;
+  const auto p = nlohmann::json::parse(ReadAll(dir / "plain.json"));
+  const auto r = nlohmann::json::parse(ReadAll(dir / "refined.json"));
+  EXPECT_EQ(p["scene"]["seam_refine_mm"].get<double>(), 0.0);
+  EXPECT_EQ(r["scene"]["seam_refine_mm"].get<double>(), 20.0);
+  // C-plain's ⌈S⌉ is 10 at the seam and 4 or more out to 20 mm: edges of h/2 or less in a 40 mm
+  // band across the 300 mm specimen, about a quarter of its area at four times the density.
+  const int v0 = p["scene"]["vertices"].get<int>(), v1 = r["scene"]["vertices"].get<int>();
+  EXPECT_GT(v1, 1.5 * v0) << v0 << " " << v1;
+  EXPECT_LT(v1, 4 * v0) << v0 << " " << v1;
+  EXPECT_TRUE(r["converged"].get<bool>());
+  EXPECT_NEAR(r["drape_coefficient"].get<double>(), p["drape_coefficient"].get<double>(), 0.02);
+  // Without seams there is nothing to refine near.
+  const auto none = Textile("drape " + kFig8 + kCoarse + " --seam-refine-mm 20 -o " +
+                            (dir / "none.json").string());
+  EXPECT_EQ(none.exit_code, 2);
+  EXPECT_NE(none.err.find("--seam-refine-mm: needs --seams weft, weft+warp or shifted"),
+            std::string::npos)
+      << none.err;
+  EXPECT_FALSE(fs::exists(dir / "none.json"));
+}
+
 // The default: the rim band (auto: ℓ/2 = 4.31 mm) split, a second solve, the DC extrapolated;
 // both DCs and both solver reports in the JSON, no shortfall note.
 TEST(CliDrape, ExtrapolateReportsBothDrapesAndTheExtrapolatedDc) {

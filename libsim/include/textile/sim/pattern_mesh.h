@@ -41,6 +41,9 @@ struct PatternMeshOptions {
   std::function<double(double d_m)> area_factor;
   // area_factor is consulted only for d < refinement_range [m]; elsewhere the factor is 1.
   double refinement_range = std::numeric_limits<double>::infinity();
+  // d is measured from the first refining_lines of the lines passed (the seams) only; the lines
+  // after them are embedded without refinement (the drapemeter's support circle). -1: all.
+  int refining_lines = -1;
   // An upper bound on the edge length at the pattern point (x, y) [m], on top of the seams' field
   // (e.g. the drapemeter's finer band along the support's rim); empty: none. It must return a
   // finite length > 0 wherever it is asked; values above element_size change nothing.

@@ -465,17 +465,24 @@ void Run(const DrapeArgs& a) {
     PrintJson(j);
     return;
   }
-  std::cout << "material: " << (m.name.empty() ? a.material : m.name) << "  [" << a.material << "]\n"
-            << "scene: specimen " << Num(a.specimen_mm) << " mm on a " << Num(a.support_mm) << " mm support, "
-            << DrapeMountName(o.mount) << ", seams " << DrapeSeamsName(o.seams)
+  std::cout << "material: " << (m.name.empty() ? a.material : m.name) << "  [" << a.material
+            << "]\n"
+            << "scene: specimen " << Num(a.specimen_mm) << " mm on a " << Num(a.support_mm)
+            << " mm support, " << DrapeMountName(o.mount) << ", seams " << DrapeSeamsName(o.seams)
             << (o.seams != DrapeSeams::kNone ? " (" + SeamLabel(o.seam_profile) + ")" : "") << ", "
-            << r.mesh.num_vertices() << " vertices (h = " << Num(units::MToMm(o.element_size)) << " mm"
+            << r.mesh.num_vertices() << " vertices (h = " << Num(units::MToMm(o.element_size))
+            << " mm"
             << (o.rim_element_size > 0.0
                     ? ", " + Num(units::MToMm(o.rim_element_size), 3) + " mm to " +
                           Num(units::MToMm(o.rim_band)) + " mm past the rim"
                     : std::string())
-            << (o.rim_extrapolation ? "; " + std::to_string(r.base_vertices) + " before the rim's split"
-                                    : std::string())
+            << (o.seams != DrapeSeams::kNone && o.seam_refinement_range > 0.0
+                    ? ", refined within " + Num(units::MToMm(o.seam_refinement_range)) +
+                          " mm of the seams"
+                    : std::string())
+            << (o.rim_extrapolation
+                    ? "; " + std::to_string(r.base_vertices) + " before the rim's split"
+                    : std::string())
             << ")\n";
   for (const DrapeSeedResult& s : r.per_seed) {
     std::cout << "  seed " << s.seed << ": DC " << Num(s.drape_coefficient, 4) << ", " << s.nodes.angles.size()

@@ -136,7 +136,8 @@ struct DrapeOptions {
   // Section 4.3 refinement near seams (element area / ⌈S(d)⌉), applied within this distance of
   // the seam lines (not of the support circle) [m]; 0 (the default) turns it off: at h = 12 mm
   // 20 mm of it (C-plain: ⌈S⌉ = 10 at the seam) moved the weft and weft + warp DCs by at most
-  // 0.003 at 1.4× the vertices and up to 2× the time (docs/drapemeter.md, "Seam refinement").
+  // 0.003 at 1.4-1.7× the vertices and up to 2.3× the time (docs/drapemeter.md, "Seam
+  // refinement"). Any range > 0 refines the seam line itself (d = 0 there).
   double seam_refinement_range = 0.0;
 
   // Newton by default; tolerance on the residual relative to the weight.

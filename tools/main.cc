@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "common/atomic_file.h"
 #include "common/blas_kernels.h"
 #include "common/cli.h"
 #include "textile/sim/error.h"
@@ -28,6 +29,8 @@ int main(int argc, char** argv) {
   // A reader that goes away (`textile ... 2>&1 | head -1`) makes writes fail instead of killing
   // the process, so that its staged files are still cleaned up.
   std::signal(SIGPIPE, SIG_IGN);
+  // Ctrl-C, kill or a closed terminal: the run's temporary files and private folders go first.
+  textile::InstallSignalCleanup();
   cli::ChooseBlasKernels();
   CLI::App app{
       "textile: textile bending characterisation.\n"

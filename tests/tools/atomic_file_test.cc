@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <csignal>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -188,6 +190,64 @@ TEST(OutputFolder, IsMadeOnlyWhenItsFilesAreCommitted) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}), 1);  // x.csv
   fs::create_symlink(d / "nowhere", d / "broken");
   EXPECT_THROW(OutputFolder((d / "broken" / "new").string()), InputError);
+}
+
+// A run stopped by a signal: the handler removes the temporary files (next to their targets
+// and in a private folder) and the private folder, then the signal ends the process as before.
+// The child dies inside the handler, so no destructor can have done it.
+TEST(SignalCleanup, ASignalledRunLeavesNoTemporaryFilesOrFolders) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  for (const int signal_number : {SIGTERM, SIGINT, SIGHUP}) {
+    const fs::path d = ScratchDir("signal_cleanup");
+    std::ofstream(d / "old.json") << "keep me";
+    EXPECT_EXIT(
+        {
+          InstallSignalCleanup();
+          AtomicFile next_to_target((d / "old.json").string());
+          next_to_target.Write("half");
+          const OutputFolder folder((d / "out").string());
+          AtomicFileSet staged;
+          staged.Add((d / "out" / "a.csv").string(), folder.stage_dir()).Write("a");
+          staged.Add((d / "out" / "b.png").string(), folder.stage_dir()).Write("b");
+          std::raise(signal_number);
+          std::_Exit(0);  // not reached
+        },
+        ::testing::KilledBySignal(signal_number), "");
+    // Only what was there before: no .tmp- file, no .textile-stage- folder, no out/.
+    std::vector<std::string> left;
+    for (const auto& e : fs::directory_iterator(d)) left.push_back(e.path().filename().string());
+    EXPECT_EQ(left, std::vector<std::string>{"old.json"}) << "signal " << signal_number;
+    EXPECT_EQ(Slurp(d / "old.json"), "keep me");
+  }
+}
+
+// A signal ignored when the run started (nohup's SIGHUP) stays ignored: the run goes on.
+TEST(SignalCleanup, AnIgnoredSignalStaysIgnored) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  EXPECT_EXIT(
+      {
+        std::signal(SIGHUP, SIG_IGN);
+        InstallSignalCleanup();
+        std::raise(SIGHUP);
+        std::_Exit(7);
+      },
+      ::testing::ExitedWithCode(7), "");
+}
+
+// Without the handler the same run leaves its temporary files behind: the test above can fail.
+TEST(SignalCleanup, WithoutTheHandlerTheFilesStay) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const fs::path d = ScratchDir("signal_no_cleanup");
+  EXPECT_EXIT(
+      {
+        std::signal(SIGTERM, SIG_DFL);
+        AtomicFile next_to_target((d / "new.json").string());
+        next_to_target.Write("half");
+        std::raise(SIGTERM);
+        std::_Exit(0);
+      },
+      ::testing::KilledBySignal(SIGTERM), "");
+  EXPECT_EQ(std::distance(fs::directory_iterator(d), fs::directory_iterator{}), 1);
 }
 
 TEST(OutputFolder, RefusesAFileInTheWay) {

@@ -1,10 +1,13 @@
 #include "common/atomic_file.h"
 
+#include <signal.h>
 #include <stdlib.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -14,6 +17,74 @@
 namespace fs = std::filesystem;
 
 namespace textile {
+
+namespace {
+
+// InstallSignalCleanup's records: a slot is free (0), being filled (1), or holds the path of a
+// temporary file (2) or of a private folder (3). Filled before they are marked, read by the
+// handler only when marked; std::atomic<int> is lock-free, so the handler may read it.
+constexpr int kCleanupSlots = 1024;
+constexpr size_t kCleanupPathBytes = 1024;
+enum CleanupKind { kFree = 0, kFilling = 1, kTempFile = 2, kStageFolder = 3 };
+struct CleanupSlot {
+  std::atomic<int> kind{kFree};
+  char path[kCleanupPathBytes];
+};
+CleanupSlot g_cleanup[kCleanupSlots];
+static_assert(std::atomic<int>::is_always_lock_free);
+
+// The slot now holding path, or -1 when there is no room (the normal paths still clean up).
+int RecordForCleanup(const std::string& path, CleanupKind kind) {
+  if (path.size() >= kCleanupPathBytes) return -1;
+  for (int i = 0; i < kCleanupSlots; ++i) {
+    int expected = kFree;
+    if (!g_cleanup[i].kind.compare_exchange_strong(expected, kFilling)) continue;
+    std::memcpy(g_cleanup[i].path, path.c_str(), path.size() + 1);
+    g_cleanup[i].kind.store(kind, std::memory_order_release);
+    return i;
+  }
+  return -1;
+}
+
+void ForgetForCleanup(int slot) {
+  if (slot >= 0) g_cleanup[slot].kind.store(kFree, std::memory_order_release);
+}
+
+extern "C" void CleanUpAndResignal(int signal_number) {
+  // Files first: a private folder goes only once it is empty.
+  for (const int kind : {kTempFile, kStageFolder}) {
+    for (CleanupSlot& slot : g_cleanup) {
+      if (slot.kind.load(std::memory_order_acquire) != kind) continue;
+      if (kind == kTempFile) {
+        ::unlink(slot.path);
+      } else {
+        ::rmdir(slot.path);
+      }
+    }
+  }
+  struct sigaction fallback {};
+  fallback.sa_handler = SIG_DFL;
+  sigemptyset(&fallback.sa_mask);
+  ::sigaction(signal_number, &fallback, nullptr);
+  ::raise(signal_number);
+}
+
+}  // namespace
+
+void InstallSignalCleanup() {
+  struct sigaction action {};
+  action.sa_handler = CleanUpAndResignal;
+  sigemptyset(&action.sa_mask);
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP})
+    sigaddset(&action.sa_mask, signal_number);
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    // A signal the run was started with ignored stays ignored: nohup's SIGHUP, SIGINT in a
+    // non-interactive shell's background jobs.
+    struct sigaction before {};
+    if (::sigaction(signal_number, nullptr, &before) == 0 && before.sa_handler == SIG_IGN) continue;
+    ::sigaction(signal_number, &action, nullptr);
+  }
+}
 
 AtomicFile::AtomicFile(std::string path, const std::string& stage_dir) : path_(std::move(path)) {
   if (path_.empty()) throw InputError("output path is empty");
@@ -33,6 +104,7 @@ AtomicFile::AtomicFile(std::string path, const std::string& stage_dir) : path_(s
   const std::string tag = std::to_string(::getpid()) + "-" + std::to_string(rd() % 1000000);
   temp_ = (dir / ("." + target.stem().string() + ".tmp-" + tag + target.extension().string()))
               .string();
+  cleanup_slot_ = RecordForCleanup(temp_, kTempFile);
 }
 
 AtomicFile::~AtomicFile() {
@@ -40,6 +112,7 @@ AtomicFile::~AtomicFile() {
     std::error_code ec;
     fs::remove(temp_, ec);
   }
+  ForgetForCleanup(cleanup_slot_);
 }
 
 void AtomicFile::CheckWritten() const {
@@ -60,6 +133,8 @@ void AtomicFile::Commit() {
   fs::rename(temp_, path_, ec);
   if (ec) throw InputError(path_ + ": cannot move output into place: " + ec.message());
   committed_ = true;
+  ForgetForCleanup(cleanup_slot_);
+  cleanup_slot_ = -1;
 }
 
 AtomicFile& AtomicFileSet::Add(std::string path, const std::string& stage_dir) {
@@ -150,11 +225,13 @@ OutputFolder::OutputFolder(const std::string& dir) {
                                                   " is not writable"));
   }
   stage_dir_ = pattern;
+  cleanup_slot_ = RecordForCleanup(stage_dir_, kStageFolder);
 }
 
 OutputFolder::~OutputFolder() {
   std::error_code ec;
   fs::remove_all(stage_dir_, ec);  // empty after a commit; a failed run's temporary files
+  ForgetForCleanup(cleanup_slot_);
 }
 
 }  // namespace textile

@@ -42,6 +42,7 @@ class AtomicFile {
  private:
   std::string path_, temp_;
   bool committed_ = false;
+  int cleanup_slot_ = -1;  // InstallSignalCleanup's record of temp_
 };
 
 // Outputs of one run that appear together or not at all (extract: a profile and an overlay per
@@ -98,7 +99,18 @@ class OutputFolder {
 
  private:
   std::string stage_dir_;
+  int cleanup_slot_ = -1;  // InstallSignalCleanup's record of stage_dir_
 };
+
+// A run stopped by SIGINT, SIGTERM or SIGHUP (Ctrl-C, kill, a closed terminal) removes its
+// AtomicFiles' temporary files and its OutputFolders' private folders before the signal ends it
+// as it would have (the exit status still says which signal). The handler uses unlink and rmdir
+// only (async-signal-safe) on paths recorded when the files and folders were made; up to 1024
+// of them at once, of up to 1023 bytes each (longer or further ones are cleaned up on the
+// normal paths only). A signal ignored when the run started (nohup's SIGHUP, SIGINT in a
+// shell's background job) stays ignored. SIGKILL cannot be caught: its leftovers stay. Call once,
+// from main.
+void InstallSignalCleanup();
 
 }  // namespace textile
 

@@ -1,5 +1,7 @@
 #include "textile/sim/mesh_io.h"
 
+#include <unistd.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
@@ -11,7 +13,9 @@
 #include <iomanip>
 #include <limits>
 #include <numbers>
+#include <random>
 #include <sstream>
+#include <string>
 #include <system_error>
 
 #include "textile/sim/error.h"
@@ -57,8 +61,11 @@ void CheckScalar(const TriangleMesh& mesh, const VertexScalar& s) {
 void WriteText(const std::string& path, const std::string& text) {
   namespace fs = std::filesystem;
   const fs::path target(path);
+  // A name of its own (process and a random number), so that it neither replaces a user's
+  // "x.obj.tmp" nor collides with another run writing the same file.
   fs::path temp = target;
-  temp += ".tmp";
+  temp +=
+      ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(std::random_device{}() % 1000000);
   {
     std::ofstream out(temp, std::ios::binary | std::ios::trunc);
     if (!out) throw InputError(path + ": cannot open for writing");

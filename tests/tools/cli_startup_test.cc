@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "run_cli.h"
 
@@ -92,6 +93,30 @@ TEST(CliStartup, AReportThatCannotBeWrittenIsAFailure) {
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 2);
   EXPECT_EQ(testing::ReadAll(err), "error: cannot write the report to stdout\n");
+}
+
+// The executable installs the signal cleanup (tools/main.cc): an `extract` stopped with SIGTERM
+// once its private folder exists dies of the signal and leaves nothing (SignalCleanup.* test the
+// handler itself).
+TEST(CliStartup, AStoppedRunDiesOfTheSignalAndLeavesNothing) {
+  const fs::path d = Scratch("CliStartup.Stopped");
+  const std::string photos =
+      "samples/photos/pabst-fig8_L040mm.jpg samples/photos/pabst-fig8_L060mm.jpg "
+      "samples/photos/pabst-fig8_L080mm.jpg";
+  // Waits (up to 5 s) for the staging folder, then stops the run; writes its exit status.
+  const std::string cmd =
+      std::string("cd '") + TEXTILE_SOURCE_DIR + "' && ('" + TEXTILE_EXE + "' extract " + photos +
+      " --mm-per-px 0.11 -o '" + (d / "out" / "sub").string() +
+      "' > /dev/null 2>&1 & pid=$!; for i in $(seq 500); do ls -d '" + d.string() +
+      "'/.textile-stage-* > /dev/null 2>&1 && break; sleep 0.01; done; "
+      "kill -TERM $pid; wait $pid; echo $? > '" +
+      (d / "status").string() + "')";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  // 143 = 128 + SIGTERM: it died of the signal (not exit 0: it had not finished).
+  EXPECT_EQ(testing::ReadAll(d / "status"), "143\n");
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(d)) left.push_back(e.path().filename().string());
+  EXPECT_EQ(left, std::vector<std::string>{"status"});
 }
 
 TEST(CliStartup, NoCommandIsOneLineNamingTheCommands) {

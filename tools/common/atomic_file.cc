@@ -1,7 +1,10 @@
 #include "common/atomic_file.h"
 
+#include <dirent.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <stdlib.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -21,13 +24,17 @@ namespace textile {
 namespace {
 
 // InstallSignalCleanup's records: a slot is free (0), being filled (1), or holds the path of a
-// temporary file (2) or of a private folder (3). Filled before they are marked, read by the
-// handler only when marked; std::atomic<int> is lock-free, so the handler may read it.
+// temporary file (2) or of a private folder (3), a folder with an open descriptor. Filled before
+// they are marked, read by the handler only when marked; std::atomic<int> is lock-free, so the
+// handler may read it. The handler runs on the main thread only (it forwards the signal there),
+// the thread that records and forgets, so a slot cannot change under it.
 constexpr int kCleanupSlots = 1024;
 constexpr size_t kCleanupPathBytes = 1024;
+constexpr int kCleanupSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
 enum CleanupKind { kFree = 0, kFilling = 1, kTempFile = 2, kStageFolder = 3 };
 struct CleanupSlot {
   std::atomic<int> kind{kFree};
+  int folder_fd = -1;  // kStageFolder: the folder, opened, to empty it of unrecorded files too
   char path[kCleanupPathBytes];
 };
 CleanupSlot g_cleanup[kCleanupSlots];
@@ -40,6 +47,8 @@ int RecordForCleanup(const std::string& path, CleanupKind kind) {
     int expected = kFree;
     if (!g_cleanup[i].kind.compare_exchange_strong(expected, kFilling)) continue;
     std::memcpy(g_cleanup[i].path, path.c_str(), path.size() + 1);
+    g_cleanup[i].folder_fd =
+        kind == kStageFolder ? ::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC) : -1;
     g_cleanup[i].kind.store(kind, std::memory_order_release);
     return i;
   }
@@ -47,20 +56,43 @@ int RecordForCleanup(const std::string& path, CleanupKind kind) {
 }
 
 void ForgetForCleanup(int slot) {
-  if (slot >= 0) g_cleanup[slot].kind.store(kFree, std::memory_order_release);
+  if (slot < 0) return;
+  CleanupSlot& s = g_cleanup[slot];
+  s.kind.store(kFilling, std::memory_order_release);  // not the handler's any more
+  if (s.folder_fd >= 0) ::close(s.folder_fd);
+  s.folder_fd = -1;
+  s.kind.store(kFree, std::memory_order_release);
+}
+
+// Unlinks every entry of the open folder (the private folders hold files only).
+void EmptyFolder(int folder_fd) {
+  alignas(8) char buffer[4096];
+  for (;;) {
+    const long n = ::syscall(SYS_getdents64, folder_fd, buffer, sizeof buffer);
+    if (n <= 0) return;
+    for (long at = 0; at < n;) {
+      const auto* entry = reinterpret_cast<const struct dirent64*>(buffer + at);
+      const char* name = entry->d_name;
+      if (!(name[0] == '.' && (name[1] == '\0' || (name[1] == '.' && name[2] == '\0'))))
+        ::unlinkat(folder_fd, name, 0);
+      at += entry->d_reclen;
+    }
+  }
 }
 
 extern "C" void CleanUpAndResignal(int signal_number) {
+  // Only the main thread records and forgets: a signal that reached another thread goes there.
+  if (::syscall(SYS_gettid) != ::getpid()) {
+    ::syscall(SYS_tgkill, ::getpid(), ::getpid(), signal_number);
+    return;
+  }
   // Files first: a private folder goes only once it is empty.
-  for (const int kind : {kTempFile, kStageFolder}) {
-    for (CleanupSlot& slot : g_cleanup) {
-      if (slot.kind.load(std::memory_order_acquire) != kind) continue;
-      if (kind == kTempFile) {
-        ::unlink(slot.path);
-      } else {
-        ::rmdir(slot.path);
-      }
-    }
+  for (CleanupSlot& slot : g_cleanup)
+    if (slot.kind.load(std::memory_order_acquire) == kTempFile) ::unlink(slot.path);
+  for (CleanupSlot& slot : g_cleanup) {
+    if (slot.kind.load(std::memory_order_acquire) != kStageFolder) continue;
+    if (slot.folder_fd >= 0) EmptyFolder(slot.folder_fd);
+    ::rmdir(slot.path);
   }
   struct sigaction fallback {};
   fallback.sa_handler = SIG_DFL;
@@ -75,9 +107,8 @@ void InstallSignalCleanup() {
   struct sigaction action {};
   action.sa_handler = CleanUpAndResignal;
   sigemptyset(&action.sa_mask);
-  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP})
-    sigaddset(&action.sa_mask, signal_number);
-  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+  for (const int signal_number : kCleanupSignals) sigaddset(&action.sa_mask, signal_number);
+  for (const int signal_number : kCleanupSignals) {
     // A signal the run was started with ignored stays ignored: nohup's SIGHUP, SIGINT in a
     // non-interactive shell's background jobs.
     struct sigaction before {};

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -42,7 +43,9 @@ static_assert(std::atomic<int>::is_always_lock_free);
 
 // The slot now holding path, or -1 when there is no room (the normal paths still clean up).
 int RecordForCleanup(const std::string& path, CleanupKind kind) {
-  if (path.size() >= kCleanupPathBytes) return -1;
+  // The handler runs on the main thread only: a record from another thread could change under
+  // it.
+  if (path.size() >= kCleanupPathBytes || ::syscall(SYS_gettid) != ::getpid()) return -1;
   for (int i = 0; i < kCleanupSlots; ++i) {
     int expected = kFree;
     if (!g_cleanup[i].kind.compare_exchange_strong(expected, kFilling)) continue;
@@ -66,6 +69,7 @@ void ForgetForCleanup(int slot) {
 
 // Unlinks every entry of the open folder (the private folders hold files only).
 void EmptyFolder(int folder_fd) {
+  ::lseek(folder_fd, 0, SEEK_SET);  // from the start, wherever the descriptor was read to
   alignas(8) char buffer[4096];
   for (;;) {
     const long n = ::syscall(SYS_getdents64, folder_fd, buffer, sizeof buffer);
@@ -83,8 +87,10 @@ void EmptyFolder(int folder_fd) {
 extern "C" void CleanUpAndResignal(int signal_number) {
   // Only the main thread records and forgets: a signal that reached another thread goes there.
   if (::syscall(SYS_gettid) != ::getpid()) {
-    ::syscall(SYS_tgkill, ::getpid(), ::getpid(), signal_number);
-    return;
+    const int saved_errno = errno;
+    const long forwarded = ::syscall(SYS_tgkill, ::getpid(), ::getpid(), signal_number);
+    errno = saved_errno;
+    if (forwarded == 0) return;  // else (no main thread) clean up here
   }
   // Files first: a private folder goes only once it is empty.
   for (CleanupSlot& slot : g_cleanup)
@@ -106,6 +112,7 @@ extern "C" void CleanUpAndResignal(int signal_number) {
 void InstallSignalCleanup() {
   struct sigaction action {};
   action.sa_handler = CleanUpAndResignal;
+  action.sa_flags = SA_RESTART;  // a thread that handed the signal on goes on where it was
   sigemptyset(&action.sa_mask);
   for (const int signal_number : kCleanupSignals) sigaddset(&action.sa_mask, signal_number);
   for (const int signal_number : kCleanupSignals) {

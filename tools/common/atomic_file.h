@@ -105,14 +105,15 @@ class OutputFolder {
 // A run stopped by SIGINT, SIGTERM, SIGHUP or SIGQUIT (Ctrl-C, kill, a closed terminal, Ctrl-\)
 // removes its AtomicFiles' temporary files and its OutputFolders' private folders, with
 // whatever is in them, before the signal ends it as it would have (the exit status still says
-// which signal). The handler uses unlink, unlinkat, getdents64 and rmdir only (async-signal-safe)
-// on paths and folders recorded when they were made, up to 1024 at once, of up to 1023 bytes
+// which signal). The handler makes async-signal-safe calls only (unlink, unlinkat, getdents64,
+// lseek, rmdir, then sigaction and raise; tgkill to hand a signal on) on paths and folders
+// recorded when they were made, by the main thread, up to 1024 at once, of up to 1023 bytes
 // each: a temporary file past that stays, a private folder past that stays with its files. It
 // runs on the main thread (the one that makes and commits outputs; a signal sent to another goes
-// there). A signal ignored when the run started (nohup's SIGHUP, SIGINT in a shell's background
-// job) stays ignored. Not covered: a signal between mkdtemp and its record, or in the middle of
-// an AtomicFileSet's renames (some outputs in place, the rest gone), and SIGKILL, which cannot
-// be caught. Call once, from main.
+// there, so the main thread must not block these signals). A signal ignored when the run started
+// (nohup's SIGHUP, SIGINT in a shell's background job) stays ignored. Not covered: a signal between
+// mkdtemp and its record, or in the middle of an AtomicFileSet's renames (some outputs in place,
+// the rest gone), and SIGKILL, which cannot be caught. Call once, from main.
 void InstallSignalCleanup();
 
 }  // namespace textile

@@ -36,6 +36,7 @@ struct DrapeArgs {
   std::optional<double> seam_rib;
   std::optional<double> contact_sink_mm;
   std::optional<double> seam_refine_mm;
+  std::optional<double> compression_ratio;
   std::string rim_mm = "auto";  // a length [mm], 0 (off) or "auto" (the default)
   double rim_band_mm = 20.0;
   double specimen_mm = 150.0, support_mm = 90.0, shift_mm = 50.0, perturbation_mm = 2.0;
@@ -350,7 +351,13 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
 
 void Run(const DrapeArgs& a) {
   DrapeOptions o = Options(a);
-  const Material m = ReadMaterial(a.material);
+  if (a.compression_ratio &&
+      !(*a.compression_ratio >= kMinCompressionRatio && *a.compression_ratio <= 1.0))
+    throw InputError(
+        "--compression-ratio: must be between 0.001 and 1 (1: as stiff in compression as in "
+        "tension)");
+  Material m = ReadMaterial(a.material);
+  if (a.compression_ratio) m.compression_ratio = *a.compression_ratio;
   // The fabric's turn-down length ℓ at the rim. DC converges from below as the rim's element e
   // shrinks, by about 0.1 e/ℓ at e = ℓ/3 for a plain fabric (docs/drapemeter.md, "Resolution
   // at the rim"; less with seams and near DC = 1, hence "up to").
@@ -465,8 +472,11 @@ void Run(const DrapeArgs& a) {
     PrintJson(j);
     return;
   }
-  std::cout << "material: " << (m.name.empty() ? a.material : m.name) << "  [" << a.material
-            << "]\n"
+  std::cout << "material: " << (m.name.empty() ? a.material : m.name) << "  [" << a.material << "]"
+            << (m.compression_ratio < 1.0
+                    ? "; membrane soft in compression (ratio " + Num(m.compression_ratio) + ")"
+                    : std::string())
+            << "\n"
             << "scene: specimen " << Num(a.specimen_mm) << " mm on a " << Num(a.support_mm)
             << " mm support, " << DrapeMountName(o.mount) << ", seams " << DrapeSeamsName(o.seams)
             << (o.seams != DrapeSeams::kNone ? " (" + SeamLabel(o.seam_profile) + ")" : "") << ", "
@@ -547,6 +557,11 @@ void RegisterDrape(CLI::App& app) {
                   "support under its own weight [mm] (1e-6 to 0.03, default 0.01; 0.001 sinks "
                   "the skirt a quarter as deep, takes twice the time and may not settle; "
                   "docs/drapemeter.md, \"Contact stiffness\")");
+  sub->add_option("--compression-ratio", a->compression_ratio,
+                  "The membrane's stiffness against compression as a fraction of its stretch "
+                  "stiffness (0.001 to 1; default the material's stretch.compression_ratio, 1: "
+                  "as stiff as in tension); fabric buckles far more easily, and the DC drops with "
+                  "it (docs/drapemeter.md, \"Compression ratio\")");
   sub->add_option("--specimen-mm", a->specimen_mm, "Specimen radius [mm] (default 150)");
   sub->add_option("--support-mm", a->support_mm, "Support radius [mm] (default 90)");
   sub->add_option(

@@ -136,8 +136,10 @@ Material ParseMaterialJson(const std::string& text, const std::string& source) {
   }
   if (root.contains("stretch")) {
     const json& st = root["stretch"];
-    if (!st.is_object()) r.Fail("stretch", "must be an object {\"stiffness_N_per_m\", \"poisson\"}");
-    r.CheckKeys(st, "stretch", {"stiffness_N_per_m", "poisson"});
+    if (!st.is_object())
+      r.Fail("stretch",
+             "must be an object {\"stiffness_N_per_m\", \"poisson\", \"compression_ratio\"}");
+    r.CheckKeys(st, "stretch", {"stiffness_N_per_m", "poisson", "compression_ratio"});
     if (st.contains("stiffness_N_per_m")) {
       m.stretch_stiffness = r.Number(st, "stiffness_N_per_m", "stretch.stiffness_N_per_m");
       if (m.stretch_stiffness <= 0.0) r.Fail("stretch.stiffness_N_per_m", "must be > 0 N/m");
@@ -146,6 +148,11 @@ Material ParseMaterialJson(const std::string& text, const std::string& source) {
     if (st.contains("poisson")) {
       m.poisson = r.Number(st, "poisson", "stretch.poisson");
       if (m.poisson < 0.0 || m.poisson >= 0.5) r.Fail("stretch.poisson", "must lie in [0, 0.5)");
+    }
+    if (st.contains("compression_ratio")) {
+      m.compression_ratio = r.Number(st, "compression_ratio", "stretch.compression_ratio");
+      if (!(m.compression_ratio >= kMinCompressionRatio && m.compression_ratio <= 1.0))
+        r.Fail("stretch.compression_ratio", "must lie in [0.001, 1] (1: as stiff as in tension)");
     }
   }
   if (root.contains("friction")) {
@@ -187,6 +194,7 @@ nlohmann::json MaterialToJson(const Material& m) {
   if (m.bending_weft) j["bending_weft"] = LawToJson(*m.bending_weft);
   j["beta"] = m.beta;
   j["stretch"] = {{"stiffness_N_per_m", m.stretch_stiffness}, {"poisson", m.poisson}};
+  if (m.compression_ratio != 1.0) j["stretch"]["compression_ratio"] = m.compression_ratio;
   j["friction"] = m.friction;
   for (const auto& [k, v] : m.extra.items()) j[k] = v;
   if (!m.fit.is_null()) j["fit"] = m.fit;

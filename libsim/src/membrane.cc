@@ -83,6 +83,51 @@ Mat6 StvkStressDerivative(const MembraneLame& l, const Mat32& f) {
   return h;
 }
 
+// ---- StVK soft in compression (MembraneLame::compression = c < 1): ψ = μ (q(E1) + q(E2)) +
+// λ/2 q(E1 + E2) over the principal Green strains, q(t) = w(t) t² with w = 1 for t ≥ 0 and c for
+// t < 0.
+
+// The principal strains Ei (E1 ≥ E2), their unit eigenvectors vi in the rest frame and the
+// principal second Piola-Kirchhoff stresses Si = ∂ψ/∂Ei = 2μ wi Ei + λ wt tr E.
+struct SoftStrains {
+  double strain[2];
+  Eigen::Vector2d v[2];
+  double stress[2];
+  double weight[2], weight_trace;
+};
+
+SoftStrains Soft(const MembraneLame& l, const Mat32& f) {
+  SoftStrains t;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> green;
+  green.computeDirect(0.5 * (f.transpose() * f - Eigen::Matrix2d::Identity()));
+  for (int i = 0; i < 2; ++i) {
+    t.strain[i] = green.eigenvalues()(1 - i);
+    t.v[i] = green.eigenvectors().col(1 - i);
+    t.weight[i] = t.strain[i] < 0 ? l.compression : 1.0;
+  }
+  const double tr = t.strain[0] + t.strain[1];
+  t.weight_trace = tr < 0 ? l.compression : 1.0;
+  for (int i = 0; i < 2; ++i)
+    t.stress[i] = 2 * l.mu * t.weight[i] * t.strain[i] + l.lambda * t.weight_trace * tr;
+  return t;
+}
+
+double SoftDensity(const MembraneLame& l, const Mat32& f) {
+  const SoftStrains t = Soft(l, f);
+  const double tr = t.strain[0] + t.strain[1];
+  return l.mu *
+             (t.weight[0] * t.strain[0] * t.strain[0] + t.weight[1] * t.strain[1] * t.strain[1]) +
+         0.5 * l.lambda * t.weight_trace * tr * tr;
+}
+
+// P = F S, S = Σ Si vi viᵀ.
+Vec6 SoftStress(const MembraneLame& l, const Mat32& f) {
+  const SoftStrains t = Soft(l, f);
+  const Eigen::Matrix2d s =
+      t.stress[0] * t.v[0] * t.v[0].transpose() + t.stress[1] * t.v[1] * t.v[1].transpose();
+  return Vec(f * s);
+}
+
 // ---- Corotational linear: ψ = μ |U - I|² + λ/2 tr(U - I)², U the stretch of F = R U.
 // With the singular values σ1, σ2 of F: |U - I|² = I1 - 2 s + 2 and tr(U) = s, where
 // I1 = |F|² = σ1² + σ2², J = |f1 × f2| = σ1 σ2 and s = σ1 + σ2 = sqrt(I1 + 2 J): the energy is a
@@ -244,6 +289,68 @@ IsotropicEigenvalues StvkEigenvalues(const MembraneLame& l, double s1, double s2
   return e;
 }
 
+// Soft StVK: ψi = σi Si; ∂²ψ/∂σi² = Si + (2μ wi + λ wt) σi², ∂²ψ/∂σ1∂σ2 = λ wt σ1 σ2; shear
+// (ψ1 − ψ2)/(σ1 − σ2) = λ wt tr E + μ (w1 (σ1³ − σ1) − w2 (σ2³ − σ2))/(σ1 − σ2), in closed form
+// μ w (σ1² + σ1 σ2 + σ2² − 1) when w1 = w2; twist (ψ1 + ψ2)/(σ1 + σ2); out of plane Si.
+IsotropicEigenvalues SoftEigenvalues(const MembraneLame& l, double s1, double s2) {
+  IsotropicEigenvalues e;
+  const double c = l.compression;
+  const double e1 = 0.5 * (s1 * s1 - 1), e2 = 0.5 * (s2 * s2 - 1), tr = e1 + e2;
+  const double w1 = e1 < 0 ? c : 1.0, w2 = e2 < 0 ? c : 1.0, wt = tr < 0 ? c : 1.0;
+  const double stress1 = 2 * l.mu * w1 * e1 + l.lambda * wt * tr;
+  const double stress2 = 2 * l.mu * w2 * e2 + l.lambda * wt * tr;
+  e.stretch << stress1 + (2 * l.mu * w1 + l.lambda * wt) * s1 * s1, l.lambda * wt * s1 * s2,
+      l.lambda * wt * s1 * s2, stress2 + (2 * l.mu * w2 + l.lambda * wt) * s2 * s2;
+  const double shear_mu = w1 == w2 || !(s1 - s2 > 1e-12)
+                              ? 0.5 * (w1 + w2) * (s1 * s1 + s1 * s2 + s2 * s2 - 1)
+                              : (w1 * (s1 * s1 * s1 - s1) - w2 * (s2 * s2 * s2 - s2)) / (s1 - s2);
+  e.shear = l.lambda * wt * tr + l.mu * shear_mu;
+  e.twist = (s1 * stress1 + s2 * stress2) / (s1 + s2);
+  e.out[0] = stress1;
+  e.out[1] = stress2;
+  return e;
+}
+
+// ∂²ψ/∂F² of an isotropic ψ(σ1, σ2) assembled from its eigensystem (above), its negative
+// eigenvalues dropped when project. A triangle collapsed to a line (σ2 ≤ 1e-6 σ1) takes any
+// unit u2 normal to u1.
+template <typename Eigenvalues>
+Mat6 IsotropicHessian(const Mat32& f, Eigenvalues eigenvalues, bool project) {
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> cauchy_green;
+  cauchy_green.computeDirect(f.transpose() * f);  // eigenvalues σi² in increasing order
+  const double large = std::sqrt(std::max(cauchy_green.eigenvalues()(1), 0.0));
+  if (!(large > 0)) return Mat6::Zero();  // F = 0: no direction to build on
+  const double small = f.col(0).cross(f.col(1)).norm() / large;
+  const double sigma[2] = {large, small};
+  const Eigen::Vector2d v[2] = {cauchy_green.eigenvectors().col(1),
+                                cauchy_green.eigenvectors().col(0)};
+  const Eigen::Vector3d u1 = f * v[0] / large;
+  const Eigen::Vector3d u2 = small > 1e-6 * large ? Eigen::Vector3d(f * v[1] / small)
+                                                  : Eigen::Vector3d(u1.unitOrthogonal());
+  const Eigen::Vector3d u3 = u1.cross(u2).normalized();
+  const IsotropicEigenvalues e = eigenvalues(sigma[0], sigma[1]);
+  auto outer = [](const Eigen::Vector3d& a, const Eigen::Vector2d& b) {
+    return Vec(a * b.transpose());
+  };
+  Mat6 h = Mat6::Zero();
+  auto add = [&](double eigenvalue, const Vec6& q) {  // q of unit length
+    if (!project || eigenvalue > 0) h += eigenvalue * q * q.transpose();
+  };
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> stretch;
+  stretch.computeDirect(e.stretch);
+  const Vec6 d1 = outer(u1, v[0]), d2 = outer(u2, v[1]);
+  for (int k = 0; k < 2; ++k) {
+    const Eigen::Vector2d ab = stretch.eigenvectors().col(k);
+    add(stretch.eigenvalues()(k), ab(0) * d1 + ab(1) * d2);
+  }
+  const Vec6 uv = outer(u1, v[1]), vu = outer(u2, v[0]);
+  add(e.shear, (uv + vu) / std::sqrt(2.0));
+  add(e.twist, (uv - vu) / std::sqrt(2.0));
+  add(e.out[0], outer(u3, v[0]));
+  add(e.out[1], outer(u3, v[1]));
+  return h;
+}
+
 // StVK's Hessian is positive semi-definite when the Green strain is (no direction compressed)
 // and λ ≥ 0: then its projection is itself and the eigen-solve can be skipped.
 bool StvkNeedsProjection(const MembraneLame& l, const Mat32& f) {
@@ -253,7 +360,8 @@ bool StvkNeedsProjection(const MembraneLame& l, const Mat32& f) {
 
 }  // namespace
 
-MembraneLame MembraneLame::FromStretch(double stretch_stiffness, double poisson) {
+MembraneLame MembraneLame::FromStretch(double stretch_stiffness, double poisson,
+                                       double compression) {
   if (!(stretch_stiffness > 0) || !std::isfinite(stretch_stiffness)) {
     throw InputError("membrane: stretch_stiffness must be a positive number of N/m, got " +
                      Num(stretch_stiffness));
@@ -262,7 +370,12 @@ MembraneLame MembraneLame::FromStretch(double stretch_stiffness, double poisson)
     throw InputError("membrane: poisson must lie in (-1, 1) for a stable sheet, got " +
                      Num(poisson));
   }
+  if (!(compression >= kMinCompressionRatio && compression <= 1)) {
+    throw InputError("membrane: compression ratio must lie in [" + Num(kMinCompressionRatio) +
+                     ", 1], got " + Num(compression));
+  }
   MembraneLame l;
+  l.compression = compression;
   l.mu = stretch_stiffness / (2 * (1 + poisson));
   l.lambda = stretch_stiffness * poisson / (1 - poisson * poisson);
   return l;
@@ -272,8 +385,9 @@ double MembraneEnergy(MembraneModel model, const MembraneLame& lame,
                       const Eigen::Matrix2d& rest_inverse, double rest_area,
                       const Eigen::Matrix3d& x) {
   const Mat32 f = DeformationGradient(rest_inverse, x);
-  const double psi =
-      model == MembraneModel::kStVK ? StvkDensity(lame, f) : CorotationalDensity(lame, f);
+  const double psi = model != MembraneModel::kStVK ? CorotationalDensity(lame, f)
+                     : lame.compression < 1.0      ? SoftDensity(lame, f)
+                                                   : StvkDensity(lame, f);
   return rest_area * psi;
 }
 
@@ -281,7 +395,9 @@ Eigen::Matrix<double, 9, 1> MembraneGradient(MembraneModel model, const Membrane
                                              const Eigen::Matrix2d& rest_inverse, double rest_area,
                                              const Eigen::Matrix3d& x) {
   const Mat32 f = DeformationGradient(rest_inverse, x);
-  const Vec6 p = model == MembraneModel::kStVK ? StvkStress(lame, f) : CorotationalStress(lame, f);
+  const Vec6 p = model != MembraneModel::kStVK ? CorotationalStress(lame, f)
+                 : lame.compression < 1.0      ? SoftStress(lame, f)
+                                               : StvkStress(lame, f);
   return rest_area * GradientMap(rest_inverse).transpose() * p;
 }
 
@@ -290,7 +406,10 @@ Eigen::Matrix<double, 9, 9> MembraneHessian(MembraneModel model, const MembraneL
                                             const Eigen::Matrix3d& x, bool project_psd) {
   const Mat32 f = DeformationGradient(rest_inverse, x);
   Mat6 h;
-  if (model == MembraneModel::kStVK) {
+  if (model == MembraneModel::kStVK && lame.compression < 1.0) {
+    h = IsotropicHessian(
+        f, [&](double s1, double s2) { return SoftEigenvalues(lame, s1, s2); }, project_psd);
+  } else if (model == MembraneModel::kStVK) {
     h = StvkStressDerivative(lame, f);
     if (project_psd && StvkNeedsProjection(lame, f))
       h = ProjectIsotropicPsd(f, h, [&](double s1, double s2) { return StvkEigenvalues(lame, s1, s2); });
@@ -304,8 +423,8 @@ Eigen::Matrix<double, 9, 9> MembraneHessian(MembraneModel model, const MembraneL
 }
 
 MembraneElements::MembraneElements(const TriangleMesh& rest, double stretch_stiffness,
-                                   double poisson, MembraneModel model)
-    : model_(model), lame_(MembraneLame::FromStretch(stretch_stiffness, poisson)) {
+                                   double poisson, MembraneModel model, double compression)
+    : model_(model), lame_(MembraneLame::FromStretch(stretch_stiffness, poisson, compression)) {
   num_vertices_ = rest.num_vertices();
   triangles_ = rest.triangles;
   const int nf = rest.num_triangles();
@@ -340,7 +459,8 @@ MembraneElements::MembraneElements(const TriangleMesh& rest, double stretch_stif
 
 MembraneElements::MembraneElements(const TriangleMesh& rest, const Material& material,
                                    MembraneModel model)
-    : MembraneElements(rest, material.stretch_stiffness, material.poisson, model) {}
+    : MembraneElements(rest, material.stretch_stiffness, material.poisson, model,
+                       material.compression_ratio) {}
 
 void MembraneElements::CheckSize(Eigen::Ref<const Vertices> x) const {
   if (x.rows() != num_vertices_) {

@@ -53,6 +53,24 @@ TEST(Material, DefaultsAndOptionalFields) {
   EXPECT_DOUBLE_EQ(m.friction, 0.5);
 }
 
+TEST(Material, CompressionRatioDefaultsToOneAndSurvivesTheRoundTrip) {
+  const std::string law = R"("bending": {"units": "kes", "b1": 0.1, "b2": 0.0892, "c1": -0.0092})";
+  const Material plain = ParseMaterialJson(R"({"areal_density_gsm": 180, )" + law + "}", "plain");
+  EXPECT_EQ(plain.compression_ratio, 1.0);
+  EXPECT_FALSE(MaterialToJson(plain)["stretch"].contains("compression_ratio"));
+  const Material soft = ParseMaterialJson(
+      R"({"areal_density_gsm": 180, )" + law + R"(, "stretch": {"compression_ratio": 0.02}})",
+      "soft");
+  EXPECT_DOUBLE_EQ(soft.compression_ratio, 0.02);
+  EXPECT_DOUBLE_EQ(soft.stretch_stiffness, 1000.0);
+  EXPECT_DOUBLE_EQ(ParseMaterialJson(MaterialToJson(soft).dump(), "round trip").compression_ratio,
+                   0.02);
+  EXPECT_THROW(ParseMaterialJson(R"({"areal_density_gsm": 180, )" + law +
+                                     R"(, "stretch": {"compression_ratio": 1.5}})",
+                                 "above one"),
+               InputError);
+}
+
 TEST(Material, JsonRoundTrip) {
   const Material a = ReadMaterial(kSamples + "pabst-interlining.json");
   const Material b = ParseMaterialJson(MaterialToJson(a).dump(), "round trip");
@@ -89,39 +107,40 @@ TEST_P(BadMaterial, IsRejectedWithFileFieldAndProblem) {
 
 INSTANTIATE_TEST_SUITE_P(
     Material, BadMaterial,
-    ::testing::Values(
-        BadCase{"empty.json", "", "empty material file"},
-        BadCase{"not-json.json", "", "not valid JSON"},
-        BadCase{"truncated.json", "", "not valid JSON"},
-        BadCase{"array.json", "(top level)", "JSON object"},
-        BadCase{"missing-gsm.json", "areal_density_gsm", "missing"},
-        BadCase{"missing-bending.json", "bending", "missing"},
-        BadCase{"missing-b2.json", "bending.b2", "missing"},
-        BadCase{"unknown-units.json", "bending.units", "unknown units 'mN'"},
-        BadCase{"nan.json", "", "not valid JSON"},
-        BadCase{"inf.json", "", "number overflow parsing '1e999'"},
-        BadCase{"string-number.json", "areal_density_gsm", "must be a number"},
-        BadCase{"b1-zero.json", "bending.b1", "must be > 0"},
-        BadCase{"b2-negative.json", "bending.b2", "must be > 0"},
-        BadCase{"kappa0-negative.json", "bending", "kappa0 = (b2 - b1)/(2 c1) < 0"},
-        BadCase{"gsm-zero.json", "areal_density_gsm", "must be > 0"},
-        BadCase{"gsm-negative.json", "areal_density_gsm", "must be > 0"},
-        BadCase{"gsm-absurd.json", "areal_density_gsm", "suspicious"},
-        BadCase{"beta-zero.json", "beta", "must be > 0"},
-        BadCase{"beta-negative.json", "beta", "must be > 0"},
-        BadCase{"si-with-kes-numbers.json", "bending.b1", "is this file in kes?"},
-        BadCase{"b-absurdly-small.json", "bending.b1", "suspicious"},
-        BadCase{"c1-absurd.json", "bending.c1", "suspicious"},
-        BadCase{"unknown-field.json", "bendng", "unknown field"},
-        BadCase{"weft-invalid.json", "bending_weft", "kappa0"},
-        BadCase{"poisson-bad.json", "stretch.poisson", "[0, 0.5)"},
-        BadCase{"stretch-negative.json", "stretch.stiffness_N_per_m", "must be > 0"},
-        BadCase{"friction-negative.json", "friction", "[0, 10]"},
-        BadCase{"bending-not-object.json", "bending", "must be an object"}),
+    ::testing::Values(BadCase{"empty.json", "", "empty material file"},
+                      BadCase{"not-json.json", "", "not valid JSON"},
+                      BadCase{"truncated.json", "", "not valid JSON"},
+                      BadCase{"array.json", "(top level)", "JSON object"},
+                      BadCase{"missing-gsm.json", "areal_density_gsm", "missing"},
+                      BadCase{"missing-bending.json", "bending", "missing"},
+                      BadCase{"missing-b2.json", "bending.b2", "missing"},
+                      BadCase{"unknown-units.json", "bending.units", "unknown units 'mN'"},
+                      BadCase{"nan.json", "", "not valid JSON"},
+                      BadCase{"inf.json", "", "number overflow parsing '1e999'"},
+                      BadCase{"string-number.json", "areal_density_gsm", "must be a number"},
+                      BadCase{"b1-zero.json", "bending.b1", "must be > 0"},
+                      BadCase{"b2-negative.json", "bending.b2", "must be > 0"},
+                      BadCase{"kappa0-negative.json", "bending", "kappa0 = (b2 - b1)/(2 c1) < 0"},
+                      BadCase{"gsm-zero.json", "areal_density_gsm", "must be > 0"},
+                      BadCase{"gsm-negative.json", "areal_density_gsm", "must be > 0"},
+                      BadCase{"gsm-absurd.json", "areal_density_gsm", "suspicious"},
+                      BadCase{"beta-zero.json", "beta", "must be > 0"},
+                      BadCase{"beta-negative.json", "beta", "must be > 0"},
+                      BadCase{"si-with-kes-numbers.json", "bending.b1", "is this file in kes?"},
+                      BadCase{"b-absurdly-small.json", "bending.b1", "suspicious"},
+                      BadCase{"c1-absurd.json", "bending.c1", "suspicious"},
+                      BadCase{"unknown-field.json", "bendng", "unknown field"},
+                      BadCase{"weft-invalid.json", "bending_weft", "kappa0"},
+                      BadCase{"poisson-bad.json", "stretch.poisson", "[0, 0.5)"},
+                      BadCase{"stretch-negative.json", "stretch.stiffness_N_per_m", "must be > 0"},
+                      BadCase{"compression-zero.json", "stretch.compression_ratio", "[0.001, 1]"},
+                      BadCase{"friction-negative.json", "friction", "[0, 10]"},
+                      BadCase{"bending-not-object.json", "bending", "must be an object"}),
     [](const auto& info) {
       std::string n = info.param.file;
       n = n.substr(0, n.find('.'));
-      for (char& ch : n) if (ch == '-') ch = '_';
+      for (char& ch : n)
+        if (ch == '-') ch = '_';
       return n;
     });
 

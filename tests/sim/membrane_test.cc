@@ -66,30 +66,58 @@ Eigen::MatrixXd DenseHessian(const MembraneElements& m, const Vertices& x, bool 
   return Eigen::MatrixXd(h);
 }
 
+// The largest gap between the gradient and central differences of the energy, over the
+// gradient's largest entry. Step 1e-7 m: truncation ~ (1e-7)² · ψ''' and round-off
+// ~ 1e-16 · E / 1e-7 both far below 1e-6 of the largest force (~10 N).
+double RelativeGradientError(const MembraneElements& m, Vertices x) {
+  const Vertices g = Gradient(m, x);
+  const double step = 1e-7;
+  double max_err = 0;
+  for (int v = 0; v < x.rows(); ++v) {
+    for (int c = 0; c < 3; ++c) {
+      const double keep = x(v, c);
+      x(v, c) = keep + step;
+      const double ep = m.Energy(x);
+      x(v, c) = keep - step;
+      const double em = m.Energy(x);
+      x(v, c) = keep;
+      max_err = std::max(max_err, std::abs((ep - em) / (2 * step) - g(v, c)));
+    }
+  }
+  return max_err / g.cwiseAbs().maxCoeff();
+}
+
+// The same for the raw Hessian against central differences of the gradient, which must also be
+// symmetric.
+double RelativeHessianError(const MembraneElements& m, Vertices x) {
+  const Eigen::MatrixXd h = DenseHessian(m, x, /*project_psd=*/false);
+  EXPECT_LT((h - h.transpose()).cwiseAbs().maxCoeff(), 1e-10 * h.cwiseAbs().maxCoeff());
+  const double step = 1e-7;
+  double max_err = 0;
+  for (int v = 0; v < x.rows(); ++v) {
+    for (int c = 0; c < 3; ++c) {
+      const double keep = x(v, c);
+      x(v, c) = keep + step;
+      const Vertices gp = Gradient(m, x);
+      x(v, c) = keep - step;
+      const Vertices gm = Gradient(m, x);
+      x(v, c) = keep;
+      const Eigen::VectorXd column = (Eigen::Map<const Eigen::VectorXd>(gp.data(), gp.size()) -
+                                      Eigen::Map<const Eigen::VectorXd>(gm.data(), gm.size())) /
+                                     (2 * step);
+      max_err = std::max(max_err, (column - h.col(3 * v + c)).cwiseAbs().maxCoeff());
+    }
+  }
+  return max_err / h.cwiseAbs().maxCoeff();
+}
+
 TEST(Membrane, GradientMatchesCentralDifferences) {
   const TriangleMesh rest = IrregularPatch(1);
   for (MembraneModel model : kModels) {
     const MembraneElements m(rest, kStiffness, kPoisson, model);
-    for (unsigned seed = 0; seed < 3; ++seed) {
-      Vertices x = RandomConfiguration(rest, 0.006, seed);
-      const Vertices g = Gradient(m, x);
-      // Step 1e-7 m: truncation ~ (1e-7)² · ψ''' and round-off ~ 1e-16 · E / 1e-7 both far below
-      // 1e-6 of the largest force (~10 N).
-      const double step = 1e-7;
-      double max_err = 0;
-      for (int v = 0; v < x.rows(); ++v) {
-        for (int c = 0; c < 3; ++c) {
-          const double keep = x(v, c);
-          x(v, c) = keep + step;
-          const double ep = m.Energy(x);
-          x(v, c) = keep - step;
-          const double em = m.Energy(x);
-          x(v, c) = keep;
-          max_err = std::max(max_err, std::abs((ep - em) / (2 * step) - g(v, c)));
-        }
-      }
-      EXPECT_LT(max_err, 1e-6 * g.cwiseAbs().maxCoeff()) << Name(model) << " seed " << seed;
-    }
+    for (unsigned seed = 0; seed < 3; ++seed)
+      EXPECT_LT(RelativeGradientError(m, RandomConfiguration(rest, 0.006, seed)), 1e-6)
+          << Name(model) << " seed " << seed;
   }
 }
 
@@ -97,27 +125,24 @@ TEST(Membrane, HessianMatchesCentralDifferencesOfTheGradient) {
   const TriangleMesh rest = IrregularPatch(2);
   for (MembraneModel model : kModels) {
     const MembraneElements m(rest, kStiffness, kPoisson, model);
+    for (unsigned seed = 0; seed < 3; ++seed)
+      EXPECT_LT(RelativeHessianError(m, RandomConfiguration(rest, 0.006, 10 + seed)), 1e-6)
+          << Name(model) << " seed " << seed;
+  }
+}
+
+// StVK soft in compression (compression ratio c < 1): its own energy, gradient and Hessian on
+// the same mix of stretched, compressed and sheared triangles (principal strains of both signs;
+// the C¹ energy's stiffness jumps where one changes sign, which these states do not straddle).
+TEST(Membrane, SoftCompressionGradientAndHessianMatchCentralDifferences) {
+  const TriangleMesh rest = IrregularPatch(3);
+  for (const double c : {0.2, 0.01}) {
+    const MembraneElements m(rest, kStiffness, kPoisson, MembraneModel::kStVK, c);
     for (unsigned seed = 0; seed < 3; ++seed) {
-      Vertices x = RandomConfiguration(rest, 0.006, 10 + seed);
-      const Eigen::MatrixXd h = DenseHessian(m, x, /*project_psd=*/false);
-      EXPECT_LT((h - h.transpose()).cwiseAbs().maxCoeff(), 1e-10 * h.cwiseAbs().maxCoeff());
-      const double step = 1e-7;
-      double max_err = 0;
-      for (int v = 0; v < x.rows(); ++v) {
-        for (int c = 0; c < 3; ++c) {
-          const double keep = x(v, c);
-          x(v, c) = keep + step;
-          const Vertices gp = Gradient(m, x);
-          x(v, c) = keep - step;
-          const Vertices gm = Gradient(m, x);
-          x(v, c) = keep;
-          const Eigen::VectorXd column = (Eigen::Map<const Eigen::VectorXd>(gp.data(), gp.size()) -
-                                          Eigen::Map<const Eigen::VectorXd>(gm.data(), gm.size())) /
-                                         (2 * step);
-          max_err = std::max(max_err, (column - h.col(3 * v + c)).cwiseAbs().maxCoeff());
-        }
-      }
-      EXPECT_LT(max_err, 1e-6 * h.cwiseAbs().maxCoeff()) << Name(model) << " seed " << seed;
+      EXPECT_LT(RelativeGradientError(m, RandomConfiguration(rest, 0.006, 20 + seed)), 1e-6)
+          << "c " << c << " seed " << seed;
+      EXPECT_LT(RelativeHessianError(m, RandomConfiguration(rest, 0.006, 30 + seed)), 1e-6)
+          << "c " << c << " seed " << seed;
     }
   }
 }
@@ -347,6 +372,53 @@ TEST(Membrane, ProjectionIsTheEigenSolvesClampedMatrix) {
     }
   }
   EXPECT_GT(indefinite, cases / 4);  // the clamping was exercised, not just the identity
+}
+
+// Under uniform strain the soft membrane stores StVK's energy where both principal strains
+// and the area grow, c times it where all of them shrink, and in between where the sheet is
+// stretched one way and compressed the other; its projected Hessian is positive semi-definite
+// and equals the raw one where that already is.
+TEST(Membrane, SoftCompressionIsStvkInTensionAndCTimesItInCompression) {
+  const TriangleMesh rest = IrregularPatch(8);
+  const double c = 0.01;
+  const MembraneElements stvk(rest, kStiffness, kPoisson, MembraneModel::kStVK);
+  const MembraneElements soft(rest, kStiffness, kPoisson, MembraneModel::kStVK, c);
+  const auto strained = [&](double a, double b) {
+    return Affine(rest, (Eigen::Matrix<double, 3, 2>() << a, 0.0, 0.0, b, 0.0, 0.0).finished());
+  };
+  const Vertices stretched = strained(1.05, 1.02), compressed = strained(0.95, 0.97),
+                 mixed = strained(1.01, 0.95);
+  EXPECT_NEAR(soft.Energy(stretched), stvk.Energy(stretched), 1e-12 * stvk.Energy(stretched));
+  EXPECT_NEAR(soft.Energy(compressed), c * stvk.Energy(compressed),
+              1e-12 * stvk.Energy(compressed));
+  EXPECT_GT(soft.Energy(mixed), c * stvk.Energy(mixed));
+  EXPECT_LT(soft.Energy(mixed), 0.5 * stvk.Energy(mixed));
+  for (const Vertices* x : {&stretched, &compressed, &mixed}) {
+    const Eigen::MatrixXd raw = DenseHessian(soft, *x, false);
+    const Eigen::MatrixXd projected = DenseHessian(soft, *x, true);
+    const double scale = raw.cwiseAbs().maxCoeff();
+    EXPECT_GT(MinEigenvalue(projected), -1e-10 * scale);
+    if (MinEigenvalue(raw) > -1e-10 * scale) {
+      EXPECT_LT((projected - raw).cwiseAbs().maxCoeff(), 1e-9 * scale);
+    }
+  }
+  // Compressed, the raw Hessian is indefinite (the geometric stiffness of a compressive
+  // stress, as in StVK, c times smaller); the projection above took that out.
+  const Eigen::MatrixXd compressed_raw = DenseHessian(soft, compressed, false);
+  EXPECT_LT(MinEigenvalue(compressed_raw), -1e-6 * compressed_raw.cwiseAbs().maxCoeff());
+}
+
+TEST(Membrane, CompressionRatioOutsideItsRangeIsRefused) {
+  const TriangleMesh rest = RegularGridMesh(0.1, 0.1, 2, 2);
+  for (const double c : {0.0, 5e-4, 1.5, std::nan("")}) {
+    try {
+      MembraneElements(rest, 1000.0, 0.3, MembraneModel::kStVK, c);
+      ADD_FAILURE() << "compression " << c << " was taken";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).substr(0, 50),
+                "membrane: compression ratio must lie in [0.001, 1]");
+    }
+  }
 }
 
 TEST(Membrane, StabilisationLeavesStretchedStvkElementsAlone) {

@@ -434,6 +434,26 @@ TEST(CliDrape, ASkirtSunkIntoTheSupportGetsANoteAndAStifferContactSinksItLess) {
   EXPECT_FALSE(c["seeds"][0].contains("max_penetration_mm"));
 }
 
+// --compression-ratio overrides the material's stretch.compression_ratio: the report names
+// it, the result's material carries it, and the skirt hangs lower than with the sample's
+// default 1 (docs/drapemeter.md, "Compression ratio").
+TEST(CliDrape, CompressionRatioSoftensTheMembraneAndIsReported) {
+  const auto dir = Scratch("CliDrape.Compression");
+  const auto soft = Textile("drape " + kFig8 + kCoarse + " --compression-ratio 0.01 -o " +
+                            (dir / "s.json").string());
+  ASSERT_EQ(soft.exit_code, 0) << soft.err;
+  EXPECT_NE(soft.out.find("; membrane soft in compression (ratio 0.01)"), std::string::npos)
+      << soft.out;
+  const auto s = nlohmann::json::parse(ReadAll(dir / "s.json"));
+  EXPECT_EQ(s["material"]["stretch"]["compression_ratio"].get<double>(), 0.01);
+  const auto plain = Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "p.json").string());
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_EQ(plain.out.find("soft in compression"), std::string::npos) << plain.out;
+  const auto p = nlohmann::json::parse(ReadAll(dir / "p.json"));
+  EXPECT_FALSE(p["material"]["stretch"].contains("compression_ratio"));
+  EXPECT_LT(s["drape_coefficient"].get<double>(), p["drape_coefficient"].get<double>() - 0.08);
+}
+
 TEST(CliDrape, RestingMountSettlesAndACutShortRunFailsCleanly) {
   const auto dir = Scratch("CliDrape.Resting");
   const auto r = Textile("drape " + kFig8 + kCoarse + " --mount resting --progress -o " +

@@ -19,6 +19,11 @@
 
 namespace textile {
 
+// The softest compression a membrane takes (Material::compression_ratio,
+// MembraneLame::compression): below it Newton's steps meet a nearly singular Hessian wherever
+// a drape compresses the sheet.
+constexpr double kMinCompressionRatio = 1e-3;
+
 struct Material {
   std::string name;                          // free text
   double areal_density = 0.0;                // ρ [kg/m²]
@@ -27,6 +32,10 @@ struct Material {
   double beta = 1.0;                         // linear bending stiffness factor β (section 3.4)
   double stretch_stiffness = 1000.0;         // membrane stiffness [N/m] (physics.md default)
   double poisson = 0.3;                      // Poisson ratio [-]
+  // The membrane's stiffness against compression as a fraction of its stretch stiffness [-]
+  // (stretch.compression_ratio, kMinCompressionRatio .. 1): 1, the default, is the stabilised
+  // StVK of physics.md, as stiff in compression as in tension (membrane.h).
+  double compression_ratio = 1.0;
   double friction = 0.3;                     // Coulomb coefficient against supports [-]
   nlohmann::json fit;                        // the `fit` report when a fit made this file
   nlohmann::json extra;                      // "notes"/"assumptions"/"source", carried through

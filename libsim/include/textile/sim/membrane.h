@@ -19,6 +19,14 @@
 //   μ = k / (2 (1 + ν)),  λ = k ν / (1 - ν²),
 // with e = ε (corotational) or e = E (StVK).
 //
+// Soft in compression (StVK with compression c < 1, the material's stretch.compression_ratio):
+// over the principal Green strains E1, E2, ψ = μ (q(E1) + q(E2)) + λ/2 q(E1 + E2) with q(t) = t²
+// for t ≥ 0 and c t² for t < 0, which is StVK's ψ when c = 1. Woven fabric buckles at a small
+// fraction of the load it takes in tension (what cloth tools call a buckling ratio); c is that
+// fraction. The energy is C¹ (its stiffness jumps where a principal strain changes sign); the
+// Hessian comes from the isotropic eigensystem in closed form (membrane.cc), exact or with its
+// negative eigenvalues clamped (project_psd). docs/drapemeter.md, "Compression ratio".
+//
 //   textile::MembraneElements membrane(rest_mesh, material, textile::MembraneModel::kStVK);
 //   double energy = membrane.Energy(x);                      // x: #V×3 positions [m]
 //   textile::Vertices grad = textile::Vertices::Zero(x.rows(), 3);
@@ -44,8 +52,13 @@ enum class MembraneModel {
 struct MembraneLame {
   double mu = 0.0;      // shear: k / (2 (1 + ν))
   double lambda = 0.0;  // k ν / (1 - ν²)
-  // Throws InputError unless k > 0 is finite and -1 < ν < 1 (a positive-definite sheet).
-  static MembraneLame FromStretch(double stretch_stiffness, double poisson);
+  // StVK only: the factor c on the energy of a compressed principal Green strain and of a
+  // compressed area (tr E < 0), c = 1: plain StVK. See MembraneModel.
+  double compression = 1.0;
+  // Throws InputError unless k > 0 is finite, -1 < ν < 1 (a positive-definite sheet) and
+  // kMinCompressionRatio ≤ compression ≤ 1.
+  static MembraneLame FromStretch(double stretch_stiffness, double poisson,
+                                  double compression = 1.0);
 };
 
 // One triangle, the building block of MembraneElements.
@@ -73,8 +86,8 @@ class MembraneElements {
   // Throws InputError for a bad stiffness or Poisson ratio, a triangle referring to a missing
   // vertex, or a degenerate rest triangle (naming it).
   MembraneElements(const TriangleMesh& rest, double stretch_stiffness, double poisson,
-                   MembraneModel model);
-  // Uses material.stretch_stiffness and material.poisson.
+                   MembraneModel model, double compression = 1.0);
+  // Uses material.stretch_stiffness, material.poisson and material.compression_ratio.
   MembraneElements(const TriangleMesh& rest, const Material& material, MembraneModel model);
 
   // @param x  #V×3 current positions [m]. Total membrane energy [J].

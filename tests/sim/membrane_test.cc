@@ -66,24 +66,29 @@ Eigen::MatrixXd DenseHessian(const MembraneElements& m, const Vertices& x, bool 
   return Eigen::MatrixXd(h);
 }
 
+// Central difference of f (the energy, or the gradient as a 3V vector) along coordinate c of
+// vertex v. Step 1e-7 m: truncation ~ (1e-7)² · ψ''' and round-off ~ 1e-16 · E / 1e-7 both far
+// below 1e-6 of the largest force (~10 N).
+template <typename F>
+auto CentralDifference(Vertices& x, int v, int c, F f) {
+  const double step = 1e-7, keep = x(v, c);
+  x(v, c) = keep + step;
+  const auto plus = f(x);
+  x(v, c) = keep - step;
+  const auto minus = f(x);
+  x(v, c) = keep;
+  return decltype(plus)((plus - minus) / (2 * step));
+}
+
 // The largest gap between the gradient and central differences of the energy, over the
-// gradient's largest entry. Step 1e-7 m: truncation ~ (1e-7)² · ψ''' and round-off
-// ~ 1e-16 · E / 1e-7 both far below 1e-6 of the largest force (~10 N).
+// gradient's largest entry.
 double RelativeGradientError(const MembraneElements& m, Vertices x) {
   const Vertices g = Gradient(m, x);
-  const double step = 1e-7;
+  const auto energy = [&](const Vertices& y) { return m.Energy(y); };
   double max_err = 0;
-  for (int v = 0; v < x.rows(); ++v) {
-    for (int c = 0; c < 3; ++c) {
-      const double keep = x(v, c);
-      x(v, c) = keep + step;
-      const double ep = m.Energy(x);
-      x(v, c) = keep - step;
-      const double em = m.Energy(x);
-      x(v, c) = keep;
-      max_err = std::max(max_err, std::abs((ep - em) / (2 * step) - g(v, c)));
-    }
-  }
+  for (int v = 0; v < x.rows(); ++v)
+    for (int c = 0; c < 3; ++c)
+      max_err = std::max(max_err, std::abs(CentralDifference(x, v, c, energy) - g(v, c)));
   return max_err / g.cwiseAbs().maxCoeff();
 }
 
@@ -92,22 +97,15 @@ double RelativeGradientError(const MembraneElements& m, Vertices x) {
 double RelativeHessianError(const MembraneElements& m, Vertices x) {
   const Eigen::MatrixXd h = DenseHessian(m, x, /*project_psd=*/false);
   EXPECT_LT((h - h.transpose()).cwiseAbs().maxCoeff(), 1e-10 * h.cwiseAbs().maxCoeff());
-  const double step = 1e-7;
+  const auto gradient = [&](const Vertices& y) {
+    const Vertices g = Gradient(m, y);
+    return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(g.data(), g.size()));
+  };
   double max_err = 0;
-  for (int v = 0; v < x.rows(); ++v) {
-    for (int c = 0; c < 3; ++c) {
-      const double keep = x(v, c);
-      x(v, c) = keep + step;
-      const Vertices gp = Gradient(m, x);
-      x(v, c) = keep - step;
-      const Vertices gm = Gradient(m, x);
-      x(v, c) = keep;
-      const Eigen::VectorXd column = (Eigen::Map<const Eigen::VectorXd>(gp.data(), gp.size()) -
-                                      Eigen::Map<const Eigen::VectorXd>(gm.data(), gm.size())) /
-                                     (2 * step);
-      max_err = std::max(max_err, (column - h.col(3 * v + c)).cwiseAbs().maxCoeff());
-    }
-  }
+  for (int v = 0; v < x.rows(); ++v)
+    for (int c = 0; c < 3; ++c)
+      max_err = std::max(
+          max_err, (CentralDifference(x, v, c, gradient) - h.col(3 * v + c)).cwiseAbs().maxCoeff());
   return max_err / h.cwiseAbs().maxCoeff();
 }
 

@@ -344,6 +344,9 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
     if (o.seams == DrapeSeams::kShifted) j["scene"]["shift_mm"] = units::MToMm(o.seam_shift);
   }
   j["material"] = MaterialToJson(m);
+  // Where the membrane's compression ratio came from: the file, or --compression-ratio over it.
+  j["scene"]["compression_ratio"] = m.compression_ratio;
+  j["scene"]["compression_ratio_from"] = a.compression_ratio ? "--compression-ratio" : "material";
   j["material"]["file"] = a.material;
   j["seconds"] = r.seconds;
   return j;
@@ -353,9 +356,8 @@ void Run(const DrapeArgs& a) {
   DrapeOptions o = Options(a);
   if (a.compression_ratio &&
       !(*a.compression_ratio >= kMinCompressionRatio && *a.compression_ratio <= 1.0))
-    throw InputError(
-        "--compression-ratio: must be between 0.001 and 1 (1: as stiff in compression as in "
-        "tension)");
+    throw InputError("--compression-ratio: must be between " + Num(kMinCompressionRatio) +
+                     " and 1 (1: as stiff in compression as in tension)");
   Material m = ReadMaterial(a.material);
   if (a.compression_ratio) m.compression_ratio = *a.compression_ratio;
   // The fabric's turn-down length ℓ at the rim. DC converges from below as the rim's element e

@@ -319,7 +319,10 @@ Mat6 IsotropicHessian(const Mat32& f, Eigenvalues eigenvalues, bool project) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> cauchy_green;
   cauchy_green.computeDirect(f.transpose() * f);  // eigenvalues σi² in increasing order
   const double large = std::sqrt(std::max(cauchy_green.eigenvalues()(1), 0.0));
-  if (!(large > 0)) return Mat6::Zero();  // F = 0: no direction to build on
+  if (!(large > 0)) {  // F = 0: ∂P/∂F = S I, S the (equal) principal stress of a collapsed sheet
+    const double s = eigenvalues(0.0, 0.0).out[0];
+    return (project ? std::max(s, 0.0) : s) * Mat6::Identity();
+  }
   const double small = f.col(0).cross(f.col(1)).norm() / large;
   const double sigma[2] = {large, small};
   const Eigen::Vector2d v[2] = {cauchy_green.eigenvectors().col(1),

@@ -446,11 +446,15 @@ TEST(CliDrape, CompressionRatioSoftensTheMembraneAndIsReported) {
       << soft.out;
   const auto s = nlohmann::json::parse(ReadAll(dir / "s.json"));
   EXPECT_EQ(s["material"]["stretch"]["compression_ratio"].get<double>(), 0.01);
+  EXPECT_EQ(s["scene"]["compression_ratio"].get<double>(), 0.01);
+  EXPECT_EQ(s["scene"]["compression_ratio_from"], "--compression-ratio");
   const auto plain = Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "p.json").string());
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
   EXPECT_EQ(plain.out.find("soft in compression"), std::string::npos) << plain.out;
   const auto p = nlohmann::json::parse(ReadAll(dir / "p.json"));
   EXPECT_FALSE(p["material"]["stretch"].contains("compression_ratio"));
+  EXPECT_EQ(p["scene"]["compression_ratio"].get<double>(), 1.0);
+  EXPECT_EQ(p["scene"]["compression_ratio_from"], "material");
   EXPECT_LT(s["drape_coefficient"].get<double>(), p["drape_coefficient"].get<double>() - 0.08);
 }
 

@@ -354,6 +354,15 @@ Mat6 IsotropicHessian(const Mat32& f, Eigenvalues eigenvalues, bool project) {
   return h;
 }
 
+// Whether the soft membrane differs from StVK at F: some principal Green strain (and so
+// possibly the trace) is negative, which a positive semi-definite E rules out. Stretched
+// triangles take StVK's closed forms, without the eigen-solves.
+bool SoftApplies(const MembraneLame& l, const Mat32& f) {
+  if (!(l.compression < 1.0)) return false;
+  const Eigen::Matrix2d e = 0.5 * (f.transpose() * f - Eigen::Matrix2d::Identity());
+  return e.trace() < 0 || e.determinant() < 0;
+}
+
 // StVK's Hessian is positive semi-definite when the Green strain is (no direction compressed)
 // and λ ≥ 0: then its projection is itself and the eigen-solve can be skipped.
 bool StvkNeedsProjection(const MembraneLame& l, const Mat32& f) {
@@ -389,7 +398,7 @@ double MembraneEnergy(MembraneModel model, const MembraneLame& lame,
                       const Eigen::Matrix3d& x) {
   const Mat32 f = DeformationGradient(rest_inverse, x);
   const double psi = model != MembraneModel::kStVK ? CorotationalDensity(lame, f)
-                     : lame.compression < 1.0      ? SoftDensity(lame, f)
+                     : SoftApplies(lame, f)        ? SoftDensity(lame, f)
                                                    : StvkDensity(lame, f);
   return rest_area * psi;
 }
@@ -399,7 +408,7 @@ Eigen::Matrix<double, 9, 1> MembraneGradient(MembraneModel model, const Membrane
                                              const Eigen::Matrix3d& x) {
   const Mat32 f = DeformationGradient(rest_inverse, x);
   const Vec6 p = model != MembraneModel::kStVK ? CorotationalStress(lame, f)
-                 : lame.compression < 1.0      ? SoftStress(lame, f)
+                 : SoftApplies(lame, f)        ? SoftStress(lame, f)
                                                : StvkStress(lame, f);
   return rest_area * GradientMap(rest_inverse).transpose() * p;
 }
@@ -409,7 +418,7 @@ Eigen::Matrix<double, 9, 9> MembraneHessian(MembraneModel model, const MembraneL
                                             const Eigen::Matrix3d& x, bool project_psd) {
   const Mat32 f = DeformationGradient(rest_inverse, x);
   Mat6 h;
-  if (model == MembraneModel::kStVK && lame.compression < 1.0) {
+  if (model == MembraneModel::kStVK && SoftApplies(lame, f)) {
     h = IsotropicHessian(
         f, [&](double s1, double s2) { return SoftEigenvalues(lame, s1, s2); }, project_psd);
   } else if (model == MembraneModel::kStVK) {

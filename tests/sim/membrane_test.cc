@@ -406,6 +406,38 @@ TEST(Membrane, SoftCompressionIsStvkInTensionAndCTimesItInCompression) {
   EXPECT_LT(MinEigenvalue(compressed_raw), -1e-6 * compressed_raw.cwiseAbs().maxCoeff());
 }
 
+// Just below c = 1 the soft membrane's eigensystem must give StVK's own Hessian, raw and
+// projected, on compressed and mixed triangles (where it does not hand over to StVK's closed
+// forms): a check of every eigenvalue that does not rest on finite differences.
+TEST(Membrane, SoftCompressionJustBelowOneIsStvk) {
+  std::mt19937 rng(14);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const MembraneLame stvk = MembraneLame::FromStretch(kStiffness, kPoisson);
+  const MembraneLame soft = MembraneLame::FromStretch(kStiffness, kPoisson, 1.0 - 1e-12);
+  Eigen::Matrix2d dm;
+  dm << 0.01, 0.004, 0.0, 0.009;
+  const Eigen::Matrix2d b = dm.inverse();
+  for (int trial = 0; trial < 50; ++trial) {
+    const Eigen::Vector2d sigma(0.85 + 0.3 * unit(rng), 0.75 + 0.2 * unit(rng));  // σ2 < 1
+    const Eigen::Matrix3d r = RandomRotation(rng);
+    const Eigen::Matrix2d v = Eigen::Rotation2Dd(3.0 * unit(rng)).toRotationMatrix();
+    const Eigen::Matrix<double, 3, 2> f = r.leftCols<2>() * sigma.asDiagonal() * v.transpose();
+    Eigen::Matrix3d x;
+    x.row(0).setZero();
+    x.row(1) = (f * dm.col(0)).transpose();
+    x.row(2) = (f * dm.col(1)).transpose();
+    for (const bool project : {false, true}) {
+      const Eigen::Matrix<double, 9, 9> expected =
+          MembraneHessian(MembraneModel::kStVK, stvk, b, 4.5e-5, x, project);
+      const Eigen::Matrix<double, 9, 9> got =
+          MembraneHessian(MembraneModel::kStVK, soft, b, 4.5e-5, x, project);
+      EXPECT_LT((got - expected).cwiseAbs().maxCoeff(), 1e-9 * expected.cwiseAbs().maxCoeff())
+          << "trial " << trial << ", σ " << sigma.transpose()
+          << (project ? ", projected" : ", raw");
+    }
+  }
+}
+
 TEST(Membrane, CompressionRatioOutsideItsRangeIsRefused) {
   const TriangleMesh rest = RegularGridMesh(0.1, 0.1, 2, 2);
   for (const double c : {0.0, 5e-4, 1.5, std::nan("")}) {

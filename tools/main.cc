@@ -56,7 +56,10 @@ int main(int argc, char** argv) {
       names += (names.empty() ? "" : ", ") + command->get_name();
     const std::string quoted =
         cli::IsValidUtf8(first) ? "'" + OneLine(first.c_str()) + "'" : "(not valid UTF-8 text)";
-    const std::string what = argc == 1                  ? "no command given"
+    // "--" ends the options, and what follows it is no command to CLI11 either.
+    const std::string what = argc == 1 ? "no command given"
+                             : first == "--"
+                                 ? "'--' before the command (it comes first: textile COMMAND ...)"
                              : first.rfind('-', 0) == 0 ? "unknown option " + quoted
                                                         : "unknown command " + quoted;
     std::fprintf(stderr, "error: %s (the commands: %s)\n", what.c_str(), names.c_str());

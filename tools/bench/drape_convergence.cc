@@ -127,9 +127,13 @@ Benchmark DrapeConvergenceBenchmark() {
                {"seam_refine_mm", seam_refine * 1e3},
                {"compression_ratio", compression}});
           if (ctx.progress)
-            std::fprintf(stderr, "drape-convergence: %s h=%.1f mm rim=%.1f mm tol=%.0e %s%s: %.2f s, DC %.4f, %g nodes\n",
-                         DrapeSeamsName(seams).c_str(), h * 1e3, rim * 1e3, tol, cascadic ? "cascadic" : "direct",
-                         extrapolate ? ", extrapolated" : "", r.seconds, r.dc, r.nodes);
+            std::fprintf(stderr,
+                         "drape-convergence: %s h=%.1f mm rim=%.1f mm tol=%.0e %s%s%s: %.2f s, DC "
+                         "%.4f, %g nodes\n",
+                         DrapeSeamsName(seams).c_str(), h * 1e3, rim * 1e3, tol,
+                         cascadic ? "cascadic" : "direct", extrapolate ? ", extrapolated" : "",
+                         compression < 1.0 ? ", soft in compression" : "", r.seconds, r.dc,
+                         r.nodes);
         };
         for (DrapeSeams seams : {DrapeSeams::kNone, DrapeSeams::kWeft}) {
           for (double h_mm : resolutions_mm) add(seams, h_mm * 1e-3, 0.0, default_tol, false);

@@ -224,40 +224,68 @@ struct IsotropicEigenvalues {
   double out[2] = {0, 0};
 };
 
-// h (= ∂²ψ/∂F²) with its negative eigenvalues clamped to zero, from the eigensystem above instead
-// of a 6×6 eigen-solve (8 % of a drape's samples): each negative eigenpair is taken out of h.
+// F = Σ σi ui viᵀ (σ1 ≥ σ2, vi in the rest frame, u3 = u1 × u2) for the eigensystem above.
 // σ2 is J/σ1 (J = |f1 × f2| = σ1 σ2), not the root of FᵀF's smaller eigenvalue, which loses
 // eps (σ1/σ2)² of it to cancellation: at σ2 = 1e-5 σ1 the corotational ψ2/σ2 came out so far off
-// that the "projected" matrix had an eigenvalue of −0.18 × 2μ. Triangles collapsed to under
-// 1e-6 σ1 take the eigen-solve.
-template <typename Eigenvalues>
-Mat6 ProjectIsotropicPsd(const Mat32& f, const Mat6& h, Eigenvalues eigenvalues) {
+// that the "projected" matrix had an eigenvalue of −0.18 × 2μ. A triangle collapsed to under
+// 1e-6 σ1 (`collapsed`) gets any unit u2 normal to u1; F = 0 has no frame (false).
+struct IsotropicFrame {
+  double sigma[2];
+  Eigen::Vector2d v[2];
+  Eigen::Vector3d u[2], u3;
+  bool collapsed = false;
+};
+
+bool SingularFrame(const Mat32& f, IsotropicFrame* frame) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> cauchy_green;
   cauchy_green.computeDirect(f.transpose() * f);  // eigenvalues σi² in increasing order
   const double large = std::sqrt(std::max(cauchy_green.eigenvalues()(1), 0.0));
-  const double small = f.col(0).cross(f.col(1)).norm() / large;  // NaN when F = 0: eigen-solve
-  if (!(small > 1e-6 * large)) return ProjectPsd(h);
-  const double sigma[2] = {large, small};
-  const Eigen::Vector2d v[2] = {cauchy_green.eigenvectors().col(1), cauchy_green.eigenvectors().col(0)};
-  const Eigen::Vector3d u[2] = {f * v[0] / sigma[0], f * v[1] / sigma[1]};
-  const Eigen::Vector3d u3 = u[0].cross(u[1]).normalized();
-  const IsotropicEigenvalues e = eigenvalues(sigma[0], sigma[1]);
-  auto outer = [](const Eigen::Vector3d& a, const Eigen::Vector2d& b) { return Vec(a * b.transpose()); };
-  Mat6 projected = 0.5 * (h + h.transpose());
-  auto remove = [&](double eigenvalue, const Vec6& q) {  // q of unit length
-    if (eigenvalue < 0) projected -= eigenvalue * q * q.transpose();
+  if (!(large > 0)) return false;
+  const double small = f.col(0).cross(f.col(1)).norm() / large;
+  frame->sigma[0] = large;
+  frame->sigma[1] = small;
+  frame->v[0] = cauchy_green.eigenvectors().col(1);
+  frame->v[1] = cauchy_green.eigenvectors().col(0);
+  frame->collapsed = !(small > 1e-6 * large);
+  frame->u[0] = f * frame->v[0] / large;
+  frame->u[1] = frame->collapsed ? Eigen::Vector3d(frame->u[0].unitOrthogonal())
+                                 : Eigen::Vector3d(f * frame->v[1] / small);
+  frame->u3 = frame->u[0].cross(frame->u[1]).normalized();
+  return true;
+}
+
+// Calls visit(eigenvalue, q) for the six eigenpairs of ∂²ψ/∂F² (q of unit length, as vec(F)).
+template <typename Visit>
+void ForEachIsotropicEigenpair(const IsotropicFrame& fr, const IsotropicEigenvalues& e,
+                               Visit visit) {
+  auto outer = [](const Eigen::Vector3d& a, const Eigen::Vector2d& b) {
+    return Vec(a * b.transpose());
   };
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> stretch;
   stretch.computeDirect(e.stretch);
-  const Vec6 d1 = outer(u[0], v[0]), d2 = outer(u[1], v[1]);
+  const Vec6 d1 = outer(fr.u[0], fr.v[0]), d2 = outer(fr.u[1], fr.v[1]);
   for (int k = 0; k < 2; ++k) {
     const Eigen::Vector2d ab = stretch.eigenvectors().col(k);
-    remove(stretch.eigenvalues()(k), ab(0) * d1 + ab(1) * d2);
+    visit(stretch.eigenvalues()(k), ab(0) * d1 + ab(1) * d2);
   }
-  const Vec6 uv = outer(u[0], v[1]), vu = outer(u[1], v[0]);
-  remove(e.shear, (uv + vu) / std::sqrt(2.0));
-  remove(e.twist, (uv - vu) / std::sqrt(2.0));
-  for (int i = 0; i < 2; ++i) remove(e.out[i], outer(u3, v[i]));
+  const Vec6 uv = outer(fr.u[0], fr.v[1]), vu = outer(fr.u[1], fr.v[0]);
+  visit(e.shear, (uv + vu) / std::sqrt(2.0));
+  visit(e.twist, (uv - vu) / std::sqrt(2.0));
+  for (int i = 0; i < 2; ++i) visit(e.out[i], outer(fr.u3, fr.v[i]));
+}
+
+// h (= ∂²ψ/∂F²) with its negative eigenvalues clamped to zero, from the eigensystem above instead
+// of a 6×6 eigen-solve (8 % of a drape's samples): each negative eigenpair is taken out of h.
+// F = 0 and collapsed triangles take the eigen-solve.
+template <typename Eigenvalues>
+Mat6 ProjectIsotropicPsd(const Mat32& f, const Mat6& h, Eigenvalues eigenvalues) {
+  IsotropicFrame frame;
+  if (!SingularFrame(f, &frame) || frame.collapsed) return ProjectPsd(h);
+  Mat6 projected = 0.5 * (h + h.transpose());
+  ForEachIsotropicEigenpair(frame, eigenvalues(frame.sigma[0], frame.sigma[1]),
+                            [&](double eigenvalue, const Vec6& q) {
+                              if (eigenvalue < 0) projected -= eigenvalue * q * q.transpose();
+                            });
   return projected;
 }
 
@@ -312,45 +340,19 @@ IsotropicEigenvalues SoftEigenvalues(const MembraneLame& l, double s1, double s2
 }
 
 // ∂²ψ/∂F² of an isotropic ψ(σ1, σ2) assembled from its eigensystem (above), its negative
-// eigenvalues dropped when project. A triangle collapsed to a line (σ2 ≤ 1e-6 σ1) takes any
-// unit u2 normal to u1.
+// eigenvalues dropped when project.
 template <typename Eigenvalues>
 Mat6 IsotropicHessian(const Mat32& f, Eigenvalues eigenvalues, bool project) {
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> cauchy_green;
-  cauchy_green.computeDirect(f.transpose() * f);  // eigenvalues σi² in increasing order
-  const double large = std::sqrt(std::max(cauchy_green.eigenvalues()(1), 0.0));
-  if (!(large > 0)) {  // F = 0: ∂P/∂F = S I, S the (equal) principal stress of a collapsed sheet
+  IsotropicFrame frame;
+  if (!SingularFrame(f, &frame)) {  // F = 0: ∂P/∂F = S I, S the (equal) principal stress
     const double s = eigenvalues(0.0, 0.0).out[0];
     return (project ? std::max(s, 0.0) : s) * Mat6::Identity();
   }
-  const double small = f.col(0).cross(f.col(1)).norm() / large;
-  const double sigma[2] = {large, small};
-  const Eigen::Vector2d v[2] = {cauchy_green.eigenvectors().col(1),
-                                cauchy_green.eigenvectors().col(0)};
-  const Eigen::Vector3d u1 = f * v[0] / large;
-  const Eigen::Vector3d u2 = small > 1e-6 * large ? Eigen::Vector3d(f * v[1] / small)
-                                                  : Eigen::Vector3d(u1.unitOrthogonal());
-  const Eigen::Vector3d u3 = u1.cross(u2).normalized();
-  const IsotropicEigenvalues e = eigenvalues(sigma[0], sigma[1]);
-  auto outer = [](const Eigen::Vector3d& a, const Eigen::Vector2d& b) {
-    return Vec(a * b.transpose());
-  };
   Mat6 h = Mat6::Zero();
-  auto add = [&](double eigenvalue, const Vec6& q) {  // q of unit length
-    if (!project || eigenvalue > 0) h += eigenvalue * q * q.transpose();
-  };
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> stretch;
-  stretch.computeDirect(e.stretch);
-  const Vec6 d1 = outer(u1, v[0]), d2 = outer(u2, v[1]);
-  for (int k = 0; k < 2; ++k) {
-    const Eigen::Vector2d ab = stretch.eigenvectors().col(k);
-    add(stretch.eigenvalues()(k), ab(0) * d1 + ab(1) * d2);
-  }
-  const Vec6 uv = outer(u1, v[1]), vu = outer(u2, v[0]);
-  add(e.shear, (uv + vu) / std::sqrt(2.0));
-  add(e.twist, (uv - vu) / std::sqrt(2.0));
-  add(e.out[0], outer(u3, v[0]));
-  add(e.out[1], outer(u3, v[1]));
+  ForEachIsotropicEigenpair(frame, eigenvalues(frame.sigma[0], frame.sigma[1]),
+                            [&](double eigenvalue, const Vec6& q) {
+                              if (!project || eigenvalue > 0) h += eigenvalue * q * q.transpose();
+                            });
   return h;
 }
 

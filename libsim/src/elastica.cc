@@ -474,9 +474,15 @@ class Shooter {
 };
 
 // Shooting unknown of a tip angle guess.
+// The same from g = log(π/2 − θ), exact where π/2 − θ underflows in θ itself.
+double UnknownOfLogTipGap(double g) {
+  if (g >= std::log(kSwitchGap)) return kHalfPi - std::exp(g);
+  return kSwitchAngle + kSwitchGap * (std::log(kSwitchGap) - g);
+}
+
 double UnknownOfTipAngle(double theta) {
   if (theta <= kSwitchAngle) return theta;
-  return kSwitchAngle + kSwitchGap * (std::log(kSwitchGap) - std::log(kHalfPi - theta));
+  return UnknownOfLogTipGap(std::log(kHalfPi - theta));
 }
 
 // Starting guess from the linear law with B(0), α = ρgL³/B: π/2 - θ_L ≈ (π/2) exp(-g(α)) with
@@ -515,6 +521,9 @@ bool ElasticaOptions::Check(std::string* why) const {
   } else if (!std::isnan(tip_angle_guess) &&
              !(tip_angle_guess >= 0.0 && tip_angle_guess < kHalfPi)) {
     s << "tip_angle_guess must be NaN or in [0, pi/2) rad, got " << tip_angle_guess;
+  } else if (!std::isnan(log_tip_gap_guess) &&
+             !(std::isfinite(log_tip_gap_guess) && log_tip_gap_guess < std::log(kHalfPi))) {
+    s << "log_tip_gap_guess must be NaN or finite and below log(pi/2), got " << log_tip_gap_guess;
   } else if (!std::all_of(variation.breakpoints.begin(), variation.breakpoints.end(),
                           [](double u) { return std::isfinite(u); })) {
     s << "variation.breakpoints must be finite";
@@ -597,8 +606,9 @@ ElasticaProfile SolveHeavyElastica(const BendingLaw& law, double areal_density, 
   // Safeguarded Newton on z with a bracket [lo, hi]: the residual at z = 0 (a flat tip) is
   // negative for any load; hi stays +∞ until a trial overshoots.
   double lo = 0.0, hi = std::numeric_limits<double>::infinity();
-  double z = std::isnan(options.tip_angle_guess) ? InitialUnknown(shooter.strip())
-                                                 : UnknownOfTipAngle(options.tip_angle_guess);
+  double z = !std::isnan(options.log_tip_gap_guess) ? UnknownOfLogTipGap(options.log_tip_gap_guess)
+             : !std::isnan(options.tip_angle_guess)  ? UnknownOfTipAngle(options.tip_angle_guess)
+                                                     : InitialUnknown(shooter.strip());
   if (!(z > 0.0 && std::isfinite(z))) z = InitialUnknown(shooter.strip());
   // Stages. kCoarse: Newton at a loose tolerance (a third of the steps) until its step is below
   // kCloseStep (relative). kFine: one shot at the requested tolerance, only with sensitivities

@@ -435,6 +435,23 @@ TEST(Elastica, WarmStartGivesTheSameStrip) {
   EXPECT_NEAR(warm.tip_y, cold.tip_y, 1e-12);
 }
 
+// A strip so long that θ(L) rounds to π/2 (not a tip_angle_guess the solver takes) warm-starts
+// from its log gap instead; a fit's continuation over a 250 mm strip relies on it.
+TEST(Elastica, WarmStartFromTheLogTipGapOfAStripHangingVertically) {
+  const BendingLaw law = LawOf(kFabrics[0]);
+  const ElasticaProfile cold = Solve(law, 0.2, 0.4);
+  ASSERT_TRUE(cold.converged) << cold.message;
+  ASSERT_EQ(cold.tip_angle, kHalfPi);  // the angle has lost what the log gap keeps
+  ASSERT_LT(cold.log_tip_gap, -40.0);
+  ElasticaOptions options;
+  options.log_tip_gap_guess = cold.log_tip_gap + 0.5;
+  const ElasticaProfile warm = Solve(law, 0.2, 0.4, options);
+  ASSERT_TRUE(warm.converged) << warm.message;
+  EXPECT_NEAR(warm.log_tip_gap, cold.log_tip_gap, 1e-6 * std::abs(cold.log_tip_gap));
+  EXPECT_NEAR(warm.tip_x, cold.tip_x, 1e-9);
+  EXPECT_NEAR(warm.tip_y, cold.tip_y, 1e-9);
+}
+
 TEST(Elastica, NonConvergenceIsReportedNotReturned) {
   // Two integrations cannot converge from a far guess: the result says so and carries no data.
   const BendingLaw law = LawOf(kFabrics[0]);
@@ -495,6 +512,12 @@ TEST(Elastica, OptionsCheckRejectsBadValues) {
   o = {};
   o.tip_angle_guess = kHalfPi;
   rejects(o, "tip_angle_guess");
+  o = {};
+  o.log_tip_gap_guess = std::log(kHalfPi);
+  rejects(o, "log_tip_gap_guess");
+  o = {};
+  o.log_tip_gap_guess = -std::numeric_limits<double>::infinity();
+  rejects(o, "log_tip_gap_guess");
   o = {};
   o.arc_lengths = {0.0, 0.02, 0.01};
   rejects(o, "ascending");

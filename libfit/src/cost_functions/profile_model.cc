@@ -54,8 +54,11 @@ bool ProfileModel::Update(const double* p, const double* length, const double* r
   options.rel_tol = tol_;
   options.num_samples = samples_;
   options.sensitivities = jacobians;
-  if (solution_.converged && std::isfinite(solution_.tip_angle)) {
-    options.tip_angle_guess = solution_.tip_angle;  // continuation: the last point is close
+  // Continuation: the last point is close. Its log gap, not its angle: a strip of 15 bending
+  // lengths or more hangs so nearly vertically that θ(L) rounds to π/2, which is not a guess
+  // the solver takes (every later step of a 250 mm fit then failed).
+  if (solution_.converged && std::isfinite(solution_.log_tip_gap)) {
+    options.log_tip_gap_guess = solution_.log_tip_gap;
   }
   try {
     const BendingLaw law = LawFromParameters(p);

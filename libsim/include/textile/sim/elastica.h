@@ -82,6 +82,11 @@ struct ElasticaOptions {
   // θ(L) [rad] to start the shooting from, in [0, π/2), e.g. from the previous solve of a
   // continuation in L; NaN lets the solver estimate it (small-load or hanging-chain limit).
   double tip_angle_guess = std::numeric_limits<double>::quiet_NaN();
+  // The same guess as log(π/2 − θ(L)) (ElasticaProfile::log_tip_gap), finite; it takes
+  // precedence over tip_angle_guess. A strip hanging nearly vertically has θ(L) == π/2 in
+  // double precision, which tip_angle_guess cannot take but its log gap can (a fit's
+  // continuation over long strips; NaN: not given).
+  double log_tip_gap_guess = std::numeric_limits<double>::quiet_NaN();
   // Stiffness and weight varying along the strip (default: a uniform strip). The law's kink
   // is then not located as an event (m/S may cross M(κ0) several times); the error control
   // takes the corner of κ(m) in its stride.

@@ -161,9 +161,11 @@ void Plot(const AcpmResult& r, const AcpmOptions& o, const Material& m, AtomicFi
 
 void Run(const AcpmArgs& a) {
   const AcpmOptions o = Options(a);
+  // Check the outputs' names and folders before reading or computing (an output must not be an
+  // input); they appear together at the end.
+  CheckDistinctOutputs({{"-o", a.out}, {"--png", a.png}, {"--obj", a.obj}},
+                       {{"--material", a.material}, {"--seam", a.seam}});
   const Material m = ReadMaterial(a.material);
-  // Check the outputs' names and folders before computing; they appear together at the end.
-  CheckDistinctOutputs({{"-o", a.out}, {"--png", a.png}, {"--obj", a.obj}});
   if (!a.png.empty()) chart::CheckPngPath(a.png);
   AtomicFileSet outputs;
   AtomicFile& result_file = outputs.Add(a.out);

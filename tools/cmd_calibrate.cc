@@ -69,7 +69,9 @@ void Run(const CalibrateArgs& a) {
     throw InputError(flag + ": " + why);
   }
   // Outputs checked before the work; they appear together.
-  CheckDistinctOutputs({{"-o", a.out}, {"--overlay", a.overlay}});
+  std::vector<std::pair<std::string, std::string>> inputs;
+  for (const std::string& board : a.boards) inputs.emplace_back("(a board photo)", board);
+  CheckDistinctOutputs({{"-o", a.out}, {"--overlay", a.overlay}}, inputs);
   AtomicFileSet outputs;
   AtomicFile& rig_file = outputs.Add(a.out);
   AtomicFile* overlay_file = a.overlay.empty() ? nullptr : &outputs.Add(a.overlay);

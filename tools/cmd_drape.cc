@@ -358,6 +358,15 @@ void Run(const DrapeArgs& a) {
       !(*a.compression_ratio >= kMinCompressionRatio && *a.compression_ratio <= 1.0))
     throw InputError("--compression-ratio: must be between " + Num(kMinCompressionRatio) +
                      " and 1 (1: as stiff in compression as in tension)");
+  // Check the outputs before reading or computing (an output must not be an input): distinct files
+  // in usable folders. They appear together at the end, or none of them.
+  const std::string outline_path = OutlinePath(a.out);
+  CheckDistinctOutputs({{"-o", a.out},
+                        {"the outline (next to -o)", outline_path},
+                        {"--png", a.png},
+                        {"--obj", a.obj},
+                        {"--ply", a.ply}},
+                       {{"--material", a.material}, {"--seam-file", a.seam_file}});
   Material m = ReadMaterial(a.material);
   if (a.compression_ratio) m.compression_ratio = *a.compression_ratio;
   // The fabric's turn-down length ℓ at the rim. DC converges from below as the rim's element e
@@ -392,11 +401,6 @@ void Run(const DrapeArgs& a) {
            (o.rim_element_size > 0.0 ? std::string("a smaller --rim-mm") : std::string("--rim-mm auto")) +
            " meshes it finer (slower; docs/drapemeter.md)";
   }
-  // Check the outputs before computing: distinct files in usable folders. They appear together
-  // at the end, or none of them.
-  const std::string outline_path = OutlinePath(a.out);
-  CheckDistinctOutputs({{"-o", a.out}, {"the outline (next to -o)", outline_path}, {"--png", a.png},
-                        {"--obj", a.obj}, {"--ply", a.ply}});
   AtomicFileSet outputs;
   AtomicFile& result_file = outputs.Add(a.out);
   AtomicFile& outline_file = outputs.Add(outline_path);

@@ -216,7 +216,9 @@ void Run(const FitArgs& a) {
     throw InputError("--thickness-mm and --no-offset contradict each other (offset t/2 vs 0)");
   const double rho = units::GsmToSi(a.gsm);
   // Check the outputs before the work (photos included), so that a bad path fails fast; they appear together.
-  CheckDistinctOutputs({{"-o", a.out}, {"--plot", a.plot}});
+  std::vector<std::pair<std::string, std::string>> inputs{{"--rig", a.photo.rig_file}};
+  for (const std::string& in : a.inputs) inputs.emplace_back("(a profile or photo)", in);
+  CheckDistinctOutputs({{"-o", a.out}, {"--plot", a.plot}}, inputs);
   if (!a.plot.empty()) textile::chart::CheckPngPath(a.plot);
   AtomicFileSet outputs;
   AtomicFile& material_file = outputs.Add(a.out);

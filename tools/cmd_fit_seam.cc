@@ -47,6 +47,7 @@ int LayersFromAcpmResult(const std::string& path) {
 }
 
 void Run(const FitSeamArgs& a) {
+  CheckDistinctOutputs({{"-o", a.out}}, {{"(the input)", a.input}});
   const std::vector<SeamSample> samples = ReadSeamSamples(a.input);
   SeamFitOptions o;
   o.name = a.name;

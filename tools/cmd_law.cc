@@ -126,6 +126,7 @@ void Plot(const Material& m, double kappa_max, const std::string& path) {
 }
 
 void Run(const LawArgs& a) {
+  CheckDistinctOutputs({{"--plot", a.plot}}, {{"--material", a.material}});
   const Material m = ReadMaterial(a.material);
   std::vector<double> kappas;
   for (double k : a.kappa) {

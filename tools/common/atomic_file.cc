@@ -185,7 +185,17 @@ void AtomicFileSet::Commit() {
   for (const auto& f : files_) f->Commit();
 }
 
-void CheckDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
+void CheckDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs,
+                          const std::vector<std::pair<std::string, std::string>>& inputs) {
+  for (const auto& [flag, path] : outputs) {
+    if (path.empty()) continue;
+    for (const auto& [input_flag, input] : inputs) {
+      std::error_code ec;  // a missing file is no input to lose
+      if (!input.empty() && fs::equivalent(path, input, ec) && !ec)
+        throw InputError(flag + " " + path + " is the input " + input_flag +
+                         ": the run would overwrite it");
+    }
+  }
   std::vector<std::pair<std::string, fs::path>> seen;  // {flag, canonical path}
   for (const auto& [flag, path] : outputs) {
     if (path.empty()) continue;

@@ -68,7 +68,11 @@ class AtomicFileSet {
 // throws InputError "<flag> and <flag> name the same file <path>". Each entry is {flag, path};
 // empty paths (outputs not asked for) are skipped; paths are compared after
 // std::filesystem::weakly_canonical, so "a.json" and "./a.json" are the same file.
-void CheckDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs);
+// Also refuses an output that is one of the run's existing input files, {flag, path} each (the
+// same file by std::filesystem::equivalent: links and "./" spellings too): throws InputError
+// "<flag> <path> is the input <flag>: the run would overwrite it".
+void CheckDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs,
+                          const std::vector<std::pair<std::string, std::string>>& inputs = {});
 
 // Refuses an output whose extension (any case) is none of `extensions` (".png", ".jpg", ...):
 // throws InputError "<flag>: <path>: name it .png or .jpg". Image writers go by the name, and

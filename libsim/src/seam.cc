@@ -1,5 +1,6 @@
 #include "textile/sim/seam.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -22,10 +23,10 @@ using nlohmann::json;
 // coefficients fitted against d in m) than a seam. Table 2's stiffest seam reaches 9.07.
 constexpr int kMaxLayers = 20;
 constexpr double kMaxFactor = kMaxSeamFactor;  // largest plausible B_f [-] (seam.h)
-constexpr double kMaxRangeMm = 1000.0;     // fit range, influence range, fade [mm]
-constexpr double kMinInfluenceMm = 1.0;    // below this d_max is surely in metres [mm]
-constexpr double kMaxAllowanceMm = 200.0;  // seam allowance [mm]
-constexpr double kMaxRibFactor = 1000.0;   // lengthwise factor on S [-]
+constexpr double kMaxRangeMm = 1000.0;         // fit range, influence range, fade [mm]
+constexpr double kMinInfluenceMm = 1.0;        // below this d_max is surely in metres [mm]
+constexpr double kMaxAllowanceMm = 200.0;      // seam allowance [mm]
+constexpr double kMaxRibFactor = 1000.0;       // lengthwise factor on S [-]
 // Coefficients of a file that names a preset must be Table 2's up to JSON round-off.
 constexpr double kPresetTolerance = 1e-12;
 
@@ -179,7 +180,8 @@ bool SeamProfile::Check(std::string* why) const {
                 "must lie in [0, " + Num(kMaxAllowanceMm) + "] mm, got " + Num(allowance_mm));
   }
   if (!(rib_factor >= 1.0 && rib_factor <= kMaxRibFactor)) {
-    return fail("rib_factor", "must lie in [1, " + Num(kMaxRibFactor) + "], got " + Num(rib_factor));
+    return fail("rib_factor",
+                "must lie in [1, " + Num(kMaxRibFactor) + "], got " + Num(rib_factor));
   }
   if (covariance) {
     const Eigen::Matrix3d& c = *covariance;
@@ -189,6 +191,15 @@ bool SeamProfile::Check(std::string* why) const {
       return fail("covariance", "must be symmetric");
     }
     if ((c.diagonal().array() < 0.0).any()) return fail("covariance", "diagonal must be >= 0");
+    // A covariance is positive semi-definite; round-off in a written file may leave an
+    // eigenvalue a hair below 0 (1e-9 of the largest entry is far above that, far below a fit).
+    const double lowest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(c, Eigen::EigenvaluesOnly)
+                              .eigenvalues()
+                              .minCoeff();
+    if (lowest < -1e-9 * scale) {
+      return fail("covariance",
+                  "must be positive semi-definite, has the eigenvalue " + Num(lowest) + " < 0");
+    }
   }
   // The stiffness factor must be positive wherever S follows it (a non-positive factor is a
   // broken fit, not a softening seam).
@@ -204,6 +215,18 @@ bool SeamProfile::Check(std::string* why) const {
     return fail("coefficients_mm", "suspicious B_f(d) = " + Num(inside.max_value) + " at d = " +
                                        Num(inside.max_at) + " mm, above " + Num(kMaxFactor) +
                                        " (coefficients are per mm: was d in m or cm?)");
+  }
+  // The multiplier actually used must be plausible too: under paper-literal it is
+  // 1 + B_f(d) (B_f(0) - 1), largest where B_f is (for B_f(0) > 1; else it is <= 1).
+  if (multiplier == SeamMultiplierReading::kPaperLiteral) {
+    const double b0 = StiffnessFactor(0.0);
+    const double largest = 1.0 + inside.max_value * (b0 - 1.0);
+    if (b0 > 1.0 && largest > kMaxFactor) {
+      return fail("multiplier", "paper-literal: S(d) = 1 + B_f(d) (B_f(0) - 1) reaches " +
+                                    Num(largest) + " at d = " + Num(inside.max_at) + " mm, above " +
+                                    Num(kMaxFactor) +
+                                    " (use \"factor\", or check the coefficients)");
+    }
   }
   if (preset) {
     if (layers != preset->layers) {
@@ -301,10 +324,9 @@ SeamProfile ParseSeamJson(const std::string& text, const std::string& source) {
   SeamReader r(source);
   const json root = ParseJsonText(text, source);
   if (!root.is_object()) r.Fail("(top level)", "must be a JSON object");
-  r.CheckKeys(
-      root, {"type", "name", "layers", "coefficients_mm", "range_mm", "covariance", "influence_mm",
-             "fade_mm", "allowance_mm", "multiplier", "rib_factor", "fit", "notes", "source",
-             "assumptions"});
+  r.CheckKeys(root, {"type", "name", "layers", "coefficients_mm", "range_mm", "covariance",
+                     "influence_mm", "fade_mm", "allowance_mm", "multiplier", "rib_factor", "fit",
+                     "notes", "source", "assumptions"});
   for (const char* k : {"type", "layers", "coefficients_mm"}) {
     if (!root.contains(k)) r.Fail(k, "missing (required: type, layers, coefficients_mm)");
   }
@@ -313,6 +335,11 @@ SeamProfile ParseSeamJson(const std::string& text, const std::string& source) {
   const json& layers = root["layers"];
   if (!layers.is_number_integer())
     r.Fail("layers", "must be a whole number, got " + SeamReader::Brief(layers));
+  // Above 2^63 - 1 nlohmann holds the number unsigned: read as int64 it would wrap.
+  if (layers.is_number_unsigned() &&
+      layers.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<int>::max())) {
+    r.Fail("layers", "suspicious count " + SeamReader::Brief(layers));
+  }
   const std::int64_t n = layers.get<std::int64_t>();
   if (n < std::numeric_limits<int>::min() || n > std::numeric_limits<int>::max()) {
     r.Fail("layers", "suspicious count " + SeamReader::Brief(layers));
@@ -558,7 +585,8 @@ std::vector<double> HingeSeamMultipliers(const TriangleMesh& mesh, const std::ve
       double lengthwise = 1.0;
       if (rib > 1.0 && d[h] < half_band) {
         const Eigen::Vector2d a = Xy(mesh, hinges[h].v[2]), b = Xy(mesh, hinges[h].v[3]);
-        const double cos_phi = (b - a).normalized().dot(NearestSegmentDirection(0.5 * (a + b), seam.line));
+        const double cos_phi =
+            (b - a).normalized().dot(NearestSegmentDirection(0.5 * (a + b), seam.line));
         lengthwise = 1.0 + (rib - 1.0) * (1.0 - cos_phi * cos_phi);
       }
       s[h] = std::max(s[h], lengthwise * seam.profile.Multiplier(units::MToMm(d[h])));

@@ -8,6 +8,8 @@
 #include <string>
 
 #include "textile/sim/error.h"
+#include "textile/sim/json_text.h"
+#include "textile/sim/material.h"
 
 namespace textile {
 namespace {
@@ -593,6 +595,38 @@ TEST(SeamFile, DefaultsWhenSettingsOmitted) {
   EXPECT_FALSE(p.covariance.has_value());
 }
 
+TEST(JsonText, RefusesDuplicateKeysNamingTheKeyAndItsObject) {
+  // nlohmann keeps the last of two equal keys; a material or seam file that repeats one is an
+  // editing mistake that would silently win.
+  const auto message = [](const std::string& text) {
+    try {
+      ParseJsonText(text, "f.json");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(message(R"({"a": 1, "a": 2})"),
+            "f.json: duplicate key \"a\" at the top level (a JSON parser would silently keep "
+            "the last one)");
+  EXPECT_EQ(message(R"({"a": {"b": [{"c": 1, "c": 1}]}})").substr(0, 39),
+            "f.json: duplicate key \"c\" in \"a.b\" (");
+  // Equal keys in different objects, or in sibling objects of an array, are fine.
+  EXPECT_NO_THROW(
+      ParseJsonText(R"({"a": {"x": 1}, "b": {"x": 1}, "l": [{"x": 1}, {"x": 2}]})", "f"));
+  EXPECT_EQ(message(R"({"a": 1)").substr(0, 22), "f.json: not valid JSON");
+  const std::string material =
+      std::string(TEXTILE_SOURCE_DIR) + "/tests/data/materials/duplicate-key.json";
+  try {
+    ReadMaterial(material);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(material + ": duplicate key \"b1\" in \"bending\""),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(SeamFile, JsonRoundTrip) {
   const SeamProfile a = ParseSeamJson(R"({
       "type": "fitted", "name": "denim, ISO 2.04.05", "layers": 4,
@@ -707,7 +741,11 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"covariance-negative-variance.json", "covariance: ", "diagonal must be >= 0"},
         BadCase{"covariance-shape.json", "covariance: ", "must be a 3×3 array"},
         BadCase{"unknown-field.json", "influence: ", "unknown field"},
-        BadCase{"fit-not-object.json", "fit: ", "must be an object"}),
+        BadCase{"fit-not-object.json", "fit: ", "must be an object"},
+        BadCase{"duplicate-key.json", "", "duplicate key \"influence_mm\" at the top level"},
+        BadCase{"multiplier-literal-absurd.json", "multiplier: ", "reaches 9703"},
+        BadCase{"covariance-not-psd.json", "covariance: ", "must be positive semi-definite"},
+        BadCase{"layers-uint64.json", "layers: ", "suspicious count 18446744073709551615"}),
     [](const auto& info) {
       std::string n = info.param.file;
       n = n.substr(0, n.find('.'));

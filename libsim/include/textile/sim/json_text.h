@@ -12,7 +12,9 @@
 namespace textile {
 
 // Parses text as JSON. Throws InputError "<source>: not valid JSON: <what and where>", one
-// line, for a syntax error or a number out of range (1e999).
+// line, for a syntax error or a number out of range (1e999), and "<source>: duplicate key
+// \"k\" in \"a.b\" ..." for an object that repeats a key (JSON leaves it open; the last would
+// win silently).
 nlohmann::json ParseJsonText(const std::string& text, const std::string& source);
 
 }  // namespace textile

@@ -93,7 +93,8 @@ struct SeamProfile {
   // 1 ≤ layers ≤ 20, finite coefficients, 0 < B_f ≤ 100 on [0, d_max] (larger values are a unit
   // mix-up), 0 ≤ lo < hi ≤ 1000 mm, 1 ≤ d_max ≤ 1000 mm,
   // 0 < fade ≤ 1000 mm, 0 ≤ allowance ≤ 200 mm, 1 ≤ rib_factor ≤ 1000, covariance finite,
-  // symmetric, diagonal ≥ 0.
+  // symmetric, diagonal ≥ 0, positive semi-definite (eigenvalues ≥ -1e-9 of its largest
+  // entry); under the paper-literal reading also 1 + B_f(d) (B_f(0) - 1) ≤ 100 on [0, d_max].
   bool Check(std::string* why) const;
 };
 

@@ -1,7 +1,8 @@
 // Reading photos safely: the dimensions come from the file header, checked before OpenCV
 // decodes anything (a forged 100k x 100k header would otherwise make it allocate tens of GB),
 // and truncated files are refused instead of decoded half-grey (PNG: no IEND; JPEG: no end of
-// image after the scan; BMP, TIFF: pixel data beyond the end of the file).
+// image after the scan; BMP, TIFF: pixel data beyond the end of the file). An EXIF orientation
+// tag is ignored: photos are read in the sensor's pixels (docs/photos.md).
 
 #include <algorithm>
 #include <cstdint>
@@ -198,10 +199,13 @@ cv::Mat ReadPhotoGray(const std::string& path) {
   if (!h.complete)
     throw InputError(path + ": truncated " + h.format + " file (image data missing)");
 
+  // The pixels as the sensor recorded them: an EXIF orientation tag (a camera held upright) is
+  // ignored. Rigs and chessboards are calibrated in sensor pixels, and board and strip photos go
+  // through here alike, so turning them would only break the rig's image_size and homography.
   cv::Mat gray;
   try {
     gray = image_codecs::Decode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, bytes.data()),
-                                cv::IMREAD_GRAYSCALE);
+                                cv::IMREAD_GRAYSCALE | cv::IMREAD_IGNORE_ORIENTATION);
   } catch (const cv::Exception& e) {
     throw InputError(path + ": cannot decode " + h.format + ": " + e.err);
   }

@@ -586,6 +586,44 @@ TEST_F(ReadPhoto, RefusesAbsurdHeadersBeforeDecoding) {
   ExpectRefused(Write("huge.jpg", jpg), "65535x65535");
 }
 
+// A camera held upright tags its JPEG with an EXIF orientation (APP1, tag 0x0112) instead of
+// turning the pixels. Rigs are calibrated in sensor pixels, so the photo must be read as stored.
+TEST_F(ReadPhoto, IgnoresTheExifOrientationTag) {
+  // 120 x 80 px, dark top-left quadrant: any turn or flip moves it or changes the size.
+  cv::Mat img(80, 120, CV_8U, cv::Scalar(220));
+  img(cv::Rect(0, 0, 60, 40)).setTo(30);
+  const std::string jpg = Bytes(Encoded("plain.jpg", img));
+  ASSERT_EQ(static_cast<unsigned char>(jpg[0]), 0xFF);
+  ASSERT_EQ(static_cast<unsigned char>(jpg[1]), 0xD8);
+  for (const int orientation : {3, 6, 8}) {
+    // APP1: "Exif\0\0", a little-endian TIFF header, one IFD with one SHORT entry.
+    std::string exif("Exif\0\0", 6);
+    exif += std::string("II*\0\x08\0\0\0", 8);           // IFD at offset 8
+    exif += std::string("\x01\0", 2);                    // one entry
+    exif += std::string("\x12\x01\x03\0\x01\0\0\0", 8);  // 0x0112, SHORT, count 1
+    exif += std::string(1, static_cast<char>(orientation)) + std::string("\0\0\0", 3);
+    exif += std::string("\0\0\0\0", 4);  // no next IFD
+    const size_t len = exif.size() + 2;
+    const std::string app1 = std::string("\xFF\xE1", 2) + static_cast<char>(len >> 8) +
+                             static_cast<char>(len & 0xFF) + exif;
+    const std::string tagged = jpg.substr(0, 2) + app1 + jpg.substr(2);
+    const std::string name = "exif" + std::to_string(orientation) + ".jpg";
+    const std::string path = Write(name, tagged);
+    // The tag is real: OpenCV's default decoding turns (6, 8) or flips (3) the image.
+    const cv::Mat turned = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(turned.empty()) << name;
+    if (orientation == 3) {
+      EXPECT_GT(turned.at<uint8_t>(10, 10), 128) << name;
+    } else {
+      EXPECT_EQ(turned.size(), cv::Size(80, 120)) << name;
+    }
+    const cv::Mat back = ReadPhotoGray(path);
+    EXPECT_EQ(back.size(), img.size()) << name;
+    EXPECT_LT(back.at<uint8_t>(10, 10), 80) << name;  // the dark quadrant stays top-left
+    EXPECT_GT(back.at<uint8_t>(70, 110), 170) << name;
+  }
+}
+
 // ------------------------------------------------------------------ real photos
 
 // Distance of each profile point from the least-squares quadratic x(s), y(s) through its

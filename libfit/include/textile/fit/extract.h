@@ -114,8 +114,9 @@ struct ExtractionSummary {
 
 // Reads a photo as 8-bit grey. The header is checked before anything is decoded: the format
 // (PNG, JPEG, TIFF, BMP), the size (kMinPhotoSidePx .. kMaxPhotoSidePx, at most
-// kMaxPhotoPixels) and, for PNG and JPEG, that the file is complete. Throws InputError
-// "<path>: <problem>".
+// kMaxPhotoPixels) and, for PNG and JPEG, that the file is complete. The pixels are the
+// sensor's: an EXIF orientation tag is ignored (rigs are calibrated in sensor pixels). Throws
+// InputError "<path>: <problem>".
 cv::Mat ReadPhotoGray(const std::string& path);
 
 // Extracts the profile from an 8-bit grey photo (CV_8UC1). Throws InputError for bad input

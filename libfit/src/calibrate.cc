@@ -34,6 +34,23 @@ double SquarePx(const std::vector<cv::Point2f>& c, int cols, int rows) {
   return MedianOf(d);
 }
 
+// Two boards whose corners all lie within this distance show one pose [px]: a copy of the same
+// photo, or the board and camera not moved in between. A turn of the board by a degree moves its
+// outer corners by several pixels; a re-encoded copy moves them by hundredths.
+constexpr double kSamePosePx = 0.5;
+
+// The largest distance between corresponding corners, in OpenCV's order or reversed (the
+// detector may start from either end of a board turned by 180°) [px].
+double CornerDistancePx(const std::vector<Eigen::Vector2d>& a,
+                        const std::vector<Eigen::Vector2d>& b) {
+  double forward = 0.0, reversed = 0.0;
+  for (size_t k = 0; k < a.size(); ++k) {
+    forward = std::max(forward, (a[k] - b[k]).norm());
+    reversed = std::max(reversed, (a[k] - b[b.size() - 1 - k]).norm());
+  }
+  return std::min(forward, reversed);
+}
+
 Eigen::Vector2d Apply(const Eigen::Matrix3d& H, const Eigen::Vector2d& p) {
   const Eigen::Vector3d q = H * Eigen::Vector3d(p.x(), p.y(), 1.0);
   return q.head<2>() / q.z();
@@ -148,6 +165,21 @@ CalibrationSummary CalibrateRig(const std::vector<cv::Mat>& boards,
                   std::to_string(o.rows) + " inner corners not found (check --board: inner corners, "
                   "not squares)";
       return s;
+    }
+  }
+  // A second photo of a pose adds no pose: the lens would be fitted to fewer views than given
+  // (a copy of the one board under another name gave fx 7417 px instead of 8000 and k2 = -26).
+  for (size_t j = 1; j < boards.size(); ++j) {
+    for (size_t i = 0; i < j; ++i) {
+      const double d = CornerDistancePx(s.detections[i].corners_px, s.detections[j].corners_px);
+      if (d < kSamePosePx) {
+        std::ostringstream m;
+        m.setf(std::ios::fixed);
+        m.precision(2);
+        m << sources[j] << ": the board is in the same pose as in " << sources[i]
+          << " (every corner within " << d << " px; a copy?): more boards must show other poses";
+        throw InputError(m.str());
+      }
     }
   }
   // The board's own frame [mm]: corner (i, j) at (i, j) squares.

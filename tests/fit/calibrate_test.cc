@@ -135,6 +135,39 @@ TEST(Calibrate, SeveralBoardsGiveALensModel) {
   EXPECT_LT(RigidResidual(calibrated, truth), 0.1);
 }
 
+// A board given twice (a copy under another name, or a photo of an unmoved board) adds no pose;
+// fitted as two views it gave a wrong focal length and k2 = -26. Refused, naming both photos,
+// whichever board is repeated; the three different poses above still calibrate.
+TEST(Calibrate, RefusesTwoBoardsInTheSamePose) {
+  const RenderedPhoto a = Rendered(PhotoDifficulty::kMedium, 1);
+  const RenderedPhoto b = Rendered(PhotoDifficulty::kMedium, 1, 20.0, 5.0);
+  const CalibrateOptions o = Board(a);
+  // A pixel-identical copy, and a copy with a little noise (a re-encoded or re-shot photo).
+  cv::Mat noisy = b.board.clone();
+  cv::Mat noise(noisy.size(), CV_16S);
+  cv::randn(noise, 0, 2);
+  noisy.convertTo(noisy, CV_16S);
+  cv::Mat sum = noisy + noise;
+  sum.convertTo(noisy, CV_8U);
+  const std::vector<std::pair<std::vector<cv::Mat>, std::string>> cases = {
+      {{a.board, a.board.clone()}, "b.png: the board is in the same pose as in a.png"},
+      {{a.board, b.board, noisy}, "c.png: the board is in the same pose as in b.png"}};
+  for (const auto& [boards, words] : cases) {
+    const std::vector<std::string> names = {"a.png", "b.png", "c.png"};
+    try {
+      CalibrateRig(boards, {names.begin(), names.begin() + boards.size()}, o);
+      ADD_FAILURE() << words;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  }
+  // Without the lens fit the extra boards are not used, but a copy is still a mistake.
+  CalibrateOptions no_lens = o;
+  no_lens.lens = false;
+  EXPECT_THROW(CalibrateRig({a.board, a.board.clone()}, {"a.png", "b.png"}, no_lens), InputError);
+  EXPECT_TRUE(CalibrateRig({a.board, b.board}, {"a.png", "b.png"}, o).success);
+}
+
 TEST(Calibrate, RefusesMissingBoardsWrongCountsAndBadOptions) {
   const RenderedPhoto r = Rendered(PhotoDifficulty::kEasy, 1);
   CalibrateOptions o = Board(r);

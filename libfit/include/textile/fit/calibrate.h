@@ -73,7 +73,8 @@ BoardDetection DetectChessboard(const cv::Mat& gray, int cols, int rows, const s
                                 int detect_side_px = 2000);
 
 // Calibrates a rig from one or more board photos (the first lies in the bending plane). Throws
-// InputError for bad options, an empty list or photos of different sizes; returns success = false
+// InputError for bad options, an empty list, photos of different sizes or two boards in the same
+// pose (every corner within half a pixel: a copy adds no view); returns success = false
 // when a board is not found or the reprojection error exceeds options.max_error_px.
 CalibrationSummary CalibrateRig(const std::vector<cv::Mat>& boards,
                                 const std::vector<std::string>& sources,

@@ -25,7 +25,8 @@ namespace {
 struct AcpmArgs {
   std::string material, seam, seam_dir, model = "auto", out, png, obj;
   std::optional<double> seam_at_mm;
-  double width_mm = 200, length_mm = 300, margin_mm = 5, barrier_deg = 41.5;
+  std::optional<double> margin_mm;  // default 5 mm; more than one ray only
+  double width_mm = 200, length_mm = 300, barrier_deg = 41.5;
   double speed_cm_per_min = 12, crossing_tol_mm = 0.05;
   int rays = 17;
   bool json = false;
@@ -44,14 +45,19 @@ AcpmOptions Options(const AcpmArgs& a) {
   o.width = units::MmToM(a.width_mm);
   o.length = units::MmToM(a.length_mm);
   o.num_rays = a.rays;
-  o.ray_margin = units::MmToM(a.margin_mm);
+  // One ray sits at the centre: a margin would be ignored.
+  if (a.margin_mm && a.rays == 1)
+    throw InputError(
+        "--margin-mm: one ray (--rays 1) sits at the centre; the margin would be ignored");
+  o.ray_margin = units::MmToM(a.margin_mm.value_or(5.0));
   o.barrier_angle = a.barrier_deg * kDegree;
   o.push_speed = a.speed_cm_per_min / 100.0 / 60.0;
   o.crossing_tolerance = units::MmToM(a.crossing_tol_mm);
   o.model = ParseAcpmModel(a.model);
   if (a.seam.empty()) {
     if (a.seam_at_mm) throw InputError("--seam-at: needs --seam (a Table 2 type or a seam file)");
-    if (!a.seam_dir.empty()) throw InputError("--seam-dir: needs --seam (a Table 2 type or a seam file)");
+    if (!a.seam_dir.empty())
+      throw InputError("--seam-dir: needs --seam (a Table 2 type or a seam file)");
   } else {
     o.seam.direction = ParseAcpmSeamDirection(a.seam_dir.empty() ? "along" : a.seam_dir);
     o.seam.profile = LoadSeam(a.seam);
@@ -64,14 +70,20 @@ AcpmOptions Options(const AcpmArgs& a) {
     }
   }
   if (std::string why; !o.Check(&why)) throw InputError("acpm: " + why);
+  // RunAcpm refuses this too; here it is the flags' fault, not the material's.
+  if (o.model == AcpmModelKind::kElastica && o.seam.direction == AcpmSeamDirection::kAlong)
+    throw InputError(
+        "--model elastica: a seam along the push direction varies across the width; "
+        "the 1D elastica cannot represent it (use --model shell or auto)");
   return o;
 }
 
 void Plot(const AcpmResult& r, const AcpmOptions& o, const Material& m, AtomicFile& out) {
   namespace chart = textile::chart;
-  chart::Panel front{.title = "Front across the width (crossing overhang per ray)",
-                     .x_label = "z across the width [mm]",
-                     .y_label = "overhang L at the " + Num(o.barrier_angle / kDegree) + "° barrier [mm]"};
+  chart::Panel front{
+      .title = "Front across the width (crossing overhang per ray)",
+      .x_label = "z across the width [mm]",
+      .y_label = "overhang L at the " + Num(o.barrier_angle / kDegree) + "° barrier [mm]"};
   chart::Series rays{.label = "rays", .style = chart::Series::Style::kLineAndMarkers};
   double lo = 1e300, hi = -1e300;
   for (const auto& ray : r.rays) {
@@ -82,10 +94,8 @@ void Plot(const AcpmResult& r, const AcpmOptions& o, const Material& m, AtomicFi
   }
   const double plain = units::MToMm(r.plain_overhang);
   front.series.push_back(rays);
-  front.series.push_back({.label = "no seam",
-                          .x = {0.0, units::MToMm(o.width)},
-                          .y = {plain, plain},
-                          .dashed = true});
+  front.series.push_back(
+      {.label = "no seam", .x = {0.0, units::MToMm(o.width)}, .y = {plain, plain}, .dashed = true});
   lo = std::min(lo, plain);
   hi = std::max(hi, plain);
   const double pad = std::max(0.1 * (hi - lo), 0.05 * hi);
@@ -108,10 +118,11 @@ void Plot(const AcpmResult& r, const AcpmOptions& o, const Material& m, AtomicFi
                  "factor G/G_plain: " + Num(flo, 4) + (fhi > flo ? " .. " + Num(fhi, 4) : ""),
                  "device time " + Num(r.device_time, 4) + " s"};
 
-  chart::Panel side{.title = "Side profile at the crossing (ray " + std::to_string(r.profile_ray + 1) + ")",
-                    .x_label = "x [mm]",
-                    .y_label = "y [mm]",
-                    .equal_aspect = true};
+  chart::Panel side{
+      .title = "Side profile at the crossing (ray " + std::to_string(r.profile_ray + 1) + ")",
+      .x_label = "x [mm]",
+      .y_label = "y [mm]",
+      .equal_aspect = true};
   chart::Series strip{.label = "sample"};
   for (size_t i = 0; i < r.profile_x.size(); ++i) {
     strip.x.push_back(units::MToMm(r.profile_x[i]));
@@ -137,26 +148,28 @@ void Plot(const AcpmResult& r, const AcpmOptions& o, const Material& m, AtomicFi
       const double f = s / overhang * (r.profile_x.size() - 1.0);
       const size_t i = std::min(static_cast<size_t>(f), r.profile_x.size() - 2);
       const double t = f - i;
-      side.series.push_back(
-          {.label = "seam line",
-           .x = {units::MToMm((1 - t) * r.profile_x[i] + t * r.profile_x[i + 1])},
-           .y = {units::MToMm((1 - t) * r.profile_y[i] + t * r.profile_y[i + 1])},
-           .style = chart::Series::Style::kMarkers});
+      side.series.push_back({.label = "seam line",
+                             .x = {units::MToMm((1 - t) * r.profile_x[i] + t * r.profile_x[i + 1])},
+                             .y = {units::MToMm((1 - t) * r.profile_y[i] + t * r.profile_y[i + 1])},
+                             .style = chart::Series::Style::kMarkers});
     } else {
-      side.notes.push_back("seam on the platform, " + Num(units::MToMm(-s), 4) + " mm behind the edge");
+      side.notes.push_back("seam on the platform, " + Num(units::MToMm(-s), 4) +
+                           " mm behind the edge");
     }
   }
-  side.notes.push_back("L = " + Num(units::MToMm(r.rays.empty() ? 0.0 : r.rays[r.profile_ray].overhang), 6) + " mm");
-  chart::WritePng({.title = "Virtual ACPM200: " + (m.name.empty() ? std::string("material") : m.name) +
-                            (o.seam.direction == AcpmSeamDirection::kNone
-                                 ? std::string(", plain sample")
-                                 : ", " + o.seam.profile.type + " seam " +
-                                       AcpmSeamDirectionName(o.seam.direction)),
-                   .width_px = 1400,
-                   .height_px = 600,
-                   .columns = 2,
-                   .panels = {front, side}},
-                  out);
+  side.notes.push_back(
+      "L = " + Num(units::MToMm(r.rays.empty() ? 0.0 : r.rays[r.profile_ray].overhang), 6) + " mm");
+  chart::WritePng(
+      {.title =
+           "Virtual ACPM200: " + (m.name.empty() ? std::string("material") : m.name) +
+           (o.seam.direction == AcpmSeamDirection::kNone
+                ? std::string(", plain sample")
+                : ", " + o.seam.profile.type + " seam " + AcpmSeamDirectionName(o.seam.direction)),
+       .width_px = 1400,
+       .height_px = 600,
+       .columns = 2,
+       .panels = {front, side}},
+      out);
 }
 
 void Run(const AcpmArgs& a) {
@@ -212,7 +225,8 @@ void Run(const AcpmArgs& a) {
               << AcpmSeamDirectionName(o.seam.direction) << " the push direction, "
               << (o.seam.direction == AcpmSeamDirection::kAlong ? "at z = " : "")
               << Num(units::MToMm(at)) << " mm"
-              << (o.seam.direction == AcpmSeamDirection::kAcross ? " behind the front" : "") << "\n";
+              << (o.seam.direction == AcpmSeamDirection::kAcross ? " behind the front" : "")
+              << "\n";
   }
   std::cout << "model: " << AcpmModelName(r.model) << " (" << r.model_reason << ")\n";
   // (µ and · are two bytes each in UTF-8: the header is spelled out, not padded by printf.)
@@ -224,9 +238,11 @@ void Run(const AcpmArgs& a) {
                 units::MToMm(ray.overhang), units::MToMm(ray.bending_length),
                 units::SiRigidityToMicroNm(ray.rigidity), ray.factor, ray.device_time);
   }
-  std::cout << "without seams: L = " << Num(units::MToMm(r.plain_overhang)) << " mm, c = "
-            << Num(units::MToMm(r.plain_bending_length)) << " mm, G = "
-            << Num(units::SiRigidityToMicroNm(r.plain_rigidity)) << " µN·m\n"
+  std::cout << "without seams: L = " << Num(units::MToMm(r.plain_overhang))
+            << " mm, c = " << Num(units::MToMm(r.plain_bending_length))
+            << " mm, G = " << Num(units::SiRigidityToMicroNm(r.plain_rigidity))
+            << " µN·m = " << Num(units::SiRigidityToMgCm(r.plain_rigidity))
+            << " mg·cm = " << Num(units::SiRigidityToGfCm(r.plain_rigidity)) << " gf·cm\n"
             << "device time " << Num(r.device_time, 4) << " s; computed in " << Num(ms, 3)
             << " ms (" << r.solves << " solves)\n"
             << "wrote " << a.out << (a.png.empty() ? "" : ", " + a.png)
@@ -242,30 +258,39 @@ void RegisterAcpm(CLI::App& app) {
       "Virtual ACPM200: push a sample over the 41.5° light barrier, 17 rays across the width; "
       "per-ray L, c, G and seam factor",
       "textile acpm --material samples/materials/pabst-fig8.json -o acpm.json --png front.png\n"
-      "  textile acpm --material samples/materials/pabst-fig8.json --seam C-plain --seam-dir across "
+      "  textile acpm --material samples/materials/pabst-fig8.json --seam C-plain --seam-dir "
+      "across "
       "--seam-at 20 -o acpm.json");
   sub->add_option("-m,--material", a->material, "Material JSON file (cli.md format)")->required();
-  sub->add_option("--seam", a->seam, "Seam: a Table 2 type (A-plain .. C-twill) or a seam JSON file");
+  sub->add_option("--seam", a->seam,
+                  "Seam: a Table 2 type (A-plain .. C-twill) or a seam JSON file");
   sub->add_option("--seam-at", a->seam_at_mm,
                   "along: width position of the seam from the left edge [mm] (default centre); "
                   "across: its distance behind the sample's front [mm] (required)");
-  sub->add_option("--seam-dir", a->seam_dir, "Seam direction relative to the push: along (default) or across")
+  sub->add_option("--seam-dir", a->seam_dir,
+                  "Seam direction relative to the push: along (default) or across")
       ->check(CLI::IsMember({"along", "across"}));
-  sub->add_option("--model", a->model, "auto (default: the elastica when it is exact), elastica or shell")
+  sub->add_option("--model", a->model,
+                  "auto (default: the elastica when it is exact), elastica or shell")
       ->check(CLI::IsMember({"auto", "elastica", "shell"}));
   sub->add_option("-o,--out", a->out, "Result JSON to write (cli.md's ACPM result)")->required();
-  sub->add_option("--png", a->png, "Write the front across the width and the side profile to a PNG");
+  sub->add_option("--png", a->png,
+                  "Write the front across the width and the side profile to a PNG");
   sub->add_option("--obj", a->obj,
                   "Write the sample at the middle ray's crossing as an OBJ mesh [m] (the shell's "
                   "mesh, or the elastica's profile swept across the width)");
   sub->add_option("--width-mm", a->width_mm, "Sample width [mm], at most 200 (default 200)");
-  sub->add_option("--length-mm", a->length_mm, "Sample length, the longest overhang [mm] (default 300)");
+  sub->add_option("--length-mm", a->length_mm,
+                  "Sample length, the longest overhang [mm] (default 300)");
   sub->add_option("--rays", a->rays, "Number of rays across the width (default 17)");
-  sub->add_option("--margin-mm", a->margin_mm, "Distance of the outer rays from the edges [mm] (default 5)");
-  sub->add_option("--barrier-deg", a->barrier_deg, "Barrier angle below the horizontal [deg] (default 41.5)");
+  sub->add_option("--margin-mm", a->margin_mm,
+                  "Distance of the outer rays from the edges [mm] (default 5)");
+  sub->add_option("--barrier-deg", a->barrier_deg,
+                  "Barrier angle below the horizontal [deg] (default 41.5)");
   sub->add_option("--speed-cm-per-min", a->speed_cm_per_min, "Push speed [cm/min] (default 12)");
-  sub->add_option("--crossing-tol-mm", a->crossing_tol_mm,
-                  "Crossing refinement of stepping models [mm] (default 0.05; the elastica is exact)");
+  sub->add_option(
+      "--crossing-tol-mm", a->crossing_tol_mm,
+      "Crossing refinement of stepping models [mm] (default 0.05; the elastica is exact)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   sub->callback([a] { Run(*a); });
 }

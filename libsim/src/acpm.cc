@@ -73,7 +73,8 @@ StripVariation AcrossSeamVariation(const SeamProfile& profile, double distance) 
   // C2: stopping costs nothing and keeps every step smooth).
   const double d_max = units::MmToM(profile.influence_mm);
   const double d_end = d_max + units::MmToM(profile.fade_mm);
-  for (double b : {distance, distance - d_max, distance + d_max, distance - d_end, distance + d_end})
+  for (double b :
+       {distance, distance - d_max, distance + d_max, distance - d_end, distance + d_end})
     if (b > 0.0) v.breakpoints.push_back(b);
   std::sort(v.breakpoints.begin(), v.breakpoints.end());
   return v;
@@ -127,9 +128,12 @@ AcpmCrossings ElasticaModel(const Material& material, const AcpmOptions& o,
 
 std::string AcpmModelName(AcpmModelKind kind) {
   switch (kind) {
-    case AcpmModelKind::kAuto: return "auto";
-    case AcpmModelKind::kElastica: return "elastica";
-    case AcpmModelKind::kShell: return "shell";
+    case AcpmModelKind::kAuto:
+      return "auto";
+    case AcpmModelKind::kElastica:
+      return "elastica";
+    case AcpmModelKind::kShell:
+      return "shell";
   }
   return "?";
 }
@@ -143,9 +147,12 @@ AcpmModelKind ParseAcpmModel(const std::string& name) {
 
 std::string AcpmSeamDirectionName(AcpmSeamDirection direction) {
   switch (direction) {
-    case AcpmSeamDirection::kNone: return "none";
-    case AcpmSeamDirection::kAlong: return "along";
-    case AcpmSeamDirection::kAcross: return "across";
+    case AcpmSeamDirection::kNone:
+      return "none";
+    case AcpmSeamDirection::kAlong:
+      return "along";
+    case AcpmSeamDirection::kAcross:
+      return "across";
   }
   return "?";
 }
@@ -208,8 +215,8 @@ bool AcpmOptions::Check(std::string* why) const {
     } else if (seam.direction == AcpmSeamDirection::kAcross && at < 0.0) {
       s << "seam-at: " << Mm(at) << " mm is negative (the seam's distance behind the front)";
     } else if (seam.direction == AcpmSeamDirection::kAcross && at > length) {
-      s << "seam-at: the seam " << Mm(at) << " mm behind the front lies outside the "
-        << Mm(length) << " mm long sample";
+      s << "seam-at: the seam " << Mm(at) << " mm behind the front lies outside the " << Mm(length)
+        << " mm long sample";
     }
   }
   if (why != nullptr) *why = s.str();
@@ -261,21 +268,25 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
     case AcpmModelKind::kAuto:
       use_elastica = !varies_across;
       if (o.seam.direction == AcpmSeamDirection::kNone) {
-        result.model_reason = "auto: nothing varies across the width (plain sample), so the front "
-                              "is straight and the 1D heavy elastica is exact";
+        result.model_reason =
+            "auto: nothing varies across the width (plain sample), so the front "
+            "is straight and the 1D heavy elastica is exact";
       } else if (o.seam.direction == AcpmSeamDirection::kAcross) {
-        result.model_reason = "auto: a seam across the push direction varies only along the "
-                              "strip, so the 1D heavy elastica with S(d) and the seam band's "
-                              "mass along its length is exact";
+        result.model_reason =
+            "auto: a seam across the push direction varies only along the "
+            "strip, so the 1D heavy elastica with S(d) and the seam band's "
+            "mass along its length is exact";
       } else {
-        result.model_reason = "auto: a seam along the push direction varies across the width, "
-                              "which needs the shell model";
+        result.model_reason =
+            "auto: a seam along the push direction varies across the width, "
+            "which needs the shell model";
       }
       break;
     case AcpmModelKind::kElastica:
       if (varies_across)
-        throw InputError("model elastica: a seam along the push direction varies across the "
-                         "width; the 1D elastica cannot represent it (use --model shell or auto)");
+        throw InputError(
+            "model elastica: a seam along the push direction varies across the "
+            "width; the 1D elastica cannot represent it (use --model shell or auto)");
       use_elastica = true;
       result.model_reason = "requested";
       break;
@@ -299,7 +310,11 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
                                           "across the push direction exactly"));
     }
     crossings = shell(material, o, z);
-    if (!crossings.converged) throw ComputeError("shell model: " + crossings.message);
+    if (!crossings.converged) {
+      // ShellAcpmCrossings' messages name the model already; a plugged-in one's may not.
+      const bool named = crossings.message.rfind("shell model", 0) == 0;
+      throw ComputeError((named ? "" : "shell model: ") + crossings.message);
+    }
     if (crossings.overhang.size() != z.size())
       throw ComputeError("shell model: returned " + std::to_string(crossings.overhang.size()) +
                          " crossings for " + std::to_string(z.size()) + " rays");
@@ -315,12 +330,13 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
              crossings.plain_overhang > 0.0) {
     plain_overhang = crossings.plain_overhang;
   } else {
-    plain_overhang = Crossing(material.EffectiveLaw(), material.areal_density, o, {},
-                              "the fabric without seams").overhang;
+    plain_overhang =
+        Crossing(material.EffectiveLaw(), material.areal_density, o, {}, "the fabric without seams")
+            .overhang;
     ++crossings.solves;
   }
-  const ClassicOutputs plain = ComputeClassicOutputs(material.areal_density, plain_overhang,
-                                                     o.barrier_angle);
+  const ClassicOutputs plain =
+      ComputeClassicOutputs(material.areal_density, plain_overhang, o.barrier_angle);
   result.plain_overhang = plain_overhang;
   result.plain_bending_length = plain.bending_length;
   result.plain_rigidity = plain.flexural_rigidity;
@@ -335,8 +351,8 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
       throw ComputeError("model returned no crossing for ray " + std::to_string(i));
     // c = L/2 and G = ρ g c³ as the device reports them (L/2 rule at 41.5°, Peirce elsewhere),
     // ρ the plain fabric's areal density (what the operator enters).
-    const ClassicOutputs c = ComputeClassicOutputs(material.areal_density, r.overhang,
-                                                   o.barrier_angle);
+    const ClassicOutputs c =
+        ComputeClassicOutputs(material.areal_density, r.overhang, o.barrier_angle);
     r.bending_length = c.bending_length;
     r.rigidity = c.flexural_rigidity;
     r.factor = r.rigidity / result.plain_rigidity;
@@ -389,13 +405,16 @@ nlohmann::json AcpmResultToJson(const AcpmResult& r, const Material& material,
                     {"bending_length_mm", units::MToMm(ray.bending_length)},
                     {"rigidity_uNm", units::SiRigidityToMicroNm(ray.rigidity)},
                     {"rigidity_mgcm", units::SiRigidityToMgCm(ray.rigidity)},
+                    {"rigidity_gfcm", units::SiRigidityToGfCm(ray.rigidity)},
                     {"factor", ray.factor},
                     {"device_time_s", ray.device_time}});
   }
   j["rays"] = rays;
   j["plain"] = {{"overhang_mm", units::MToMm(r.plain_overhang)},
                 {"bending_length_mm", units::MToMm(r.plain_bending_length)},
-                {"rigidity_uNm", units::SiRigidityToMicroNm(r.plain_rigidity)}};
+                {"rigidity_uNm", units::SiRigidityToMicroNm(r.plain_rigidity)},
+                {"rigidity_mgcm", units::SiRigidityToMgCm(r.plain_rigidity)},
+                {"rigidity_gfcm", units::SiRigidityToGfCm(r.plain_rigidity)}};
   j["device_time_s"] = r.device_time;
   json x = json::array(), y = json::array();
   for (size_t i = 0; i < r.profile_x.size(); ++i) {

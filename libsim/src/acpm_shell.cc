@@ -29,7 +29,8 @@ TriangleMesh TensorGrid(const std::vector<double>& xs, const std::vector<double>
   int f = 0;
   for (int i = 0; i + 1 < nx1; ++i) {
     for (int j = 0; j + 1 < ny1; ++j) {
-      const int a = i * ny1 + j, b = (i + 1) * ny1 + j, c = (i + 1) * ny1 + j + 1, d = i * ny1 + j + 1;
+      const int a = i * ny1 + j, b = (i + 1) * ny1 + j, c = (i + 1) * ny1 + j + 1,
+                d = i * ny1 + j + 1;
       if (alternate ? (i + j) % 2 == 0 : 2 * j + 1 < ny1 - 1) {
         mesh.triangles.row(f++) << a, b, c;
         mesh.triangles.row(f++) << a, c, d;
@@ -52,8 +53,17 @@ int CellsAlong(double reference_overhang, double element_length) {
 ShellAcpmSettings HalvedSettings(const ShellAcpmSettings& settings, double reference_overhang) {
   ShellAcpmSettings half = settings;
   half.element_length = reference_overhang /
-                        (2.0 * CellsAlong(reference_overhang, settings.element_length)) * (1.0 + 1e-9);
+                        (2.0 * CellsAlong(reference_overhang, settings.element_length)) *
+                        (1.0 + 1e-9);
   return half;
+}
+
+// A length [m] in mm for messages ("300", "342.5").
+std::string MmText(double m) {
+  std::ostringstream s;
+  s.precision(4);
+  s << units::MToMm(m);
+  return s.str();
 }
 
 using Clock = std::chrono::steady_clock;
@@ -77,24 +87,45 @@ class PushedSample {
         deadline_(deadline) {
     nx_ = CellsAlong(reference_overhang, settings.element_length);
     platform_ = reference_overhang / nx_;
+    // A seam across gets a second platform row (below): the seam line may lie behind the edge.
+    platform_rows_ = seam.direction == AcpmSeamDirection::kAcross ? 2 : 1;
     // Across the width: uniform, with the seam along the push direction on a grid line.
     const bool along = seam.direction == AcpmSeamDirection::kAlong;
     const int ny = along ? settings.width_cells_seam : settings.width_cells_plain;
     for (int j = 0; j <= ny; ++j) ys_.push_back(options.width * j / ny);
     if (along) {
       const double zs = std::isfinite(seam.position) ? seam.position : 0.5 * options.width;
-      auto nearest = std::min_element(ys_.begin() + 1, ys_.end() - 1, [&](double a, double b) {
-        return std::abs(a - zs) < std::abs(b - zs);
-      });
-      if (ny >= 2) *nearest = zs;
-      seam_z_ = zs;
+      // A seam on (or within round-off of) a side edge runs along that edge's grid line; any
+      // other seam moves the nearest inner line onto it (moving an inner line onto an edge
+      // would leave a cell of zero width).
+      const double snap = kEdgeSnap * options.width;
+      if (std::abs(zs) <= snap) {
+        seam_z_ = ys_.front();
+      } else if (std::abs(zs - options.width) <= snap) {
+        seam_z_ = ys_.back();
+      } else {
+        auto nearest = std::min_element(ys_.begin() + 1, ys_.end() - 1, [&](double a, double b) {
+          return std::abs(a - zs) < std::abs(b - zs);
+        });
+        *nearest = zs;
+        seam_z_ = zs;
+      }
     }
   }
 
   // Solves the sample at overhang L, warm-started from the last solved state. False (with
   // *message) when the solver did not converge.
   bool Solve(double overhang, std::string* message) {
-    std::vector<double> xs = {-platform_};
+    std::vector<double> xs;
+    if (platform_rows_ == 2) {
+      // The seam across lies D behind the front, at x = L - D, which is behind the edge
+      // (x < 0) until L reaches D. S(d) reaches d_max + fade (120 mm by default), so the hinges
+      // past the edge are stiffened by a seam still on the platform: the platform reaches back
+      // to the seam line (its second row, held like the first; one cell of the usual length
+      // stays at the edge, so the edge's elements do not change).
+      xs.push_back(std::min(overhang - seam_.position, -2.0 * platform_));
+    }
+    xs.push_back(-platform_);
     for (int i = 0; i <= nx_; ++i) xs.push_back(overhang * i / nx_);
     // The hinge energies need alternating diagonals (with one diagonal everywhere their
     // bend-twist coupling tilts the front across the width). The curvature tensor is exact on
@@ -107,8 +138,9 @@ class PushedSample {
       SeamLine line(2, 2);
       line << -platform_, seam_z_, overhang, seam_z_;
       seams.push_back({seam_.profile, line});
-    } else if (seam_.direction == AcpmSeamDirection::kAcross && seam_.position <= overhang) {
-      // A seam still on the platform is held flat there: it changes nothing.
+    } else if (seam_.direction == AcpmSeamDirection::kAcross) {
+      // On the overhang, or on the platform (then the platform's first row): either way the
+      // hinges past the edge get S(d) by their distance d to the line (physics.md, "Seams").
       SeamLine line(2, 2);
       line << overhang - seam_.position, 0.0, overhang - seam_.position, options_.width;
       seams.push_back({seam_.profile, line});
@@ -121,7 +153,8 @@ class PushedSample {
     for (int v = 0; v < mesh.num_vertices(); ++v)
       if (mesh.vertices(v, 0) <= 0.0) held.push_back(v);
     Vertices at(static_cast<long>(held.size()), 3);
-    for (size_t k = 0; k < held.size(); ++k) at.row(static_cast<long>(k)) = mesh.vertices.row(held[k]);
+    for (size_t k = 0; k < held.size(); ++k)
+      at.row(static_cast<long>(k)) = mesh.vertices.row(held[k]);
     problem_->FixVertices(held, at);
     if (state_.rows() != mesh.num_vertices()) {
       state_ = mesh.vertices;
@@ -130,6 +163,8 @@ class PushedSample {
       const double scale = overhang / overhang_;
       for (int v = 0; v < state_.rows(); ++v)
         if (mesh.vertices(v, 0) > 0.0) state_.row(v) *= scale;
+      // The held rows where this mesh has them (a seam across moves the platform's first row).
+      for (int v : held) state_.row(v) = mesh.vertices.row(v);
     }
     // Each solve gets at most the run's time left (ShellAcpmSettings::max_seconds).
     const double left = std::chrono::duration<double>(deadline_ - Clock::now()).count();
@@ -176,7 +211,7 @@ class PushedSample {
       if (std::abs(ys_[k] - z) < std::abs(ys_[j] - z)) j = k;
     px->clear();
     py->clear();
-    for (int i = 1; i < mesh_.num_vertices() / ny1; ++i) {  // from the edge (i = 1) on
+    for (int i = platform_rows_; i < mesh_.num_vertices() / ny1; ++i) {  // from the edge on
       px->push_back(state_(i * ny1 + j, 0));
       py->push_back(state_(i * ny1 + j, 2));
     }
@@ -202,7 +237,8 @@ class PushedSample {
         kept.push_back(f);
     out.triangles.resize(static_cast<long>(kept.size()), 3);
     for (size_t k = 0; k < kept.size(); ++k)
-      for (int c = 0; c < 3; ++c) out.triangles(static_cast<long>(k), c) = index[mesh_.triangles(kept[k], c)];
+      for (int c = 0; c < 3; ++c)
+        out.triangles(static_cast<long>(k), c) = index[mesh_.triangles(kept[k], c)];
     return out;
   }
   void Restore(const Vertices& state, double overhang) {
@@ -215,8 +251,11 @@ class PushedSample {
   const AcpmOptions& options_;
   AcpmSeam seam_;
   ShellAcpmSettings settings_;
+  // Seams closer than this fraction of the width to a side edge lie on the edge.
+  static constexpr double kEdgeSnap = 1e-9;
   int nx_ = 0;
   double platform_ = 0.0;
+  int platform_rows_ = 1;  // held rows behind the edge (x < 0)
   std::vector<double> ys_;
   double seam_z_ = 0.0;
   std::unique_ptr<ClothProblem> problem_;
@@ -243,8 +282,8 @@ AcpmCrossings Push(const Material& material, const AcpmOptions& options, const A
     // Warm start from the nearest solved overhang.
     if (!solved.empty()) {
       auto it = solved.lower_bound(overhang);
-      if (it == solved.end() || (it != solved.begin() &&
-                                 overhang - std::prev(it)->first < it->first - overhang))
+      if (it == solved.end() ||
+          (it != solved.begin() && overhang - std::prev(it)->first < it->first - overhang))
         it = it == solved.begin() ? it : std::prev(it);
       sample.Restore(it->second.state, it->first);
     }
@@ -261,10 +300,13 @@ AcpmCrossings Push(const Material& material, const AcpmOptions& options, const A
     if (!s) return out;
     if (*std::max_element(s->front.begin(), s->front.end()) <= 0.0) break;
     if (overhang >= options.length) {
-      out.message = "does not reach the barrier within " +
-                    std::to_string(static_cast<int>(std::lround(units::MToMm(options.length)))) +
-                    " mm (shell model)";
-      return out;
+      // Bad input, as for the plain fabric (ShellAcpmCrossings).
+      throw InputError(std::string(seam.direction == AcpmSeamDirection::kNone
+                                       ? "the fabric"
+                                       : "the fabric with the seam") +
+                       " does not reach the barrier within " + MmText(options.length) +
+                       " mm (shell model): too stiff for a " + MmText(options.length) +
+                       " mm sample on this tester");
     }
     overhang = std::min(overhang + step, options.length);
   }
@@ -360,9 +402,17 @@ AcpmCrossings ShellAcpmCrossings(const Material& material, const AcpmOptions& op
   if (!options.Check(&why)) throw InputError(why);
   const Clock::time_point deadline = DeadlineAfter(settings.max_seconds);
   // The plain fabric's exact crossing sets the scale of the grid and the push.
-  const BarrierCrossing plain_exact = FindBarrierCrossing(material.EffectiveLaw(),
-                                                          material.areal_density);
+  // Within the sample's length (options.length), as the elastica model searches.
+  CrossingOptions search;
+  search.barrier_angle = options.barrier_angle;
+  search.max_length = options.length;
+  const BarrierCrossing plain_exact =
+      FindBarrierCrossing(material.EffectiveLaw(), material.areal_density, search);
   if (!plain_exact.converged) {
+    // Too stiff for the tester is bad input, as in the elastica model (acpm.h, RunAcpm).
+    if (plain_exact.message.rfind("does not reach the barrier", 0) == 0)
+      throw InputError("the fabric " + plain_exact.message + ": too stiff for a " +
+                       MmText(options.length) + " mm sample on this tester");
     AcpmCrossings out;
     out.message = "shell model: " + plain_exact.message;
     return out;
@@ -399,7 +449,7 @@ AcpmCrossings ShellAcpmCrossings(const Material& material, const AcpmOptions& op
   const AcpmCrossings plain = run(AcpmSeam{}, centre, &coarse);
   if (!plain.converged) {
     result.converged = false;
-    result.message = "plain reference: " + plain.message;
+    result.message = "shell model: plain reference: " + plain.message;
     return result;
   }
   const double correction = plain.overhang.front() / coarse.overhang.front();
@@ -423,7 +473,7 @@ bool CantileverAt(PushedSample* sample, double overhang, double width, std::vect
                   std::vector<double>* y, std::string* message) {
   double reached = 0.25 * overhang;  // nominally: the flat start
   double step = 0.15 * overhang;
-  Vertices good;                     // empty: start flat
+  Vertices good;  // empty: start flat
   while (reached < overhang) {
     const double next = std::min(overhang, reached + step);
     if (sample->Solve(next, message)) {
@@ -445,8 +495,10 @@ ShellCantilever SolveShellCantilever(const Material& material, double overhang, 
                                      const ShellAcpmSettings& settings) {
   std::string why;
   if (!settings.Check(&why)) throw InputError(why);
-  if (!(overhang > 0.0 && overhang <= 1.0)) throw InputError("shell cantilever: overhang must lie in (0, 1000] mm");
-  if (!(width > 0.0 && width <= 0.2)) throw InputError("shell cantilever: width must lie in (0, 200] mm");
+  if (!(overhang > 0.0 && overhang <= 1.0))
+    throw InputError("shell cantilever: overhang must lie in (0, 1000] mm");
+  if (!(width > 0.0 && width <= 0.2))
+    throw InputError("shell cantilever: width must lie in (0, 200] mm");
   AcpmOptions options;
   options.width = width;
   options.length = overhang;
@@ -458,8 +510,7 @@ ShellCantilever SolveShellCantilever(const Material& material, double overhang, 
   out.vertices = coarse.num_vertices();
   std::ostringstream notes;
   notes << std::setprecision(2) << "elements "
-        << units::MToMm(overhang / CellsAlong(overhang, settings.element_length))
-        << " mm along";
+        << units::MToMm(overhang / CellsAlong(overhang, settings.element_length)) << " mm along";
   if (settings.extrapolate) {
     const ShellAcpmSettings half = HalvedSettings(settings, overhang);
     PushedSample fine(material, options, AcpmSeam{}, half, overhang, deadline);

@@ -37,9 +37,10 @@ struct DrapeArgs {
   std::optional<double> contact_sink_mm;
   std::optional<double> seam_refine_mm;
   std::optional<double> compression_ratio;
-  std::string rim_mm = "auto";  // a length [mm], 0 (off) or "auto" (the default)
-  double rim_band_mm = 20.0;
-  double specimen_mm = 150.0, support_mm = 90.0, shift_mm = 50.0, perturbation_mm = 2.0;
+  std::string rim_mm = "auto";        // a length [mm], 0 (off) or "auto" (the default)
+  std::optional<double> rim_band_mm;  // default: 20 mm, or a third of a smaller overhang
+  std::optional<double> shift_mm;     // --seams shifted only; default 50 mm
+  double specimen_mm = 150.0, support_mm = 90.0, perturbation_mm = 2.0;
   double frame_deg = 0.0;
   std::optional<double> tolerance;
   double max_seconds = 600.0;
@@ -116,12 +117,19 @@ DrapeOptions Options(const DrapeArgs& a) {
   if (a.specimen_mm <= a.support_mm)
     throw InputError("--specimen-mm: the specimen (" + Num(a.specimen_mm) +
                      " mm) must be larger than the support (" + Num(a.support_mm) + " mm)");
-  o.seam_shift = units::MmToM(finite(a.shift_mm, "--shift-mm"));
-  if (std::abs(a.shift_mm) >= a.specimen_mm) throw InputError("--shift-mm: the seam must cross the specimen");
+  if (a.shift_mm && o.seams != DrapeSeams::kShifted)
+    throw InputError("--shift-mm: needs --seams shifted (the other seams run through the centre)");
+  const double shift_mm = a.shift_mm ? finite(*a.shift_mm, "--shift-mm") : 50.0;
+  if (std::abs(shift_mm) >= a.specimen_mm)
+    throw InputError("--shift-mm: the seam must cross the specimen");
+  o.seam_shift = units::MmToM(shift_mm);
   o.perturbation = units::MmToM(finite(a.perturbation_mm, "--perturbation-mm"));
   if (!(a.perturbation_mm > 0.0 && a.perturbation_mm <= a.specimen_mm))
-    throw InputError("--perturbation-mm: must be in (0, the specimen radius " + Num(a.specimen_mm) + " mm]");
-  o.frame_angle = finite(a.frame_deg, "--frame-deg") * kDegree;
+    throw InputError("--perturbation-mm: must be in (0, the specimen radius " + Num(a.specimen_mm) +
+                     " mm]");
+  // Reduced exactly to (-180, 180]: past about 1e16 degrees a product with π/180 has no
+  // fraction of a turn left, and cos and sin of it say nothing.
+  o.frame_angle = std::remainder(finite(a.frame_deg, "--frame-deg"), 360.0) * kDegree;
   if (a.seeds < 1 || a.seeds > 1000) throw InputError("--seeds: must be in 1..1000");
   o.seeds = a.seeds;
   o.first_seed = a.first_seed;
@@ -134,6 +142,18 @@ DrapeOptions Options(const DrapeArgs& a) {
     o.element_size = units::MmToM(h);
   }
   o.element_size = std::min(o.element_size, 0.25 * (o.specimen_radius - o.support_radius));
+  // The support circle is meshed with 24 chords or more; far below an element they are not
+  // meshable (the mesher merges points closer than 1e-3 of the element size).
+  if (o.support_radius < 0.25 * o.element_size)
+    throw InputError("--support-mm: must be at least a quarter of the element size (" +
+                     Num(0.25 * units::MToMm(o.element_size)) + " mm; --resolution-mm " +
+                     Num(units::MToMm(o.element_size)) + " mm)");
+  if (o.seams == DrapeSeams::kShifted && std::abs(o.seam_shift) > MaxSeamShift(o) * (1.0 + 1e-12))
+    throw InputError(
+        "--shift-mm: the shifted seam must lie at least one element (" +
+        Num(units::MToMm(o.element_size)) +
+        " mm) inside the specimen's edge: |shift| <= " + Num(units::MToMm(MaxSeamShift(o))) +
+        " mm" + (a.shift_mm ? std::string() : std::string(" (the default is 50 mm)")));
   if (a.rim_mm != "auto") {  // "auto" needs the material: Run
     char* end = nullptr;
     const double rim = std::strtod(a.rim_mm.c_str(), &end);
@@ -145,7 +165,12 @@ DrapeOptions Options(const DrapeArgs& a) {
     }
     o.rim_element_size = units::MmToM(rim);
   }
-  const double band = finite(a.rim_band_mm, "--rim-band-mm");
+  if (a.rim_band_mm && a.rim_mm != "auto" && o.rim_element_size == 0.0)
+    throw InputError("--rim-band-mm: needs a finer rim (--rim-mm auto or a size, not 0)");
+  // The default band, 20 mm, is a third of the default overhang; a smaller overhang gets a
+  // third of itself (as the default --resolution-mm shrinks to a quarter of it).
+  const double band = a.rim_band_mm ? finite(*a.rim_band_mm, "--rim-band-mm")
+                                    : std::min(20.0, (a.specimen_mm - a.support_mm) / 3.0);
   if (!(band >= 0.0 && band <= a.specimen_mm - a.support_mm)) {
     throw InputError("--rim-band-mm: must be between 0 and the overhang (" +
                      Num(a.specimen_mm - a.support_mm) + " mm)");
@@ -159,13 +184,16 @@ DrapeOptions Options(const DrapeArgs& a) {
       throw InputError("--contact-sink-mm: must be between 1e-06 and 0.03 mm");
     o.contact_sink = units::MmToM(sink);
   }
-  if (a.coarse && a.no_coarse) throw InputError("--coarse-to-fine and --no-coarse-to-fine: give one");
+  if (a.coarse && a.no_coarse)
+    throw InputError("--coarse-to-fine and --no-coarse-to-fine: give one");
   o.coarse_to_fine = a.coarse;
-  if (a.extrapolate && a.no_extrapolate) throw InputError("--extrapolate and --no-extrapolate: give one");
+  if (a.extrapolate && a.no_extrapolate)
+    throw InputError("--extrapolate and --no-extrapolate: give one");
   if (a.extrapolate && a.rim_mm != "auto" && o.rim_element_size == 0.0)
     throw InputError("--extrapolate: needs a rim band (--rim-mm auto or a size, not 0)");
   if (a.tolerance) {
-    if (!(*a.tolerance > 0.0) || *a.tolerance > 0.1) throw InputError("--tolerance: must be in (0, 0.1]");
+    if (!(*a.tolerance > 0.0) || *a.tolerance > 0.1)
+      throw InputError("--tolerance: must be in (0, 0.1]");
     o.solver.tolerance = *a.tolerance;
   }
   if (!(std::isfinite(a.max_seconds) && a.max_seconds > 0.0))
@@ -198,13 +226,15 @@ std::string OutlineCsv(const DrapeSeedResult& s) {
 std::string DrapedPly(const DrapeResult& r, const DrapeSeedResult& s) {
   TriangleMesh draped = r.mesh;
   draped.vertices = s.positions;
-  std::vector<VertexScalar> scalars = {{"rest_x", r.mesh.vertices.col(0)}, {"rest_y", r.mesh.vertices.col(1)}};
+  std::vector<VertexScalar> scalars = {{"rest_x", r.mesh.vertices.col(0)},
+                                       {"rest_y", r.mesh.vertices.col(1)}};
   if (!r.seam_lines.empty()) {
     Eigen::VectorXd d(r.mesh.num_vertices());
     for (int v = 0; v < r.mesh.num_vertices(); ++v) {
       d(v) = std::numeric_limits<double>::infinity();
       for (const SeamLine& line : r.seam_lines)
-        d(v) = std::min(d(v), DistanceToSeamLine(r.mesh.vertices.row(v).head<2>().transpose(), line));
+        d(v) =
+            std::min(d(v), DistanceToSeamLine(r.mesh.vertices.row(v).head<2>().transpose(), line));
     }
     scalars.push_back({"seam_distance", d});
   }
@@ -229,14 +259,15 @@ cv::Mat ShadowImage(const DrapeResult& r, const DrapeSeedResult& s, const DrapeO
       const int i = static_cast<int>(std::lround((x - sh.origin_x) / sh.cell));
       const int j = static_cast<int>(std::lround((y - sh.origin_y) / sh.cell));
       if (i < 0 || j < 0 || i >= sh.width || j >= sh.height) continue;
-      if (sh.mask[static_cast<size_t>(j) * sh.width + i]) img.at<cv::Vec3b>(v, u) = cv::Vec3b(70, 60, 50);
+      if (sh.mask[static_cast<size_t>(j) * sh.width + i])
+        img.at<cv::Vec3b>(v, u) = cv::Vec3b(70, 60, 50);
     }
   }
   const cv::Point centre = to_px(0.0, 0.0);
-  cv::circle(img, centre, static_cast<int>(o.specimen_radius * px_per_m), cv::Scalar(160, 160, 160), 1,
-             cv::LINE_AA);
-  cv::circle(img, centre, static_cast<int>(o.support_radius * px_per_m), cv::Scalar(60, 160, 240), 2,
-             cv::LINE_AA);
+  cv::circle(img, centre, static_cast<int>(o.specimen_radius * px_per_m), cv::Scalar(160, 160, 160),
+             1, cv::LINE_AA);
+  cv::circle(img, centre, static_cast<int>(o.support_radius * px_per_m), cv::Scalar(60, 160, 240),
+             2, cv::LINE_AA);
   for (const auto& path : r.seam_paths) {
     for (size_t k = 1; k < path.size(); ++k) {
       cv::line(img, to_px(s.positions(path[k - 1], 0), s.positions(path[k - 1], 1)),
@@ -246,29 +277,38 @@ cv::Mat ShadowImage(const DrapeResult& r, const DrapeSeedResult& s, const DrapeO
   }
   for (size_t k = 0; k < s.nodes.angles.size(); ++k) {
     const double t = s.nodes.angles[k], rad = s.nodes.radii[k];
-    cv::circle(img, to_px(rad * std::cos(t), rad * std::sin(t)), 6, cv::Scalar(40, 200, 40), 2, cv::LINE_AA);
+    cv::circle(img, to_px(rad * std::cos(t), rad * std::sin(t)), 6, cv::Scalar(40, 200, 40), 2,
+               cv::LINE_AA);
   }
   std::ostringstream caption;
   caption.precision(3);
   caption << "DC " << s.drape_coefficient << ", " << s.nodes.angles.size() << " nodes, seams "
           << DrapeSeamsName(o.seams) << ", seed " << s.seed;
-  cv::putText(img, caption.str(), cv::Point(12, 28), cv::FONT_HERSHEY_SIMPLEX, 0.7, cv::Scalar(30, 30, 30), 2,
-              cv::LINE_AA);
+  cv::putText(img, caption.str(), cv::Point(12, 28), cv::FONT_HERSHEY_SIMPLEX, 0.7,
+              cv::Scalar(30, 30, 30), 2, cv::LINE_AA);
   return img;
 }
 
 nlohmann::json SummaryJson(const SolveSummary& s) {
-  return {{"converged", s.converged},   {"method", s.method},
-          {"message", s.message},       {"iterations", s.iterations},
+  return {{"converged", s.converged},
+          {"method", s.method},
+          {"message", s.message},
+          {"iterations", s.iterations},
           {"coarse_iterations", s.coarse_iterations},
-          {"factorizations", s.factorizations}, {"exact_hessian_steps", s.exact_steps},
+          {"factorizations", s.factorizations},
+          {"exact_hessian_steps", s.exact_steps},
           {"friction_slips", s.slips},
-          {"residual", s.residual},     {"energy_J", s.energy},
-          {"seconds", s.seconds},       {"coarse_seconds", s.coarse_seconds},
-          {"contacts", s.contacts},     {"anchors", s.anchors}};
+          {"residual", s.residual},
+          {"energy_J", s.energy},
+          {"seconds", s.seconds},
+          {"coarse_seconds", s.coarse_seconds},
+          {"contacts", s.contacts},
+          {"anchors", s.anchors}};
 }
 
-nlohmann::json NumberOrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+nlohmann::json NumberOrNull(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
 
 nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Material& m,
                           const DrapeArgs& a, double turn_down) {
@@ -287,14 +327,17 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
   j["mean_radius_sd_mm"] = NumberOrNull(units::MToMm(r.mean_radius_sd));
   j["seeds"] = nlohmann::json::array();
   for (const DrapeSeedResult& s : r.per_seed) {
-    nlohmann::json js = {{"seed", s.seed}, {"converged", s.converged}, {"solver", SummaryJson(s.summary)}};
-    if (o.rim_extrapolation && s.summary.converged) js["split_solver"] = SummaryJson(s.split_summary);
+    nlohmann::json js = {
+        {"seed", s.seed}, {"converged", s.converged}, {"solver", SummaryJson(s.summary)}};
+    if (o.rim_extrapolation && s.summary.converged)
+      js["split_solver"] = SummaryJson(s.split_summary);
     if (s.converged) {
       js["drape_coefficient"] = s.drape_coefficient;
       if (o.rim_extrapolation) {
         js["base_drape_coefficient"] = s.base_drape_coefficient;
         js["split_drape_coefficient"] = s.split_drape_coefficient;
         js["extrapolation_bound"] = s.extrapolation_bound;
+        js["extrapolation_reversed"] = s.extrapolation_reversed;
       }
       js["nodes"] = s.nodes.angles.size();
       js["shadow_area_mm2"] = s.shadow.area * 1e6;
@@ -320,7 +363,8 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
                 {"frame_deg", o.frame_angle / kDegree},
                 {"resolution_mm", units::MToMm(o.element_size)},
                 {"rim_mm", units::MToMm(o.rim_element_size)},
-                {"rim_band_mm", units::MToMm(o.rim_band)},
+                {"rim_band_mm", o.rim_element_size > 0.0 ? nlohmann::json(units::MToMm(o.rim_band))
+                                                         : nlohmann::json()},
                 {"seam_refine_mm", o.seams != DrapeSeams::kNone
                                        ? nlohmann::json(units::MToMm(o.seam_refinement_range))
                                        : nlohmann::json()},
@@ -381,25 +425,39 @@ void Run(const DrapeArgs& a) {
   // at most the element size (which may itself be under 0.5 mm when the overhang is tiny).
   const double rim_if_extrapolating =
       a.rim_mm == "auto" ? AutoRimElementSize(m, o, true) : o.rim_element_size;
-  const bool extrapolate_possible = o.mount == DrapeMount::kClamped &&
-                                    rim_if_extrapolating > 0.0 && o.rim_band >= rim_if_extrapolating;
+  const bool extrapolate_possible = o.mount == DrapeMount::kClamped && rim_if_extrapolating > 0.0 &&
+                                    o.rim_band >= rim_if_extrapolating;
   o.rim_extrapolation = a.extrapolate || (!a.no_extrapolate && extrapolate_possible);
-  if (a.rim_mm == "auto") o.rim_element_size = AutoRimElementSize(m, o, o.rim_extrapolation);
+  bool rim_capped = false;
+  if (a.rim_mm == "auto")
+    o.rim_element_size = AutoRimElementSize(m, o, o.rim_extrapolation, &rim_capped);
   if (std::string why; !o.Check(&why)) throw InputError("drape: " + why);
   const double rim_size = o.rim_element_size > 0.0 ? o.rim_element_size : o.element_size;
   std::string note;  // reported with the result (a refused run prints its one error line only)
   // (An extrapolated DC has no first-order shortfall: no note.)
-  if (const double shortfall = 0.1 * rim_size / turn_down; shortfall > 0.02 && !o.rim_extrapolation &&
-                                                                o.mount == DrapeMount::kClamped) {
+  if (const double shortfall = 0.1 * rim_size / turn_down;
+      shortfall > 0.02 && !o.rim_extrapolation && o.mount == DrapeMount::kClamped) {
     // The estimate is first order in rim / turn-down; past about 0.5 it says only "a lot" (a
     // limp, heavy fabric printed 4e+03 for a DC that cannot exceed 1).
     note = (shortfall > 0.5 ? std::string("DC may be far too low")
                             : "DC may be low by up to about " + Num(shortfall, 1)) +
-           ": the rim's elements (" +
-           Num(units::MToMm(rim_size), 3) + " mm) are coarse against this fabric's turn-down length there (" +
+           ": the rim's elements (" + Num(units::MToMm(rim_size), 3) +
+           " mm) are coarse against this fabric's turn-down length there (" +
            Num(units::MToMm(turn_down), 2) + " mm); " +
-           (o.rim_element_size > 0.0 ? std::string("a smaller --rim-mm") : std::string("--rim-mm auto")) +
+           (o.rim_element_size > 0.0 ? std::string("a smaller --rim-mm")
+                                     : std::string("--rim-mm auto")) +
            " meshes it finer (slower; docs/drapemeter.md)";
+  }
+  if (rim_capped) {
+    // Decision (docs/drapemeter.md): auto stays fast and says so; an explicit --rim-mm meshes
+    // as finely as asked.
+    note += std::string(note.empty() ? "" : "; ") + "--rim-mm auto: the rim's elements (" +
+            Num(units::MToMm(o.rim_element_size), 3) +
+            " mm) are capped to keep the rim band under about " + Num(kAutoRimMaxVertices) +
+            " vertices; this fabric's turn-down length (" + Num(units::MToMm(turn_down), 2) +
+            " mm) asks for " +
+            Num(units::MToMm(std::max(turn_down / (o.rim_extrapolation ? 2.0 : 3.0), 5e-4)), 3) +
+            " mm: give that as --rim-mm for the finer mesh (far slower)";
   }
   AtomicFileSet outputs;
   AtomicFile& result_file = outputs.Add(a.out);
@@ -414,20 +472,24 @@ void Run(const DrapeArgs& a) {
 
   // Progress lines (the mesh, each seed's solves) only on a terminal or with --progress: a
   // failed run's stderr holds its one error line (cli.md).
-  o.progress = [progress = a.progress](const std::string& line) { Progress("drape: " + line, progress); };
+  o.progress = [progress = a.progress](const std::string& line) {
+    Progress("drape: " + line, progress);
+  };
   DrapeResult r;
   try {
     r = SimulateDrape(m, o);
   } catch (const InputError& e) {
     throw InputError(a.material + ": " + e.what());
   }
-  if (!r.converged) throw ComputeError("drape: not converged (" + r.message + "); no drape coefficient");
+  if (!r.converged)
+    throw ComputeError("drape: not converged (" + r.message + "); no drape coefficient");
 
   // A resting fabric that left part of the disk's top bare slid off it or, with contact on the
   // nodes only, passed through it (docs/drapemeter.md, "Fabric through the support"): the
   // support's own shadow keeps the DC ≥ 0, but the drape needs a look.
   double bare = 0.0;
-  for (const DrapeSeedResult& seed : r.per_seed) bare = std::max(bare, seed.shadow.bare_support_area);
+  for (const DrapeSeedResult& seed : r.per_seed)
+    bare = std::max(bare, seed.shadow.bare_support_area);
   if (bare > 0.02 * r.support_area) {  // a coarse rim polygon leaves slivers of up to ~1 %
     char percent[32];
     std::snprintf(percent, sizeof percent, "%.0f", 100.0 * bare / r.support_area);
@@ -449,6 +511,19 @@ void Run(const DrapeArgs& a) {
             Num(units::MToMm(o.contact_sink)) +
             "); on the default mesh 1 mm cost the Fig. 8 fabric's DC about 0.03 "
             "(docs/drapemeter.md, \"Contact stiffness\")";
+  }
+  // The extrapolation assumes the DC converges from below as the rim is refined; a split rim
+  // with a lower DC than the base's reverses the bracket (docs/drapemeter.md, "Extrapolated DC").
+  std::string reversed;
+  for (const DrapeSeedResult& seed : r.per_seed)
+    if (seed.extrapolation_reversed)
+      reversed += (reversed.empty() ? "" : ", ") + std::to_string(seed.seed);
+  if (!reversed.empty()) {
+    note += std::string(note.empty() ? "" : "; ") + "seed" +
+            (reversed.find(',') == std::string::npos ? " " : "s ") + reversed +
+            ": the split rim's DC is below the base's (a reversed bracket): the DC did not "
+            "converge from below as the extrapolation assumes; a finer --rim-mm or "
+            "--resolution-mm should agree before this DC is trusted";
   }
   const DrapeSeedResult& first = r.per_seed.front();
   nlohmann::json j = ResultJson(r, o, m, a, turn_down);
@@ -501,13 +576,15 @@ void Run(const DrapeArgs& a) {
                     : std::string())
             << ")\n";
   for (const DrapeSeedResult& s : r.per_seed) {
-    std::cout << "  seed " << s.seed << ": DC " << Num(s.drape_coefficient, 4) << ", " << s.nodes.angles.size()
-              << " nodes, r " << Num(units::MToMm(s.min_radius), 4) << ".." << Num(units::MToMm(s.max_radius), 4)
-              << " mm, " << s.summary.iterations << " iterations, " << Num(s.summary.seconds, 3) << " s";
+    std::cout << "  seed " << s.seed << ": DC " << Num(s.drape_coefficient, 4) << ", "
+              << s.nodes.angles.size() << " nodes, r " << Num(units::MToMm(s.min_radius), 4) << ".."
+              << Num(units::MToMm(s.max_radius), 4) << " mm, " << s.summary.iterations
+              << " iterations, " << Num(s.summary.seconds, 3) << " s";
     if (o.rim_extrapolation)
       std::cout << "; DC ± " << Num(s.extrapolation_bound, 2) << ": between the split rim's "
-                << Num(s.split_drape_coefficient, 4) << " (" << s.split_summary.iterations << " iterations, "
-                << Num(s.split_summary.seconds, 3) << " s) and " << Num(2.0 * s.split_drape_coefficient - s.base_drape_coefficient, 4)
+                << Num(s.split_drape_coefficient, 4) << " (" << s.split_summary.iterations
+                << " iterations, " << Num(s.split_summary.seconds, 3) << " s) and "
+                << Num(2.0 * s.split_drape_coefficient - s.base_drape_coefficient, 4)
                 << " (first order from the base's " << Num(s.base_drape_coefficient, 4) << ")";
     std::cout << "\n";
   }
@@ -520,11 +597,12 @@ void Run(const DrapeArgs& a) {
       return Num(units::MToMm(mean), 4) + " ± " + Num(std::round(units::MToMm(sd) * 100.0) / 100.0);
     };
     std::cout << "\noutline radius [mm]: min " << radius(r.min_radius, r.min_radius_sd) << ", mean "
-              << radius(r.mean_radius, r.mean_radius_sd) << ", max " << radius(r.max_radius, r.max_radius_sd);
+              << radius(r.mean_radius, r.mean_radius_sd) << ", max "
+              << radius(r.max_radius, r.max_radius_sd);
   }
   if (!note.empty()) std::cout << "\nnote: " << note;
-  std::cout << "\ntime: " << Num(r.seconds, 3) << " s\nresult: " << a.out << "\noutline: " << outline_file.path()
-            << "\n";
+  std::cout << "\ntime: " << Num(r.seconds, 3) << " s\nresult: " << a.out
+            << "\noutline: " << outline_file.path() << "\n";
   if (!a.png.empty()) std::cout << "shadow: " << a.png << "\n";
   if (!a.obj.empty()) std::cout << "mesh: " << a.obj << "\n";
   if (!a.ply.empty()) std::cout << "mesh (PLY): " << a.ply << "\n";
@@ -542,22 +620,29 @@ void RegisterDrape(CLI::App& app) {
       "--seeds 3 -o drape.json --png drape.png");
   sub->add_option("-m,--material", a->material, "Material JSON file (cli.md format)")->required();
   sub->add_option("--seams", a->seams, "none (default), weft, weft+warp or shifted");
-  sub->add_option("--seam-type", a->seam_type, "Table 2 seam type A-plain .. C-twill (default C-plain)");
-  sub->add_option("--seam-file", a->seam_file, "Seam JSON file (from fit-seam) instead of --seam-type");
+  sub->add_option("--seam-type", a->seam_type,
+                  "Table 2 seam type A-plain .. C-twill (default C-plain)");
+  sub->add_option("--seam-file", a->seam_file,
+                  "Seam JSON file (from fit-seam) instead of --seam-type");
   sub->add_option("--seam-rib", a->seam_rib,
                   "Lengthwise stiffness of the seam band as a factor on S (>= 1; default the "
                   "seam file's rib_factor, 1 for the presets: the paper's model; docs/seams.md)");
-  sub->add_option("--mount", a->mount, "clamped (default: held between two disks) or resting (lies on the disk, "
-                  "held by Coulomb friction, the material's friction; one solve unless --extrapolate)");
+  sub->add_option(
+      "--mount", a->mount,
+      "clamped (default: held between two disks) or resting (lies on the disk, "
+      "held by Coulomb friction, the material's friction; one solve unless --extrapolate)");
   sub->add_option("--seeds", a->seeds, "Number of perturbations (repeated tests; default 1)");
   sub->add_option("--first-seed", a->first_seed, "First seed (default 1)");
-  sub->add_option("--resolution-mm", a->resolution_mm, "Element size away from seams [mm] (default 12)");
-  sub->add_option("--rim-mm", a->rim_mm,
-                  "Element size along the support's rim [mm]; auto (the default): half the fabric's "
-                  "turn-down length when extrapolating, else a third; 0: no finer rim and no "
-                  "extrapolation (10x faster; clamped: DC about 0.1 low; docs/drapemeter.md)");
+  sub->add_option("--resolution-mm", a->resolution_mm,
+                  "Element size away from seams [mm] (default 12)");
+  sub->add_option(
+      "--rim-mm", a->rim_mm,
+      "Element size along the support's rim [mm]; auto (the default): half the fabric's "
+      "turn-down length when extrapolating, else a third; 0: no finer rim and no "
+      "extrapolation (10x faster; clamped: DC about 0.1 low; docs/drapemeter.md)");
   sub->add_option("--rim-band-mm", a->rim_band_mm,
-                  "Width of that finer band beyond the rim [mm] (default 20)");
+                  "Width of that finer band beyond the rim [mm] (default 20, or a third of an "
+                  "overhang under 60 mm)");
   sub->add_option("--contact-sink-mm", a->contact_sink_mm,
                   "Resting mount: the contact's stiffness, as how far a node sinks into the "
                   "support under its own weight [mm] (1e-6 to 0.03, default 0.01; 0.001 sinks "
@@ -574,27 +659,36 @@ void RegisterDrape(CLI::App& app) {
       "--seam-refine-mm", a->seam_refine_mm,
       "Refine the mesh within this distance of the seam lines [mm]: element area / ceil(S(d)) "
       "(Pabst 4.3; default 0: off; docs/drapemeter.md, \"Seam refinement\")");
-  sub->add_option("--shift-mm", a->shift_mm, "Offset of the shifted seam from the centre [mm] (default 50)");
-  sub->add_option("--perturbation-mm", a->perturbation_mm, "Start perturbation at the rim [mm] (default 2)");
-  sub->add_option("--frame-deg", a->frame_deg, "Rotate seams and perturbation about the centre [deg]");
-  sub->add_option("--tolerance", a->tolerance, "Solver tolerance on the residual / weight (default 1e-4)");
-  sub->add_option("--max-seconds", a->max_seconds, "Solver wall-time cap per level and seed [s] (default 600)");
+  sub->add_option("--shift-mm", a->shift_mm,
+                  "Offset of the shifted seam from the centre [mm] (default 50)");
+  sub->add_option("--perturbation-mm", a->perturbation_mm,
+                  "Start perturbation at the rim [mm] (default 2)");
+  sub->add_option("--frame-deg", a->frame_deg,
+                  "Rotate seams and perturbation about the centre [deg]");
+  sub->add_option("--tolerance", a->tolerance,
+                  "Solver tolerance on the residual / weight (default 1e-4)");
+  sub->add_option("--max-seconds", a->max_seconds,
+                  "Solver wall-time cap per level and seed [s] (default 600)");
   sub->add_flag("--coarse-to-fine", a->coarse, "Solve on a mesh twice as coarse first (cascadic)");
   sub->add_flag("--no-coarse-to-fine", a->no_coarse, "Solve on the fine mesh only (the default)");
-  sub->add_flag("--extrapolate", a->extrapolate,
-                "Split the rim band's triangles, solve again from the drape and report the middle of "
-                "the bracket the two DCs give for a zero rim element (the default where it applies: "
-                "clamped, with a rim band)");
+  sub->add_flag(
+      "--extrapolate", a->extrapolate,
+      "Split the rim band's triangles, solve again from the drape and report the middle of "
+      "the bracket the two DCs give for a zero rim element (the default where it applies: "
+      "clamped, with a rim band)");
   sub->add_flag("--no-extrapolate", a->no_extrapolate, "One solve on the rim band as meshed");
-  sub->add_option("-o,--output", a->out, "Result JSON file; the outline CSV goes next to it")->required();
+  sub->add_option("-o,--output", a->out, "Result JSON file; the outline CSV goes next to it")
+      ->required();
   sub->add_option("--png", a->png, "Top-view shadow picture (PNG)");
   sub->add_option("--obj", a->obj, "Draped mesh of the first seed (OBJ)");
-  sub->add_option("--ply", a->ply,
-                  "Draped mesh of the first seed (ASCII PLY, metres) with each vertex's pattern position "
-                  "rest_x, rest_y and, with seams, its distance to the nearest seam line seam_distance [m]");
-  sub->add_flag("--progress", a->progress,
-                "Print the progress lines (the mesh, each seed's solves) on stderr even when it is not a "
-                "terminal");
+  sub->add_option(
+      "--ply", a->ply,
+      "Draped mesh of the first seed (ASCII PLY, metres) with each vertex's pattern position "
+      "rest_x, rest_y and, with seams, its distance to the nearest seam line seam_distance [m]");
+  sub->add_flag(
+      "--progress", a->progress,
+      "Print the progress lines (the mesh, each seed's solves) on stderr even when it is not a "
+      "terminal");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   sub->callback([a] { Run(*a); });
 }

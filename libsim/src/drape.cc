@@ -42,6 +42,10 @@ SeamLine Chord(double radius, double angle, double offset) {
   return line;
 }
 
+// The frame angle reduced to (-π, π] (exactly: std::remainder is exact), so that a huge angle
+// (1e17°) is a rotation like any other rather than cos/sin of a number with no digits left.
+double Frame(const DrapeOptions& o) { return std::remainder(o.frame_angle, 2.0 * kPi); }
+
 // The support circle as an open polyline covering all but one segment (so that no two embedded
 // lines share an end point); starting half a segment off the axes, where seams run.
 Polyline2 SupportCircle(double radius, int segments, double frame) {
@@ -81,8 +85,8 @@ Pattern MeshPattern(const DrapeOptions& o, const std::vector<Seam>& seams, doubl
   const double rim = scale * o.rim_element_size;  // 0: no rim band
   std::vector<Polyline2> lines;
   for (const Seam& s : seams) lines.push_back(Polyline2(s.line));
-  lines.push_back(SupportCircle(o.support_radius,
-                                CircleSegments(o, rim > 0.0 ? rim : element_size), o.frame_angle));
+  lines.push_back(
+      SupportCircle(o.support_radius, CircleSegments(o, rim > 0.0 ? rim : element_size), Frame(o)));
   PatternMeshOptions mo;
   mo.element_size = element_size;
   if (rim > 0.0) {
@@ -134,7 +138,8 @@ Pattern SplitRim(const Pattern& base, const DrapeOptions& o, RefinedMesh* refine
     std::vector<int> out;
     for (size_t i = 0; i < path.size(); ++i) {
       if (i > 0) {
-        const auto it = midpoint.find({std::min(path[i - 1], path[i]), std::max(path[i - 1], path[i])});
+        const auto it =
+            midpoint.find({std::min(path[i - 1], path[i]), std::max(path[i - 1], path[i])});
         if (it != midpoint.end()) {
           out.push_back(it->second);
           if (p.pm.vertex_seam[static_cast<size_t>(it->second)] < 0)
@@ -167,7 +172,7 @@ Vertices StartState(const TriangleMesh& mesh, const DrapeOptions& o, unsigned se
     const double r = std::hypot(x(v, 0), x(v, 1));
     x(v, 2) = lift;
     if (r <= o.support_radius || total == 0.0) continue;
-    const double theta = std::atan2(x(v, 1), x(v, 0)) - o.frame_angle;
+    const double theta = std::atan2(x(v, 1), x(v, 0)) - Frame(o);
     double w = 0.0;
     for (size_t i = 0; i < c.size(); ++i)
       w += c[i] * std::cos((o.min_harmonic + static_cast<int>(i)) * theta + phi[i]);
@@ -238,10 +243,14 @@ DrapeMount ParseDrapeMount(const std::string& name) {
 
 std::string DrapeSeamsName(DrapeSeams seams) {
   switch (seams) {
-    case DrapeSeams::kNone: return "none";
-    case DrapeSeams::kWeft: return "weft";
-    case DrapeSeams::kWeftWarp: return "weft+warp";
-    case DrapeSeams::kShifted: return "shifted";
+    case DrapeSeams::kNone:
+      return "none";
+    case DrapeSeams::kWeft:
+      return "weft";
+    case DrapeSeams::kWeftWarp:
+      return "weft+warp";
+    case DrapeSeams::kShifted:
+      return "shifted";
   }
   return "none";
 }
@@ -288,6 +297,10 @@ bool DrapeOptions::Check(std::string* why) const {
   if (!Finite(start_droop) || start_droop < 0.0 || start_droop > 0.5 * kPi)
     return Fail(why, "start_droop: must be in [0, π/2]");
   if (!Finite(frame_angle)) return Fail(why, "frame_angle: must be finite");
+  // The support circle's 24 or more chords must stay far above the mesher's snap (1e-3 of the
+  // element size): at R_s = h/4 they are 0.065 h long.
+  if (Finite(element_size) && support_radius < 0.25 * element_size)
+    return Fail(why, "support_radius: must be at least a quarter of element_size");
   if (!Finite(element_size) || element_size <= 0.0 ||
       element_size > 0.5 * (specimen_radius - support_radius))
     return Fail(why, "element_size: must be in (0, half the overhang]");
@@ -299,7 +312,8 @@ bool DrapeOptions::Check(std::string* why) const {
   if (!Finite(rim_band) || rim_band < 0.0 || rim_band > specimen_radius - support_radius)
     return Fail(why, "rim_band: must be in [0, the overhang]");
   if (coarse_to_fine && mount == DrapeMount::kResting)
-    return Fail(why, "coarse_to_fine: clamped mount only (the fine level would restart the friction)");
+    return Fail(why,
+                "coarse_to_fine: clamped mount only (the fine level would restart the friction)");
   if (rim_extrapolation && rim_element_size == 0.0)
     return Fail(why, "rim_extrapolation: needs a rim band (rim_element_size > 0)");
   if (rim_extrapolation && rim_band < rim_element_size)
@@ -316,6 +330,10 @@ bool DrapeOptions::Check(std::string* why) const {
   }
   if (!Finite(seam_shift) || std::abs(seam_shift) >= specimen_radius)
     return Fail(why, "seam_shift: must be inside the specimen");
+  if (seams == DrapeSeams::kShifted && std::abs(seam_shift) > MaxSeamShift(*this) * (1.0 + 1e-12))
+    return Fail(why,
+                "seam_shift: the shifted seam must lie at least one element (element_size) "
+                "inside the specimen's edge");
   if (!Finite(seam_refinement_range) || seam_refinement_range < 0.0)
     return Fail(why, "seam_refinement_range: must be ≥ 0");
   std::string w;
@@ -324,7 +342,8 @@ bool DrapeOptions::Check(std::string* why) const {
     return Fail(why, "raster_cell: must be in (0, specimen_radius / 20]");
   if (specimen_radius / raster_cell > 4000.0)
     return Fail(why, "raster_cell: too fine for this specimen (over 8000 cells across)");
-  if (outline_bins < 8 || outline_bins > 100000) return Fail(why, "outline_bins: must be in 8..100000");
+  if (outline_bins < 8 || outline_bins > 100000)
+    return Fail(why, "outline_bins: must be in 8..100000");
   if (smoothing_bins < 1 || smoothing_bins % 2 == 0 || smoothing_bins > outline_bins / 4)
     return Fail(why, "smoothing_bins: must be odd, ≥ 1 and at most a quarter of outline_bins");
   if (!Finite(node_prominence) || node_prominence < 0.0)
@@ -352,14 +371,17 @@ DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double 
   const double lo_y = std::min(x.col(1).minCoeff(), -support_radius);
   const double hi_y = std::max(x.col(1).maxCoeff(), support_radius);
   const double cells_x = (hi_x - lo_x) / cell, cells_y = (hi_y - lo_y) / cell;
-  if (cells_x * cells_y > 1e8) throw InputError("shadow: the projection spans over 1e8 raster cells");
+  if (cells_x * cells_y > 1e8)
+    throw InputError("shadow: the projection spans over 1e8 raster cells");
   // Two empty cells of margin on every side, so the border is outside the shadow.
   s.width = static_cast<int>(std::ceil(cells_x)) + 5;
   s.height = static_cast<int>(std::ceil(cells_y)) + 5;
   s.origin_x = lo_x - 2.0 * cell;
   s.origin_y = lo_y - 2.0 * cell;
   s.mask.assign(static_cast<size_t>(s.width) * s.height, 0);
-  auto at = [&](int i, int j) -> std::uint8_t& { return s.mask[static_cast<size_t>(j) * s.width + i]; };
+  auto at = [&](int i, int j) -> std::uint8_t& {
+    return s.mask[static_cast<size_t>(j) * s.width + i];
+  };
 
   for (int f = 0; f < triangles.rows(); ++f) {
     const Eigen::Vector2d a = x.row(triangles(f, 0)).head<2>().transpose();
@@ -368,10 +390,16 @@ DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double 
     const double area2 = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
     if (area2 == 0.0) continue;  // seen edge-on: its neighbours cover its line
     const double sign = area2 > 0.0 ? 1.0 : -1.0;
-    const int i0 = std::max(0, static_cast<int>(std::floor((std::min({a.x(), b.x(), c.x()}) - s.origin_x) / cell)));
-    const int i1 = std::min(s.width - 1, static_cast<int>(std::ceil((std::max({a.x(), b.x(), c.x()}) - s.origin_x) / cell)));
-    const int j0 = std::max(0, static_cast<int>(std::floor((std::min({a.y(), b.y(), c.y()}) - s.origin_y) / cell)));
-    const int j1 = std::min(s.height - 1, static_cast<int>(std::ceil((std::max({a.y(), b.y(), c.y()}) - s.origin_y) / cell)));
+    const int i0 = std::max(
+        0, static_cast<int>(std::floor((std::min({a.x(), b.x(), c.x()}) - s.origin_x) / cell)));
+    const int i1 = std::min(
+        s.width - 1,
+        static_cast<int>(std::ceil((std::max({a.x(), b.x(), c.x()}) - s.origin_x) / cell)));
+    const int j0 = std::max(
+        0, static_cast<int>(std::floor((std::min({a.y(), b.y(), c.y()}) - s.origin_y) / cell)));
+    const int j1 = std::min(
+        s.height - 1,
+        static_cast<int>(std::ceil((std::max({a.y(), b.y(), c.y()}) - s.origin_y) / cell)));
     // Edge functions, inclusive (a cell centre on a shared edge belongs to both triangles).
     auto edge = [sign](const Eigen::Vector2d& p, const Eigen::Vector2d& q, double px, double py) {
       return sign * ((q.x() - p.x()) * (py - p.y()) - (q.y() - p.y()) * (px - p.x()));
@@ -503,6 +531,11 @@ DrapeNodes FindNodes(const Eigen::VectorXd& radii, int smoothing_bins, double mi
   return nodes;
 }
 
+RimExtrapolation ExtrapolateRim(double base_dc, double split_dc) {
+  const double step = split_dc - base_dc;
+  return {split_dc + 0.5 * step, 0.5 * std::abs(step), step < 0.0};
+}
+
 double DrapeCoefficient(double shadow_area, double specimen_area, double support_area) {
   if (!(support_area > 0.0) || !(specimen_area > support_area) || !Finite(specimen_area))
     throw InputError("drape coefficient: need specimen area > support area > 0");
@@ -511,15 +544,21 @@ double DrapeCoefficient(double shadow_area, double specimen_area, double support
   return (shadow_area - support_area) / (specimen_area - support_area);
 }
 
+double MaxSeamShift(const DrapeOptions& o) { return o.specimen_radius - o.element_size; }
+
 std::vector<SeamLine> DrapeSeamLines(const DrapeOptions& o) {
   // The pattern's x axis is the warp (bending_element.h), y the weft.
-  const double weft = o.frame_angle + 0.5 * kPi, warp = o.frame_angle;
+  const double weft = Frame(o) + 0.5 * kPi, warp = Frame(o);
   const double r = o.specimen_radius;
   switch (o.seams) {
-    case DrapeSeams::kNone: return {};
-    case DrapeSeams::kWeft: return {Chord(r, weft, 0.0)};
-    case DrapeSeams::kWeftWarp: return {Chord(r, weft, 0.0), Chord(r, warp, 0.0)};
-    case DrapeSeams::kShifted: return {Chord(r, weft, -o.seam_shift)};
+    case DrapeSeams::kNone:
+      return {};
+    case DrapeSeams::kWeft:
+      return {Chord(r, weft, 0.0)};
+    case DrapeSeams::kWeftWarp:
+      return {Chord(r, weft, 0.0), Chord(r, warp, 0.0)};
+    case DrapeSeams::kShifted:
+      return {Chord(r, weft, -o.seam_shift)};
   }
   return {};
 }
@@ -536,9 +575,18 @@ double RimTurnDownLength(const Material& material, const DrapeOptions& o) {
   return std::sqrt(b / (material.areal_density * g * overhang));
 }
 
-double AutoRimElementSize(const Material& material, const DrapeOptions& o, bool extrapolate) {
+double AutoRimElementSize(const Material& material, const DrapeOptions& o, bool extrapolate,
+                          bool* capped) {
   const double turn_down = RimTurnDownLength(material, o);
-  return std::min(std::max(turn_down / (extrapolate ? 2.0 : 3.0), 0.0005), o.element_size);
+  // Vertices of the band (from the rim to rim_band past it) at element e: about 1.155 A / e²
+  // on equilateral triangles. A limp fabric's ℓ/2 (0.5 mm) gave 67k vertices (251k split) and
+  // minutes of solving without a word; the cap keeps auto under kAutoRimMaxVertices there.
+  const double outer = o.support_radius + o.rim_band;
+  const double band_area = kPi * (outer * outer - o.support_radius * o.support_radius);
+  const double smallest = std::sqrt(2.0 / std::sqrt(3.0) * band_area / kAutoRimMaxVertices);
+  const double wanted = std::max(turn_down / (extrapolate ? 2.0 : 3.0), 0.0005);
+  if (capped) *capped = wanted < smallest && smallest < o.element_size;
+  return std::min(std::max(wanted, smallest), o.element_size);
 }
 
 DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
@@ -572,7 +620,8 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
   {
     std::ostringstream line;
     line << "mesh: " << fine.pm.mesh.num_vertices() << " vertices, " << fine.pm.mesh.num_triangles()
-         << " triangles" << (coarse ? " (coarse " + std::to_string(result.coarse_vertices) + " vertices)" : "")
+         << " triangles"
+         << (coarse ? " (coarse " + std::to_string(result.coarse_vertices) + " vertices)" : "")
          << ", " << fine.clamp.size() << " on the support";
     if (split)
       line << "; split at the rim: " << split->pm.mesh.num_vertices() << " vertices, "
@@ -589,7 +638,8 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
     if (coarse) {
       auto coarse_problem = MakeProblem(*coarse, material, seams, o);
       Vertices xc = StartState(coarse->pm.mesh, o, seed.seed);
-      seed.summary = SolveCascadic(coarse_problem.get(), fine_problem.get(), &xc, &seed.positions, o.solver);
+      seed.summary =
+          SolveCascadic(coarse_problem.get(), fine_problem.get(), &xc, &seed.positions, o.solver);
     } else {
       seed.positions = StartState(fine.pm.mesh, o, seed.seed);
       seed.summary = SolveStatic(fine_problem.get(), &seed.positions, o.solver);
@@ -599,7 +649,8 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
     seed.extrapolation_bound = kNaN;
     std::string failure = seed.summary.message;  // why this seed has no DC
     const auto measure = [&](const Vertices& x, const TriangleMesh& mesh) {
-      seed.shadow = MeasureShadow(x, mesh.triangles, o.raster_cell, o.outline_bins, o.support_radius);
+      seed.shadow =
+          MeasureShadow(x, mesh.triangles, o.raster_cell, o.outline_bins, o.support_radius);
       return DrapeCoefficient(seed.shadow.area, result.specimen_area, result.support_area);
     };
     // #V of the split mesh (a failed coarse level of a cascade leaves no positions).
@@ -617,7 +668,8 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
       auto split_problem = MakeProblem(*split, material, seams, o);
       seed.positions = refined.Prolong(seed.positions);
       // Resting: the friction goes on from where each node landed on the base mesh.
-      if (o.mount == DrapeMount::kResting) split_problem->CarryAnchorsFrom(*fine_problem, refined.parents);
+      if (o.mount == DrapeMount::kResting)
+        split_problem->CarryAnchorsFrom(*fine_problem, refined.parents);
       // The carried-over drape is near the split mesh's equilibrium: the exact Hessian from the
       // first step (taken where it is positive definite) halved the steps (seed 2 of the Fig. 8
       // fabric: 104 → 52; docs/drapemeter.md, "Extrapolated DC").
@@ -637,8 +689,11 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
         // Between the split rim's DC and its first-order extrapolation: the middle, and half
         // the bracket as the bound (docs/drapemeter.md, "Extrapolated DC").
         seed.split_drape_coefficient = seed.drape_coefficient;
-        seed.extrapolation_bound = 0.5 * (seed.split_drape_coefficient - seed.base_drape_coefficient);
-        seed.drape_coefficient = seed.split_drape_coefficient + seed.extrapolation_bound;
+        const RimExtrapolation e =
+            ExtrapolateRim(seed.base_drape_coefficient, seed.split_drape_coefficient);
+        seed.drape_coefficient = e.drape_coefficient;
+        seed.extrapolation_bound = e.bound;
+        seed.extrapolation_reversed = e.reversed;
       }
       seed.nodes = FindNodes(seed.shadow.radii, o.smoothing_bins, o.node_prominence,
                              o.node_prominence_relative);

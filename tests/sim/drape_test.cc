@@ -56,7 +56,8 @@ TEST(DrapeShadow, FlatDiskGivesItsOwnAreaAndRadiusSoDcIsOne) {
   // the bound is half a cell times the perimeter.
   EXPECT_NEAR(s.area, area, 0.5 * cell * 2.0 * kPi * 0.15);
   const double support = kPi * 0.09 * 0.09;
-  EXPECT_NEAR(DrapeCoefficient(s.area, area, support), 1.0, 0.5 * cell * 2.0 * kPi * 0.15 / (area - support));
+  EXPECT_NEAR(DrapeCoefficient(s.area, area, support), 1.0,
+              0.5 * cell * 2.0 * kPi * 0.15 / (area - support));
   // Outline: the polygon's rim, between its inscribed radius (sag h²/8R) and R, less a cell.
   EXPECT_LE(s.radii.maxCoeff(), 0.15 + 1e-12);
   EXPECT_GT(s.radii.minCoeff(), 0.15 - 0.01 * 0.01 / (8 * 0.15) - 1.5 * cell);
@@ -145,7 +146,8 @@ TEST(DrapeNodes, AnOutlineWithKLobesHasKNodesAtTheLobes) {
   Eigen::VectorXd two(360);
   for (int b = 0; b < 360; ++b) {
     const double t = (b + 0.5) * 2.0 * kPi / 360;
-    two(b) = 0.1 + 0.02 * std::exp(-std::pow((t - 1.0) / 0.2, 2)) + 0.01 * std::exp(-std::pow((t - 4.0) / 0.2, 2));
+    two(b) = 0.1 + 0.02 * std::exp(-std::pow((t - 1.0) / 0.2, 2)) +
+             0.01 * std::exp(-std::pow((t - 4.0) / 0.2, 2));
   }
   const DrapeNodes n2 = FindNodes(two, 5, 0.003, 0.15);
   ASSERT_EQ(n2.angles.size(), 2u);
@@ -176,7 +178,8 @@ TEST(Drape, SpecimenNotLargerThanTheSupportIsRefused) {
     SimulateDrape(Fig8(), o);
     FAIL() << "accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("must be larger than the support"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("must be larger than the support"), std::string::npos)
+        << e.what();
   }
   o = Coarse();
   o.seeds = 0;
@@ -211,6 +214,81 @@ TEST(Drape, RimBandOptionsAreCheckedByName) {
   o.rim_band = 0.07;  // the overhang is 60 mm
   EXPECT_EQ(why(o), "rim_band: must be in [0, the overhang]");
   EXPECT_THROW(SimulateDrape(Fig8(), o), InputError);
+}
+
+TEST(Drape, RimExtrapolationBoundIsHalfTheBracketEitherWay) {
+  // docs/drapemeter.md, "Extrapolated DC": the middle of [DC_split, 2 DC_split - DC_base] and
+  // half its width; a split DC below the base's is a reversed bracket, said as such, and its
+  // bound is still >= 0 (it was printed as "DC ± -0.0038").
+  const RimExtrapolation up = ExtrapolateRim(0.80, 0.84);
+  EXPECT_NEAR(up.drape_coefficient, 0.86, 1e-15);
+  EXPECT_NEAR(up.bound, 0.02, 1e-15);
+  EXPECT_FALSE(up.reversed);
+  const RimExtrapolation down = ExtrapolateRim(0.84, 0.80);
+  EXPECT_NEAR(down.drape_coefficient, 0.78, 1e-15);
+  EXPECT_NEAR(down.bound, 0.02, 1e-15);
+  EXPECT_TRUE(down.reversed);
+  const RimExtrapolation same = ExtrapolateRim(0.8, 0.8);
+  EXPECT_EQ(same.bound, 0.0);
+  EXPECT_FALSE(same.reversed);
+}
+
+TEST(Drape, SupportAndShiftTheMesherCannotTakeAreRefusedByName) {
+  const auto why = [](const DrapeOptions& o) {
+    std::string w;
+    EXPECT_FALSE(o.Check(&w));
+    return w;
+  };
+  DrapeOptions o = Coarse();  // 15 mm elements
+  o.support_radius = 0.0037;  // under a quarter of an element: its chords merge in the mesher
+  EXPECT_EQ(why(o), "support_radius: must be at least a quarter of element_size");
+  o.support_radius = 0.00375;
+  std::string w;
+  EXPECT_TRUE(o.Check(&w)) << w;
+  o = Coarse();
+  o.seams = DrapeSeams::kShifted;
+  o.seam_shift = -0.13501;  // closer than one element to the rim (|shift| <= 135 mm)
+  EXPECT_EQ(why(o).substr(0, 11), "seam_shift:");
+  o.seam_shift = 0.135;
+  EXPECT_DOUBLE_EQ(MaxSeamShift(o), 0.135);
+  EXPECT_TRUE(o.Check(&w)) << w;
+  o.seams = DrapeSeams::kWeft;  // the shift of a seam that is not shifted is not checked
+  o.seam_shift = 0.149;
+  EXPECT_TRUE(o.Check(&w)) << w;
+}
+
+TEST(Drape, AutoRimIsCappedForALimpFabricOnly) {
+  // A limp fabric's turn-down length asks for the 0.5 mm floor: 67k vertices in the band and
+  // minutes of solving. Auto keeps the band under about kAutoRimMaxVertices vertices and says
+  // it capped; the Fig. 8 fabric's ℓ/2 (4.31 mm) is far from the cap.
+  const DrapeOptions o;  // 90 mm support, 20 mm band
+  Material limp;
+  limp.areal_density = 0.3;
+  limp.bending = BendingLaw::FromKes(0.0005, 0.0005, 0.0);
+  bool capped = false;
+  const double e = AutoRimElementSize(limp, o, true, &capped);
+  EXPECT_TRUE(capped);
+  const double area = std::numbers::pi * (0.11 * 0.11 - 0.09 * 0.09);
+  EXPECT_NEAR(2.0 / std::sqrt(3.0) * area / (e * e), kAutoRimMaxVertices,
+              1e-6 * kAutoRimMaxVertices);
+  EXPECT_GT(e, 0.0005);
+  const double fig8 = AutoRimElementSize(Fig8(), o, true, &capped);
+  EXPECT_FALSE(capped);
+  EXPECT_NEAR(fig8, 0.5 * RimTurnDownLength(Fig8(), o), 1e-15);
+}
+
+TEST(Drape, HugeFrameAnglesAreATurnLikeAnyOther) {
+  // 1e17 degrees in radians has no fraction of a turn in its last bits: the support circle's
+  // points, frame + i step, collapsed onto each other ("seam 0 segment 0 has zero length").
+  // The frame is used modulo 2π, so the drape is that of the reduced angle, exactly.
+  DrapeOptions o = Coarse();
+  o.frame_angle = 1e17 * std::numbers::pi / 180.0;
+  const DrapeResult huge = SimulateDrape(Fig8(), o);
+  o.frame_angle = std::remainder(o.frame_angle, 2.0 * std::numbers::pi);
+  const DrapeResult reduced = SimulateDrape(Fig8(), o);
+  ASSERT_TRUE(huge.converged) << huge.message;
+  EXPECT_EQ(huge.drape_coefficient, reduced.drape_coefficient);
+  EXPECT_EQ(huge.mesh.num_vertices(), reduced.mesh.num_vertices());
 }
 
 TEST(Drape, RimTurnDownLengthIsTheClampedStripsBoundaryLayer) {
@@ -285,7 +363,8 @@ TEST(Drape, RimExtrapolationSplitsTheRimAndExtrapolates) {
   EXPECT_EQ(s.base_drape_coefficient, base.drape_coefficient);
   EXPECT_GT(s.split_drape_coefficient, s.base_drape_coefficient + 0.005);
   // Between the split DC and the first-order extrapolation 2 DC_split − DC_base, in the middle.
-  EXPECT_DOUBLE_EQ(s.extrapolation_bound, 0.5 * (s.split_drape_coefficient - s.base_drape_coefficient));
+  EXPECT_DOUBLE_EQ(s.extrapolation_bound,
+                   0.5 * (s.split_drape_coefficient - s.base_drape_coefficient));
   EXPECT_DOUBLE_EQ(s.drape_coefficient, s.split_drape_coefficient + s.extrapolation_bound);
   EXPECT_EQ(r.drape_coefficient, s.drape_coefficient);
   // The split rim is a 2.5 mm rim: a mesh made with 2.5 mm there drapes alike (measured, seed
@@ -409,8 +488,10 @@ TEST(Drape, RestingSpecimenCarriesItsFrictionOverToTheSplitRim) {
   const DrapeSeedResult& s = r.per_seed[0];
   EXPECT_TRUE(s.split_summary.converged);
   EXPECT_GT(s.split_summary.contacts, s.summary.contacts);  // the split mesh has more nodes there
-  EXPECT_NEAR(r.drape_coefficient, s.split_drape_coefficient + 0.5 * (s.split_drape_coefficient - s.base_drape_coefficient),
-              1e-12);
+  EXPECT_NEAR(
+      r.drape_coefficient,
+      s.split_drape_coefficient + 0.5 * (s.split_drape_coefficient - s.base_drape_coefficient),
+      1e-12);
   EXPECT_GT(r.drape_coefficient, 0.0);
   EXPECT_LT(r.drape_coefficient, 1.0);
   EXPECT_GT(r.min_radius, o.support_radius + 0.01);  // nothing slid over the rim
@@ -437,8 +518,8 @@ TEST(Drape, SolverShortcutsReachTheSameDrapeInFewerSteps) {
   for (const DrapeOptions& other : {no_doubling, no_exact}) {
     const DrapeResult r = SimulateDrape(Fig8(), other);
     const SolveSummary& s = r.per_seed.at(0).summary;
-    SCOPED_TRACE(std::string(other.solver.expand_steps ? "no exact Hessian" : "no doubling") + ": " +
-                 s.BriefReport());
+    SCOPED_TRACE(std::string(other.solver.expand_steps ? "no exact Hessian" : "no doubling") +
+                 ": " + s.BriefReport());
     ASSERT_TRUE(r.converged) << r.message;
     EXPECT_NEAR(both.drape_coefficient, r.drape_coefficient, 1e-3);
     EXPECT_NEAR(b.energy, s.energy, 1e-6 * std::abs(s.energy));
@@ -458,8 +539,8 @@ TEST(Drape, NonConvergedRunReportsNoDrapeCoefficient) {
   EXPECT_NE(r.message.find("iteration cap"), std::string::npos) << r.message;
   EXPECT_TRUE(std::isnan(r.drape_coefficient));
   EXPECT_TRUE(std::isnan(r.per_seed.at(0).drape_coefficient));
-  for (double figure : {r.drape_coefficient_sd, r.nodes, r.nodes_sd, r.min_radius, r.max_radius, r.mean_radius,
-                        r.min_radius_sd, r.max_radius_sd, r.mean_radius_sd})
+  for (double figure : {r.drape_coefficient_sd, r.nodes, r.nodes_sd, r.min_radius, r.max_radius,
+                        r.mean_radius, r.min_radius_sd, r.max_radius_sd, r.mean_radius_sd})
     EXPECT_TRUE(std::isnan(figure)) << figure;
 }
 

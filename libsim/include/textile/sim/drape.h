@@ -30,12 +30,13 @@
 // Measurement (MeasureShadow): the draped mesh's triangles are projected on the plane z = 0 and
 // rasterised on a square grid (cell centres sampled); holes are filled (cells not reachable
 // from the grid's border through empty cells count as shadow); the support disk is shadow too
-// (its own, as the opaque disk casts it), so r(θ) ≥ R_s; A_shadow = shadow cells × cell area. DC = (A_shadow - A_support) / (A_specimen - A_support), with A_specimen the area of the
-// meshed pattern (so a flat specimen gives DC = 1 on any mesh) and A_support = π R_s².
-// The outline r(θ) is the largest radius of a shadow cell centre in each of `outline_bins`
-// equal angle bins (the shadow is star-shaped about the centre in every drape we have seen; a
-// bin that no cell reaches is interpolated). Nodes (FindNodes) are the local maxima of r(θ),
-// smoothed by a circular moving average, whose topographic prominence reaches the threshold.
+// (its own, as the opaque disk casts it), so r(θ) ≥ R_s; A_shadow = shadow cells × cell area. DC =
+// (A_shadow - A_support) / (A_specimen - A_support), with A_specimen the area of the meshed pattern
+// (so a flat specimen gives DC = 1 on any mesh) and A_support = π R_s². The outline r(θ) is the
+// largest radius of a shadow cell centre in each of `outline_bins` equal angle bins (the shadow is
+// star-shaped about the centre in every drape we have seen; a bin that no cell reaches is
+// interpolated). Nodes (FindNodes) are the local maxima of r(θ), smoothed by a circular moving
+// average, whose topographic prominence reaches the threshold.
 //
 // Units: SI inside (m, kg, rad); the CLI converts to mm.
 
@@ -55,9 +56,9 @@ namespace textile {
 enum class DrapeMount { kClamped, kResting };
 enum class DrapeSeams { kNone, kWeft, kWeftWarp, kShifted };
 
-std::string DrapeMountName(DrapeMount mount);      // "clamped" | "resting"
+std::string DrapeMountName(DrapeMount mount);         // "clamped" | "resting"
 DrapeMount ParseDrapeMount(const std::string& name);  // InputError naming the value
-std::string DrapeSeamsName(DrapeSeams seams);      // "none" | "weft" | "weft+warp" | "shifted"
+std::string DrapeSeamsName(DrapeSeams seams);         // "none" | "weft" | "weft+warp" | "shifted"
 DrapeSeams ParseDrapeSeams(const std::string& name);  // InputError naming the value
 
 // The solver settings a drape starts from: Newton + CHOLMOD, relative residual 1e-4 (DC is
@@ -66,7 +67,7 @@ SolveOptions DefaultDrapeSolveOptions();
 
 struct DrapeOptions {
   double specimen_radius = 0.15;  // R [m] (Cusick, BS 5058, ISO 9073-9)
-  double support_radius = 0.09;   // R_s [m], < R
+  double support_radius = 0.09;   // R_s [m], < R, ≥ element_size / 4
   DrapeMount mount = DrapeMount::kClamped;
   // Resting mount: the support disk's thickness and rim rounding [m], the start height of the
   // flat specimen above it [m].
@@ -96,6 +97,7 @@ struct DrapeOptions {
   int max_harmonic = 8;
   // Rotates the seams and the perturbation (not the mesh, not the material axes) about the
   // centre [rad]: DC must not depend on how the mesh sits under them (isotropic fabrics).
+  // Any finite angle; used modulo 2π.
   double frame_angle = 0.0;
 
   // Target edge length of the fine mesh away from seams [m]. The default keeps a single-seed
@@ -105,8 +107,8 @@ struct DrapeOptions {
   // The support's rim, where the overhang turns down over the length RimTurnDownLength (8.6 mm
   // for the Fig. 8 fabric). A mesh of element_size there folds along the clamp's edges too
   // cheaply, and the DC comes out low, by about 0.1 × element / turn-down length for a plain
-  // fabric (docs/drapemeter.md, "Resolution at the rim"). Edges are at most rim_element_size [m] from
-  // one such element inside the support to rim_band [m] beyond its edge, growing by half the
+  // fabric (docs/drapemeter.md, "Resolution at the rim"). Edges are at most rim_element_size [m]
+  // from one such element inside the support to rim_band [m] beyond its edge, growing by half the
   // distance past that; 0: no band (the default, for run time).
   double rim_element_size = 0.0;
   double rim_band = 0.02;
@@ -131,7 +133,8 @@ struct DrapeOptions {
   DrapeSeams seams = DrapeSeams::kNone;
   // The seam type (Table 2 preset or a fitted file) of every seam.
   SeamProfile seam_profile = SeamPreset("C-plain");
-  // The shifted seam runs parallel to the weft seam, this far from the centre [m].
+  // The shifted seam runs parallel to the weft seam, this far from the centre [m];
+  // |seam_shift| ≤ MaxSeamShift (one element inside the edge).
   double seam_shift = 0.05;
   // Section 4.3 refinement near seams (element area / ⌈S(d)⌉), applied within this distance of
   // the seam lines (not of the support circle) [m]; 0 (the default) turns it off: at h = 12 mm
@@ -147,7 +150,8 @@ struct DrapeOptions {
   double raster_cell = 0.0005;  // shadow grid cell [m]
   int outline_bins = 360;       // angle bins of r(θ)
   int smoothing_bins = 5;       // circular moving average before node detection (odd, ≥ 1)
-  // A node's prominence must reach max(node_prominence, node_prominence_relative × (max r - min r)).
+  // A node's prominence must reach max(node_prominence, node_prominence_relative × (max r - min
+  // r)).
   double node_prominence = 0.003;          // [m]
   double node_prominence_relative = 0.15;  // [-]
 
@@ -160,15 +164,15 @@ struct DrapeOptions {
 
 // The shadow of a draped specimen: a raster mask and the polar outline.
 struct DrapeShadow {
-  double area = 0.0;               // A_shadow, holes filled [m²]
-  double cell = 0.0;               // raster cell [m]
+  double area = 0.0;                      // A_shadow, holes filled [m²]
+  double cell = 0.0;                      // raster cell [m]
   double origin_x = 0.0, origin_y = 0.0;  // centre of cell (0, 0) [m]
-  int width = 0, height = 0;       // cells
-  std::vector<std::uint8_t> mask;  // height × width, row-major (row = y), 1 = shadow
-  Eigen::VectorXd angles;          // #B bin centres θ_b ∈ [0, 2π) [rad]
-  Eigen::VectorXd radii;           // #B outline radius r(θ_b) [m]
-  // Support cells no fabric covers (a specimen that left the disk's top) × cell area [m²]; 0 without
-  // a support radius.
+  int width = 0, height = 0;              // cells
+  std::vector<std::uint8_t> mask;         // height × width, row-major (row = y), 1 = shadow
+  Eigen::VectorXd angles;                 // #B bin centres θ_b ∈ [0, 2π) [rad]
+  Eigen::VectorXd radii;                  // #B outline radius r(θ_b) [m]
+  // Support cells no fabric covers (a specimen that left the disk's top) × cell area [m²]; 0
+  // without a support radius.
   double bare_support_area = 0.0;
 };
 
@@ -197,12 +201,12 @@ double DrapeCoefficient(double shadow_area, double specimen_area, double support
 struct DrapeSeedResult {
   unsigned seed = 0;
   bool converged = false;
-  SolveSummary summary;              // fine level (with coarse figures when cascadic)
-  double drape_coefficient = 0.0;    // NaN unless converged
-  DrapeShadow shadow;                // empty unless converged
-  DrapeNodes nodes;                  // empty unless converged
+  SolveSummary summary;            // fine level (with coarse figures when cascadic)
+  double drape_coefficient = 0.0;  // NaN unless converged
+  DrapeShadow shadow;              // empty unless converged
+  DrapeNodes nodes;                // empty unless converged
   double min_radius = 0.0, max_radius = 0.0, mean_radius = 0.0;  // of the outline [m]
-  Vertices positions;                // #V×3 final state [m] (also when not converged)
+  Vertices positions;  // #V×3 final state [m] (also when not converged)
   // Resting mount: how deep the deepest node lies inside the support [m] (0 clamped, or when
   // not converged); the penalty's sink under the rim's load (contact_sink).
   double max_penetration = 0.0;
@@ -212,8 +216,23 @@ struct DrapeSeedResult {
   // when the base solve failed). summary is the base mesh's solve, split_summary the split's.
   double base_drape_coefficient = 0.0, split_drape_coefficient = 0.0;
   double extrapolation_bound = 0.0;
+  // The split rim's DC is below the base's: the bracket is reversed, against the convergence
+  // from below that the extrapolation assumes (ExtrapolateRim).
+  bool extrapolation_reversed = false;
   SolveSummary split_summary;
 };
+
+// The rim extrapolation's figures from the base mesh's DC and the split one's
+// (docs/drapemeter.md, "Extrapolated DC"): the middle of the bracket [DC_split,
+// 2 DC_split − DC_base] (DC_split + Δ/2, Δ = DC_split − DC_base), the bound |Δ|/2 (≥ 0), and
+// whether Δ < 0 (reversed: the DC fell as the rim was refined, which the method does not
+// expect; the figures are still the bracket's).
+struct RimExtrapolation {
+  double drape_coefficient = 0.0;
+  double bound = 0.0;
+  bool reversed = false;
+};
+RimExtrapolation ExtrapolateRim(double base_dc, double split_dc);
 
 struct DrapeResult {
   bool converged = false;  // every seed converged; otherwise no figure below is meaningful
@@ -221,7 +240,7 @@ struct DrapeResult {
   // Over the seeds (sd: sample standard deviation, 0 for a single seed); NaN unless converged.
   double drape_coefficient = 0.0, drape_coefficient_sd = 0.0;
   double nodes = 0.0, nodes_sd = 0.0;
-  double mean_radius = 0.0, min_radius = 0.0, max_radius = 0.0;  // means over seeds [m]
+  double mean_radius = 0.0, min_radius = 0.0, max_radius = 0.0;           // means over seeds [m]
   double mean_radius_sd = 0.0, min_radius_sd = 0.0, max_radius_sd = 0.0;  // their sample sd [m]
   std::vector<DrapeSeedResult> per_seed;
   TriangleMesh mesh;                         // the fine pattern (rest, z = 0); split at the rim
@@ -236,6 +255,10 @@ struct DrapeResult {
   double seconds = 0.0;                      // wall time, meshing included [s]
 };
 
+// The largest |seam_shift| [m] a shifted seam may have: one element (element_size) inside the
+// specimen's edge (closer, the chord is too short and too near the rim for the mesher).
+double MaxSeamShift(const DrapeOptions& options);
+
 // The seam lines of a configuration [m] (frame_angle applied).
 std::vector<SeamLine> DrapeSeamLines(const DrapeOptions& options);
 
@@ -249,9 +272,13 @@ std::vector<SeamLine> DrapeSeamLines(const DrapeOptions& options);
 double RimTurnDownLength(const Material& material, const DrapeOptions& options);
 
 // The rim element size of `--rim-mm auto` [m]: ℓ/2 for a rim extrapolation (the split halves
-// it), else ℓ/3 (docs/drapemeter.md, "Extrapolated DC"); at least 0.5 mm, at most
-// options.element_size. Throws as RimTurnDownLength.
-double AutoRimElementSize(const Material& material, const DrapeOptions& options, bool extrapolate);
+// it), else ℓ/3 (docs/drapemeter.md, "Extrapolated DC"); at least 0.5 mm, and at least the
+// size that keeps the rim band (support radius to rim_band past it) under about
+// kAutoRimMaxVertices vertices (a limp fabric asks for far more; *capped, when given, says
+// whether this bound decided); at most options.element_size. Throws as RimTurnDownLength.
+inline constexpr double kAutoRimMaxVertices = 10000.0;
+double AutoRimElementSize(const Material& material, const DrapeOptions& options, bool extrapolate,
+                          bool* capped = nullptr);
 
 // Runs the drapemeter. Throws InputError for bad options or material (a specimen not larger
 // than the support, ...) and ComputeError when meshing fails; a solve that does not converge is

@@ -225,6 +225,15 @@ CalibrationSummary CalibrateRig(const std::vector<cv::Mat>& boards,
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) lens.camera_matrix(r, c) = K.at<double>(r, c);
     for (int k = 0; k < static_cast<int>(dist.total()); ++k) lens.distortion.push_back(dist.at<double>(k));
+    // A model fitted to too few or too similar views can fold the photo's corners over: extract
+    // would refuse the rig, so it is not written.
+    if (const std::string why = LensProblemOverImage(lens, boards[0].cols, boards[0].rows);
+        !why.empty()) {
+      s.message = "lens calibration over " + std::to_string(boards.size()) +
+                  " boards gives an implausible distortion: " + why +
+                  " (add boards in other poses, or --no-lens)";
+      return s;
+    }
     rig.lens = lens;
     s.lens_model = true;
     // The first board's corners without distortion, in the same camera's pixels.

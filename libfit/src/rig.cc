@@ -4,6 +4,7 @@
 #include <Eigen/LU>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
@@ -64,6 +65,21 @@ class Fields {
   std::string source_;
 };
 
+// A lens model must be undone exactly where photos are measured: undistorting a point and
+// distorting it back must return it within this distance [px] (a tenth of the extraction's
+// sub-pixel scatter). Real lenses meet it by orders of magnitude.
+constexpr double kLensRoundTripPx = 0.05;
+// Grid cells per side on which the lens model is checked over a photo.
+constexpr int kLensGridCells = 24;
+
+std::string Px(double x, double y) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(1);
+  s << "(" << x << ", " << y << ") px";
+  return s.str();
+}
+
 // NaN-safe JSON: the file format has no NaN.
 json Matrix3ToJson(const Eigen::Matrix3d& m) {
   json rows = json::array();
@@ -72,6 +88,61 @@ json Matrix3ToJson(const Eigen::Matrix3d& m) {
 }
 
 }  // namespace
+
+std::string LensProblemOverImage(const Lens& lens, int width, int height) {
+  cv::Mat K, D(lens.distortion, true);
+  cv::eigen2cv(lens.camera_matrix, K);
+  const int n = kLensGridCells;
+  std::vector<cv::Point2d> px, normalized, back;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      px.emplace_back(-0.5 + width * static_cast<double>(i) / n,
+                      -0.5 + height * static_cast<double>(j) / n);
+    }
+  }
+  // Undistorted as Rig::PlaneFromImage does it, then distorted back by the forward model.
+  try {
+    cv::undistortPoints(
+        px, normalized, K, D, cv::noArray(), cv::noArray(),
+        cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 50, 1e-9));
+    std::vector<cv::Point3d> rays;
+    for (const auto& q : normalized) rays.emplace_back(q.x, q.y, 1.0);
+    cv::projectPoints(rays, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, D, back);
+  } catch (const cv::Exception& e) {
+    return "OpenCV cannot apply it (" + e.err + ")";
+  }
+  size_t worst = 0;
+  double miss = 0.0;
+  for (size_t k = 0; k < px.size(); ++k) {
+    const double d = std::hypot(back[k].x - px[k].x, back[k].y - px[k].y);
+    if (!(d <= miss)) {  // NaN counts as the worst
+      worst = k;
+      miss = std::isnan(d) ? std::numeric_limits<double>::infinity() : d;
+      if (std::isinf(miss)) break;
+    }
+  }
+  if (!(miss <= kLensRoundTripPx)) {
+    std::ostringstream m;
+    m << "it cannot be undone at " << Px(px[worst].x, px[worst].y) << " of a " << width << "x"
+      << height << " px photo (undistorted and distorted back, it comes out at "
+      << (std::isinf(miss) ? std::string("infinity") : Px(back[worst].x, back[worst].y)) << ")";
+    return m.str();
+  }
+  // The undistorted grid must keep its order: a model that folds the photo over maps two
+  // places to one.
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      const cv::Point2d& q = normalized[j * (n + 1) + i];
+      const bool right = i < n && !(normalized[j * (n + 1) + i + 1].x > q.x);
+      const bool down = j < n && !(normalized[(j + 1) * (n + 1) + i].y > q.y);
+      if (right || down) {
+        return "it folds the photo over near " + Px(px[j * (n + 1) + i].x, px[j * (n + 1) + i].y) +
+               " of a " + std::to_string(width) + "x" + std::to_string(height) + " px photo";
+      }
+    }
+  }
+  return "";
+}
 
 Rig Rig::FromScale(double mm_per_px, const std::string& source) {
   if (!std::isfinite(mm_per_px) || mm_per_px <= 0.0) {
@@ -135,6 +206,12 @@ void Rig::CheckForImage(int width, int height, const std::string& photo) const {
     throw InputError(source + ": the homography maps part of " + photo +
                      " beyond the horizon (is it plane_from_image, px -> mm?)");
   }
+  if (lens) {
+    const std::string why = LensProblemOverImage(*lens, width, height);
+    if (!why.empty()) {
+      throw InputError(source + ": distortion: implausible lens model for " + photo + ": " + why);
+    }
+  }
   const double s = MmPerPxAt({width / 2.0, height / 2.0});
   if (!std::isfinite(s) || s < kMinMmPerPx || s > kMaxMmPerPx) {
     std::ostringstream m;
@@ -195,6 +272,10 @@ Rig ParseRigJson(const std::string& text, const std::string& source) {
              "expected 4, 5, 8, 12 or 14 coefficients (OpenCV's model), got " + std::to_string(n));
     }
     if (rig.plain_scale) f.Fail("distortion", "a plain scale rig has no lens model");
+    if (rig.image_size) {
+      const std::string why = LensProblemOverImage(lens, rig.image_size->x(), rig.image_size->y());
+      if (!why.empty()) f.Fail("distortion", "implausible lens model: " + why);
+    }
     rig.lens = lens;
   }
   if (j.contains("reprojection_error_px")) {

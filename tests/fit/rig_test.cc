@@ -104,6 +104,44 @@ TEST(Rig, ChecksThePhotoAgainstTheCalibration) {
   EXPECT_THROW(horizon.CheckForImage(2000, 1500, "a.jpg"), InputError);
 }
 
+// Lens models that OpenCV cannot undo over the photo gave a profile identical to no lens
+// (k1 = -5), or a crash in extraction (k6 = 1e9). They are refused naming the field, at parse
+// time when the rig gives image_size, else when it meets a photo; real lenses pass.
+TEST(Rig, RefusesLensModelsThatCannotBeUndoneOverThePhoto) {
+  const std::string h =
+      R"("type": "homography", "plane_from_image": [[0.1, 0, 0], [0, 0.1, 0], [0, 0, 1]],
+         "camera_matrix": [[2000, 0, 1000], [0, 2000, 750], [0, 0, 1]])";
+  for (const char* d : {"[-5, 0, 0, 0, 0]", "[1e6, 0, 0, 0, 0]", "[0, 0, 0, 0, 0, 0, 0, 1e9]",
+                        "[0, -40, 0, 0, 0]", "[0, 0, 0.9, 0, 0]"}) {
+    const Rig rig = ParseRigJson("{" + h + R"(, "distortion": )" + d + "}", "rig.json");
+    try {
+      rig.CheckForImage(2000, 1500, "a.jpg");
+      ADD_FAILURE() << "accepted: " << d;
+    } catch (const InputError& e) {
+      const std::string m = e.what();
+      EXPECT_EQ(m.rfind("rig.json: distortion: implausible lens model for a.jpg", 0), 0u) << m;
+      EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    }
+    ExpectRefused("{" + h + R"(, "image_size": [2000, 1500], "distortion": )" + d + "}",
+                  "distortion: implausible lens model");
+  }
+  // Real lenses, from a phone's wide angle (strong barrel) to a long lens, and a calibration's
+  // rational model: undone everywhere to far better than the 0.05 px demanded.
+  for (const char* d : {"[-0.3, 0.12, 0.001, -0.001, -0.02]", "[0.05, -0.1, 0, 0, 0.1]",
+                        "[-0.12, 0.05, 0, 0, 0, 0.1, 0.02, 0.01]", "[0, 0, 0, 0]"}) {
+    const std::string text = "{" + h + R"(, "image_size": [2000, 1500], "distortion": )" + d + "}";
+    EXPECT_NO_THROW(ParseRigJson(text, "rig.json").CheckForImage(2000, 1500, "a.jpg")) << d;
+  }
+  // A barrel lens (k1 = -0.3: r_d = r (1 - 0.3 r^2) turns back at r_d = 0.70) is fine over
+  // its 800x600 photo (corners at r_d = 0.5) but not over a larger one through the same camera
+  // matrix (corners at r_d = 2).
+  Lens barrel;
+  barrel.camera_matrix << 1000, 0, 400, 0, 1000, 300, 0, 0, 1;
+  barrel.distortion = {-0.3, 0, 0, 0, 0};
+  EXPECT_EQ(LensProblemOverImage(barrel, 800, 600), "");
+  EXPECT_NE(LensProblemOverImage(barrel, 2000, 1500), "");
+}
+
 TEST(Rig, RefusesBadFiles) {
   ExpectRefused("", "not valid JSON");
   ExpectRefused("{\"type\": \"scale\", ", "not valid JSON");

@@ -55,11 +55,20 @@ struct Rig {
   // Local scale at an image point: the square root of the Jacobian's area ratio [mm/px].
   double MmPerPxAt(const Eigen::Vector2d& px) const;
   // Throws InputError (naming the rig source and the photo) if the rig cannot map a photo of
-  // this size: wrong size for the calibrated camera, or the horizon crossing the image.
+  // this size: wrong size for the calibrated camera, the horizon crossing the image, or a lens
+  // model that is not one to one over it (LensProblemOverImage).
   void CheckForImage(int width, int height, const std::string& photo) const;
 };
 
-// Parses rig JSON; throws InputError "<source>: <field>: <problem>" (one line).
+// Empty if the lens model can be undone over a width x height photo: on a grid over the whole
+// photo, undistorting a point (as Rig::PlaneFromImage does) and distorting it back returns it
+// within 0.05 px, and the undistorted grid keeps its order (no fold). Otherwise a phrase saying
+// where it fails. Catches coefficients that OpenCV cannot invert (k1 = -5 with fx = 2000 px on
+// a 2000 px photo, k1 = 1e6, k6 = 1e9).
+std::string LensProblemOverImage(const Lens& lens, int width, int height);
+
+// Parses rig JSON; throws InputError "<source>: <field>: <problem>" (one line). A lens model
+// with an image_size is checked over that size (LensProblemOverImage).
 Rig ParseRigJson(const std::string& text, const std::string& source);
 // Reads a rig file; throws InputError if it cannot be read or is invalid.
 Rig ReadRigJson(const std::string& path);

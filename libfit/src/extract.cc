@@ -1005,8 +1005,10 @@ const char* BorderName(int b) {
 }  // namespace
 
 bool ExtractOptions::Check(std::string* why) const {
-  if (!(std::isfinite(step_mm) && step_mm > 0.0 && step_mm <= 50.0)) {
-    *why = "step_mm must lie in (0, 50] mm";
+  // Finer than 0.01 mm only interpolates (a pixel is 0.05-0.2 mm on a cantilever photo) and
+  // makes files of millions of rows; coarser than 10 mm leaves too few points on most strips.
+  if (!(std::isfinite(step_mm) && step_mm >= kMinStepMm && step_mm <= kMaxStepMm)) {
+    *why = "step_mm must lie in [" + Fmt(kMinStepMm, 2) + ", " + Fmt(kMaxStepMm, 0) + "] mm";
     return false;
   }
   if (level_deg && !(std::isfinite(*level_deg) && std::abs(*level_deg) <= 45.0)) {
@@ -1484,11 +1486,29 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   std::vector<Vec2> curve{first_mm};
   curve.insert(curve.end(), bridge.begin(), bridge.end());
   curve.insert(curve.end(), mm.begin() + start, mm.end());
-  const std::vector<Vec2> resampled = ResampleByArc(curve, options.step_mm);
   // Arc length along the traced line (not along the chords between samples): k·step, and the
   // whole length at the tip.
   double length = 0.0;
   for (size_t k = 1; k < curve.size(); ++k) length += (curve[k] - curve[k - 1]).norm();
+  // The spacing is the user's choice: fine enough (under an absurd rig scale) to make millions
+  // of rows, or too coarse for this strip (below), it is bad input, named as the flag.
+  const double points = std::floor(length / options.step_mm) + 1.0;
+  if (!(points <= kMaxExtractedPoints)) {
+    throw InputError("--step-mm " + Fmt(options.step_mm, 2) + ": the " + Fmt(length, 0) +
+                     " mm strip in " + source + " would get " + Fmt(points, 0) +
+                     " points, more than " + std::to_string(kMaxExtractedPoints) +
+                     " (is the rig's scale right?)");
+  }
+  const std::vector<Vec2> resampled = ResampleByArc(curve, options.step_mm);
+  if (resampled.size() < static_cast<size_t>(kMinProfilePoints) &&
+      length >= (kMinProfilePoints - 1) * kDefaultStepMm) {
+    // At the default spacing the strip would have enough points.
+    const double enough = std::floor(100.0 * length / (kMinProfilePoints - 1)) / 100.0;
+    throw InputError("--step-mm " + Fmt(options.step_mm, 2) + ": the " + Fmt(length, 1) +
+                     " mm strip in " + source + " gets only " + std::to_string(resampled.size()) +
+                     " points at that spacing (" + std::to_string(kMinProfilePoints) +
+                     " needed: --step-mm " + Fmt(std::max(kMinStepMm, enough), 2) + " or less)");
+  }
   Profile& p = r.profile;
   p.source = source;
   for (size_t k = 0; k < resampled.size(); ++k) {

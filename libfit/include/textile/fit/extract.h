@@ -50,6 +50,13 @@ inline constexpr int kMinPhotoSidePx = 32;
 inline constexpr int kMaxPhotoSidePx = 40000;
 inline constexpr double kMaxPhotoPixels = 64e6;  // 50 MP cameras plus margin
 
+// Profile spacing along the arc [mm]: the default and the range ExtractOptions::Check accepts;
+// a profile may not get more points than kMaxExtractedPoints.
+inline constexpr double kDefaultStepMm = 0.5;
+inline constexpr double kMinStepMm = 0.01;
+inline constexpr double kMaxStepMm = 10.0;
+inline constexpr int kMaxExtractedPoints = 1000000;
+
 struct ExtractOptions {
   // Which line to trace.
   TraceLine trace = TraceLine::kMid;
@@ -61,8 +68,10 @@ struct ExtractOptions {
   // Horizontal = image rows turned by this angle [deg], counter-clockwise as seen in the image
   // (a camera rolled clockwise by 1° needs +1). Default: rows (clamp), or the platform's top.
   std::optional<double> level_deg;
-  // Spacing of the profile along its arc length [mm].
-  double step_mm = 0.5;
+  // Spacing of the profile along its arc length [mm], in [kMinStepMm, kMaxStepMm]. A strip
+  // that would get fewer than kMinProfilePoints at it (but enough at the default) is refused
+  // as bad input, as is one that would get more than kMaxExtractedPoints.
+  double step_mm = kDefaultStepMm;
   // Long side of the reduced image on which the strip and the rig are detected [px].
   int detect_side_px = 1000;
   // Wall-time cap [s], checked between the stages: a run past it fails ("time cap ..."), with

@@ -117,8 +117,11 @@ void Run(const RenderArgs& a) {
                          LengthTag(a.overhangs_mm[i]) + ")");
     }
   }
-  if (!(std::isfinite(a.thickness_mm) && a.thickness_mm >= 0.01 && a.thickness_mm <= 20))
-    throw InputError("--thickness-mm must lie in [0.01, 20] mm");
+  if (!(std::isfinite(a.thickness_mm) && a.thickness_mm >= 0.01 &&
+        a.thickness_mm <= kMaxRenderThickness * 1e3)) {
+    throw InputError("--thickness-mm must lie in [0.01, " + Num(kMaxRenderThickness * 1e3) +
+                     "] mm (thicker strips rise too far above the platform for extract)");
+  }
   if (!(std::isfinite(a.mm_per_px) && a.mm_per_px >= 0.001 && a.mm_per_px <= 10))
     throw InputError("--mm-per-px must lie in [0.001, 10]");
   if (a.jpeg > 100 || a.jpeg < -1) throw InputError("--jpeg must lie in [0, 100]");
@@ -241,7 +244,8 @@ void RegisterRenderPhoto(CLI::App& app) {
   sub->add_option("--seed", a->seed, "Random seed: pose, polarity, direction, defects, noise (default 1)");
   sub->add_option("--size", a->size, "Photo size WxH [px] (default 2000x1500)");
   sub->add_option("--mm-per-px", a->mm_per_px, "Scale at the aim point in the bending plane (default 0.1)");
-  sub->add_option("--thickness-mm", a->thickness_mm, "Strip thickness [mm] (default 0.5)");
+  sub->add_option("--thickness-mm", a->thickness_mm,
+                  "Strip thickness [mm], 0.01 to 4 (default 0.5)");
   sub->add_option("--polarity", a->polarity, "auto (from the seed), dark or light strip")
       ->check(CLI::IsMember({"auto", "dark", "light"}));
   sub->add_option("--direction", a->direction, "auto (from the seed), right or left overhang")

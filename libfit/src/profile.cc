@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 
 #include "textile/sim/error.h"
@@ -16,6 +17,10 @@ namespace {
 constexpr double kMaxRiseM = 3e-3;
 // How far x may run backwards before we call it folding back (noise on a vertical tail).
 constexpr double kFoldBackM = 1e-3;
+// A rig tilted by up to this much [rad] (3°; `fit --fit-rotation` fits it) turns a vertical
+// tail back by sin(tilt) per unit of arc length: a 2° tilt once refused synth-profile's own
+// 80 mm profile as folding back.
+constexpr double kMaxTiltRad = 3.0 * std::numbers::pi / 180.0;
 
 std::string Trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t\r\n");
@@ -127,10 +132,23 @@ void CheckProfile(const Profile& p) {
                        ")");
     }
     if (p.y[i] > kMaxRiseM) {
+      // A mid-line starts half a thickness up: near the edge, a thick strip is the likelier cause.
+      const std::string cause = p.s[i] - p.s.front() < 2 * kMaxRiseM
+                                    ? "; a strip thicker than " +
+                                          std::to_string(static_cast<int>(2e3 * kMaxRiseM)) +
+                                          " mm, whose mid-line starts higher, is not supported"
+                                    : "";
       throw InputError(src + ": " + row + " lies " + std::to_string(p.y[i] * 1e3) +
-                       " mm above the platform; a hanging strip has y_mm <= 0 (is y pointing down?)");
+                       " mm above the platform, more than " +
+                       std::to_string(static_cast<int>(1e3 * kMaxRiseM)) +
+                       " mm; a hanging strip has y_mm <= 0 (is y pointing down?)" + cause);
     }
-    if (p.x[i] < max_x - fold_back) {
+    if (p.x[i] < max_x - std::max(fold_back, std::sin(kMaxTiltRad) * (p.s[i] - p.s.front()))) {
+      if (max_x <= fold_back)  // never went right: an overhang to the left
+        throw InputError(
+            src + ": " + row + ": x_mm runs backwards from the edge (to " +
+            std::to_string(p.x[i] * 1e3) +
+            "); x must point along the overhang (mirror a left overhang: x_mm -> -x_mm)");
       throw InputError(src + ": " + row + ": the profile folds back (x_mm decreases from " +
                        std::to_string(max_x * 1e3) + " to " + std::to_string(p.x[i] * 1e3) + ")");
     }

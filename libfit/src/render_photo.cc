@@ -353,8 +353,9 @@ bool RenderPhotoOptions::Check(std::string* why) const {
   };
   if (!finite_in(overhang, 1e-3, 2.0)) {
     p << "overhang must lie in [1, 2000] mm";
-  } else if (!finite_in(thickness, 1e-5, 0.02)) {
-    p << "thickness must lie in [0.01, 20] mm";
+  } else if (!finite_in(thickness, 1e-5, kMaxRenderThickness)) {
+    p << "thickness must lie in [0.01, " << kMaxRenderThickness * 1e3
+      << "] mm (thicker strips rise too far above the platform for extract)";
   } else if (!finite_in(strip_width, 0.0, 0.5)) {
     p << "strip_width must lie in [0, 500] mm";
   } else if (width_px < 64 || height_px < 64 || width_px > 12000 || height_px > 12000 ||

@@ -40,6 +40,38 @@ struct BadCase {
   const char* fragment;
 };
 
+// A mid-line starts half a thickness above the platform: a strip thicker than the rise check
+// allows (6 mm) is named as the likelier cause near the edge; a rise further out is not.
+TEST(Profile, RiseNearTheEdgeNamesTheThickness) {
+  Profile p;
+  p.source = "thick.csv";
+  for (int i = 0; i < 20; ++i) {
+    p.s.push_back(i * 1e-3);
+    p.x.push_back(i * 1e-3);
+    p.y.push_back(4e-3 - i * 1e-4);  // starts 4 mm up, a 8 mm strip
+  }
+  try {
+    CheckProfile(p);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("point 1 lies 4.000000 mm above the platform, more than 3 mm"),
+              std::string::npos)
+        << m;
+    EXPECT_NE(m.find("a strip thicker than 6 mm"), std::string::npos) << m;
+  }
+  for (double& y : p.y) y = -1e-3;
+  p.y[15] = 5e-3;  // far from the edge: a rising tip, not a thick strip
+  try {
+    CheckProfile(p);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("point 16 lies"), std::string::npos) << m;
+    EXPECT_EQ(m.find("thicker"), std::string::npos) << m;
+  }
+}
+
 class BadProfile : public ::testing::TestWithParam<BadCase> {};
 
 TEST_P(BadProfile, IsRejectedNamingTheFile) {

@@ -43,7 +43,8 @@ std::string ToString(PhotoDifficulty d);
 struct RenderPhotoOptions {
   // --- the strip ---
   double overhang = 0.06;       // free length L beyond the platform edge [m]
-  double thickness = 0.5e-3;    // t [m]: the band's height as seen side-on
+  double thickness = 0.5e-3;    // t [m]: the band's height as seen side-on, at most
+                                // kMaxRenderThickness (what extraction measures reliably)
   double strip_width = 0.0;     // depth of the strip away from the camera [m]; > 0 shows its top
                                 // or bottom face as a band next to the side face (oblique view)
   double on_platform = 0.04;    // length lying on the platform, visible part [m]
@@ -91,6 +92,11 @@ struct RenderPhotoOptions {
   // True if every field is usable; otherwise *why says which and why.
   bool Check(std::string* why) const;
 };
+
+// Thickest strip rendered [m]: its mid-line starts t/2 above the platform, and extraction
+// refuses mid-lines more than 3 mm up (CheckProfile); 4 mm leaves a millimetre for the noise of
+// the first points (4 mm strips extract to about 0.05 mm RMS, 5 mm ones were refused or worse).
+inline constexpr double kMaxRenderThickness = 4e-3;
 
 struct RenderedPhoto {
   cv::Mat photo;                    // CV_8UC1, width_px × height_px (after JPEG if asked)

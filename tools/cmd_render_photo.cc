@@ -146,7 +146,14 @@ void Run(const RenderArgs& a) {
   }
   if (a.direction != "auto") o.overhang_left = a.direction == "left";
   std::string why;
-  if (!o.Check(&why)) throw InputError("render-photo: " + why);
+  if (!o.Check(&why)) {
+    // Name the flag where one set the field.
+    const std::string flag = why.rfind("photo size", 0) == 0  ? "--size"
+                             : why.rfind("board", 0) == 0     ? "--board"
+                             : why.rfind("thickness", 0) == 0 ? "--thickness-mm"
+                                                              : "render-photo";
+    throw InputError(flag + ": " + why);
+  }
 
   // One camera for every overhang: framed on the longest strip.
   std::vector<double> lengths = a.overhangs_mm;

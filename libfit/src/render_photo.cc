@@ -259,6 +259,20 @@ cv::Mat RenderScene(const Scene& sc, const RenderPhotoOptions& o, std::uint64_t 
   return photo;
 }
 
+// The board's square [mm]: as given, or about 60 % of the photo's short way across the card
+// (the inner corners plus a square and a half of margin each side), whole or half millimetres.
+double BoardSquareMm(const RenderPhotoOptions& o) {
+  if (o.board_square_mm > 0) return o.board_square_mm;
+  const double W = o.width_px * o.mm_per_px, H = o.height_px * o.mm_per_px;
+  const double sq = 0.6 * std::min(W / (o.board_cols + 3), H / (o.board_rows + 3));
+  return std::max(0.5, std::round(sq * 2.0) / 2.0);
+}
+
+// Fewest pixels a board square may span for `calibrate` to find its corners: rendered 9x6
+// boards with 10 px squares were found on every level (the auto size cannot go lower without
+// shrinking the photo below what holds a strip).
+constexpr double kMinBoardSquarePx = 10.0;
+
 }  // namespace
 
 PhotoDifficulty ParsePhotoDifficulty(const std::string& text, const std::string& flag) {
@@ -386,11 +400,21 @@ bool RenderPhotoOptions::Check(std::string* why) const {
     p << "supersample must lie in [1, 8]";
   } else if (board_cols < 3 || board_rows < 3 || board_cols > 40 || board_rows > 40 ||
              board_cols == board_rows) {
-    p << "the board needs 3..40 inner corners a side, different counts (its orientation)";
+    p << "board needs 3..40 inner corners a side, different counts (its orientation)";
   } else if (aim_mm && !(std::isfinite(aim_mm->x()) && std::isfinite(aim_mm->y()))) {
     p << "aim_mm must be finite";
   } else if (!finite_in(board_square_mm, 0, 500)) {
     p << "board_square_mm must lie in [0, 500]";
+  } else if (const double sq = BoardSquareMm(*this);
+             sq / mm_per_px < kMinBoardSquarePx ||
+             (board_cols + 1) * sq > 0.9 * width_px * mm_per_px ||
+             (board_rows + 1) * sq > 0.9 * height_px * mm_per_px) {
+    // A board that cannot be calibrated from is no use: its squares too small to be found, or
+    // the board larger than the photo.
+    p << "board " << board_cols << "x" << board_rows << " with " << sq << " mm squares ("
+      << sq / mm_per_px << " px) does not fit a " << width_px << "x" << height_px
+      << " px photo with squares of at least " << kMinBoardSquarePx
+      << " px (fewer corners or a larger photo)";
   }
   if (why) *why = p.str();
   return p.str().empty();
@@ -579,11 +603,7 @@ RenderedPhoto RenderPhoto(const BendingLaw& law, double areal_density,
   }
 
   // The chessboard in the bending plane, centred on the aim point, on a white card.
-  double sq = o.board_square_mm;
-  if (sq <= 0) {
-    sq = 0.6 * std::min(W / (o.board_cols + 3), H / (o.board_rows + 3));
-    sq = std::max(0.5, std::round(sq * 2.0) / 2.0);
-  }
+  const double sq = BoardSquareMm(o);
   {
     Scene board;
     board.bg = o.light_strip ? 0.3 : o.background_reflectance;

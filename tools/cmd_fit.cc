@@ -32,8 +32,19 @@ struct FitArgs {
   bool thickness_given = false;  // else the offset is fitted
   bool no_offset = false, fit_rotation = false, json = false;
   double robust_mm = 0.5;
+  bool robust_given = false;
   PhotoFlags photo;  // photos among the inputs are extracted first
 };
+
+// "pabst-fig8_L040mm" for .../pabst-fig8_L040mm.profile.csv (extract's and synth-profile's
+// names) and for a photo .../pabst-fig8_L040mm.jpg.
+std::string InputStem(const std::string& path) {
+  std::string stem = std::filesystem::path(path).stem().string();
+  const std::string suffix = ".profile";
+  if (stem.size() > suffix.size() && stem.ends_with(suffix))
+    stem.resize(stem.size() - suffix.size());
+  return stem;
+}
 
 // JSON null for a value that is not available (an undetermined constant's σ).
 nlohmann::json OrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
@@ -63,11 +74,14 @@ Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double
   nlohmann::json per = nlohmann::json::array();
   for (size_t i = 0; i < profiles.size(); ++i) {
     const auto& r = fit.profiles[i];
-    per.push_back({{"source", r.source}, {"overhang_mm", r.overhang * 1e3},
-                   {"data_length_mm", r.data_length * 1e3}, {"rms_mm", r.rms * 1e3},
+    per.push_back({{"source", r.source},
+                   {"overhang_mm", r.overhang * 1e3},
+                   {"data_length_mm", r.data_length * 1e3},
+                   {"rms_mm", r.rms * 1e3},
                    {"max_mm", r.max * 1e3},
                    {"clamp_curvature_per_cm", units::SiCurvatureToKes(r.clamp_curvature)}});
-    out.comparisons.push_back(CompareWithElastica(out.law, rho, profiles[i], r.overhang, fit.offset));
+    out.comparisons.push_back(
+        CompareWithElastica(out.law, rho, profiles[i], r.overhang, fit.offset));
   }
   out.report = {{"method", "direct"},
                 {"b1_sd", OrNull(units::SiStiffnessToKes(fit.b1_sd))},
@@ -107,8 +121,10 @@ Outcome RunClapp(const std::vector<Profile>& profiles, double rho) {
     const ProfileComparison c = CompareWithElastica(out.law, rho, profiles[i], L, 0.0);
     s2 += c.rms * c.rms * profiles[i].size();
     n += static_cast<int>(profiles[i].size());
-    per.push_back({{"source", profiles[i].source}, {"overhang_mm", L * 1e3},
-                   {"data_length_mm", profiles[i].s.back() * 1e3}, {"rms_mm", c.rms * 1e3},
+    per.push_back({{"source", profiles[i].source},
+                   {"overhang_mm", L * 1e3},
+                   {"data_length_mm", profiles[i].s.back() * 1e3},
+                   {"rms_mm", c.rms * 1e3},
                    {"max_mm", c.max * 1e3},
                    {"polynomial_rms_mm", fit.profiles[i].residual_rms * 1e3}});
     out.comparisons.push_back(c);
@@ -151,19 +167,23 @@ void Plot(const FitArgs& a, const std::vector<Profile>& profiles, const Outcome&
           const std::optional<ClappResult>& clapp, AtomicFile& out) {
   namespace chart = textile::chart;
   chart::Panel prof{.title = "Profiles: measured and fitted",
-                    .x_label = "x [mm]", .y_label = "y [mm]", .equal_aspect = true};
+                    .x_label = "x [mm]",
+                    .y_label = "y [mm]",
+                    .equal_aspect = true};
   std::vector<chart::Series> models;
   for (size_t i = 0; i < profiles.size(); ++i) {
     const auto color = chart::PaletteColor(static_cast<int>(i));
     chart::Series data{.label = std::filesystem::path(profiles[i].source).filename().string(),
-                       .style = chart::Series::Style::kMarkers, .color = color};
+                       .style = chart::Series::Style::kMarkers,
+                       .color = color};
     for (size_t j = 0; j < profiles[i].size(); ++j) {
       data.x.push_back(profiles[i].x[j] * 1e3);
       data.y.push_back(profiles[i].y[j] * 1e3);
     }
     // Thin dark lines on top of the dots, so that the fit is visible through the data.
     chart::Series model{.label = i == 0 ? "fitted elastica" : "",
-                        .color = chart::Rgb{0.1, 0.1, 0.1}, .line_width = 1.2};
+                        .color = chart::Rgb{0.1, 0.1, 0.1},
+                        .line_width = 1.2};
     for (size_t j = 0; j < o.comparisons[i].model_x.size(); ++j) {
       model.x.push_back(o.comparisons[i].model_x[j] * 1e3);
       model.y.push_back(o.comparisons[i].model_y[j] * 1e3);
@@ -187,7 +207,8 @@ void Plot(const FitArgs& a, const std::vector<Profile>& profiles, const Outcome&
   };
   mk.series.push_back(curve(o.law, a.method == "direct" ? "direct fit" : "Clapp fit", false));
   if (clapp && clapp->law) {
-    chart::Series pts{.label = "Clapp (κ, M) points", .style = chart::Series::Style::kMarkers,
+    chart::Series pts{.label = "Clapp (κ, M) points",
+                      .style = chart::Series::Style::kMarkers,
                       .color = chart::Rgb{0.6, 0.6, 0.6}};
     for (const auto& p : clapp->points) {
       pts.x.push_back(units::SiCurvatureToKes(p.kappa));
@@ -196,26 +217,42 @@ void Plot(const FitArgs& a, const std::vector<Profile>& profiles, const Outcome&
     mk.series.push_back(pts);
     if (a.method == "direct") mk.series.push_back(curve(*clapp->law, "Clapp's law", true));
   }
-  mk.notes = {"b1 = " + Num(o.law.b1_kes(), 4) + " gf·cm", "b2 = " + Num(o.law.b2_kes(), 4) + " gf·cm",
+  mk.notes = {"b1 = " + Num(o.law.b1_kes(), 4) + " gf·cm",
+              "b2 = " + Num(o.law.b2_kes(), 4) + " gf·cm",
               "c1 = " + Num(o.law.c1_kes(), 4) + " gf·cm²",
               "κ0 = " + Num(units::SiCurvatureToKes(o.law.kappa0()), 4) + " /cm"};
   chart::WritePng({.title = "textile fit (" + a.method + "), " + Num(a.gsm) + " g/m²",
-                   .width_px = 1300, .height_px = 600, .columns = 2, .panels = {prof, mk}},
+                   .width_px = 1300,
+                   .height_px = 600,
+                   .columns = 2,
+                   .panels = {prof, mk}},
                   out);
   (void)rho;
 }
 
 void Run(const FitArgs& a) {
   if (!std::isfinite(a.gsm) || a.gsm <= 0.0) throw InputError("--gsm must be a number > 0 (g/m²)");
-  if (a.gsm < 1.0 || a.gsm > 1e4) throw InputError("--gsm " + Num(a.gsm) + " g/m² is implausible (1 .. 10000)");
+  if (a.gsm < 1.0 || a.gsm > 1e4)
+    throw InputError("--gsm " + Num(a.gsm) + " g/m² is implausible (1 .. 10000)");
   if (!(a.robust_mm == 0.0 || (a.robust_mm >= 0.001 && a.robust_mm <= 100.0)))
     throw InputError("--robust-mm must be 0 (off) or in [0.001, 100] mm");
   if (a.thickness_given && !(a.thickness_mm > 0.0 && a.thickness_mm <= 20.0))
     throw InputError("--thickness-mm must lie in (0, 20] mm, got " + Num(a.thickness_mm));
   if (a.thickness_given && a.no_offset)
     throw InputError("--thickness-mm and --no-offset contradict each other (offset t/2 vs 0)");
+  // Clapp's polynomial takes the profiles as they are: no offset, rotation or robust loss.
+  if (a.method == "clapp") {
+    for (const auto& [given, flag] :
+         {std::pair{a.thickness_given, "--thickness-mm"}, std::pair{a.no_offset, "--no-offset"},
+          std::pair{a.fit_rotation, "--fit-rotation"}, std::pair{a.robust_given, "--robust-mm"}})
+      if (given)
+        throw InputError(
+            std::string(flag) +
+            ": an option of the direct fit; --method clapp fits the profiles as they are");
+  }
   const double rho = units::GsmToSi(a.gsm);
-  // Check the outputs before the work (photos included), so that a bad path fails fast; they appear together.
+  // Check the outputs before the work (photos included), so that a bad path fails fast; they appear
+  // together.
   std::vector<std::pair<std::string, std::string>> inputs{{"--rig", a.photo.rig_file}};
   for (const std::string& in : a.inputs) inputs.emplace_back("(a profile or photo)", in);
   CheckDistinctOutputs({{"-o", a.out}, {"--plot", a.plot}}, inputs);
@@ -226,17 +263,23 @@ void Run(const FitArgs& a) {
 
   const std::vector<LoadedProfile> loaded = LoadProfileInputs(a.inputs, a.photo.Options());
   std::vector<Profile> profiles;
-  std::ostringstream extracted;  // printed once the fit has succeeded: a failed run's stdout stays empty
-  std::string photo_warnings;    // what may explain a failed fit, for its one error line
+  std::ostringstream
+      extracted;  // printed once the fit has succeeded: a failed run's stdout stays empty
+  std::string photo_warnings;  // what may explain a failed fit, for its one error line
   nlohmann::json photos = nlohmann::json::array();
   for (const auto& in : loaded) {
     profiles.push_back(in.profile);
     if (!in.extraction) continue;
     const ExtractionSummary& r = *in.extraction;
-    photos.push_back({{"photo", in.source}, {"rig_type", r.rig_type}, {"polarity", r.polarity},
-                      {"direction", r.direction}, {"trace", r.trace},
-                      {"points", r.profile.size()}, {"length_mm", r.length_mm},
-                      {"tip_mm", {r.tip_mm.x(), r.tip_mm.y()}}, {"mm_per_px", r.mm_per_px},
+    photos.push_back({{"photo", in.source},
+                      {"rig_type", r.rig_type},
+                      {"polarity", r.polarity},
+                      {"direction", r.direction},
+                      {"trace", r.trace},
+                      {"points", r.profile.size()},
+                      {"length_mm", r.length_mm},
+                      {"tip_mm", {r.tip_mm.x(), r.tip_mm.y()}},
+                      {"mm_per_px", r.mm_per_px},
                       {"warnings", r.warnings}});
     if (!a.json) {
       extracted << "extracted " << in.source << ": " << r.rig_type << " rig, " << r.polarity
@@ -257,7 +300,8 @@ void Run(const FitArgs& a) {
       probe.bending = o.law;
       ParseMaterialJson(MaterialToJson(probe).dump(), "fitted law");
     } catch (const InputError& e) {
-      throw ComputeError(std::string("fit (") + a.method + ") gave an implausible law: " + e.what());
+      throw ComputeError(std::string("fit (") + a.method +
+                         ") gave an implausible law: " + e.what());
     }
   } catch (const ComputeError& e) {
     if (photo_warnings.empty()) throw;
@@ -280,7 +324,7 @@ void Run(const FitArgs& a) {
   }
 
   Material m;
-  m.name = a.name.empty() ? "fitted from " + std::filesystem::path(a.inputs.front()).stem().string() : a.name;
+  m.name = a.name.empty() ? "fitted from " + InputStem(a.inputs.front()) : a.name;
   m.areal_density = rho;
   m.bending = o.law;
   m.fit = o.report;
@@ -293,14 +337,16 @@ void Run(const FitArgs& a) {
   }
   std::cout << extracted.str() << o.brief << "\n";
   std::cout << "law: b1 = " << Num(o.law.b1_kes(), 5) << " gf·cm, b2 = " << Num(o.law.b2_kes(), 5)
-            << " gf·cm, c1 = " << Num(o.law.c1_kes(), 5) << " gf·cm²  (kappa0 = "
-            << Num(units::SiCurvatureToKes(o.law.kappa0()), 4) << " /cm)\n";
+            << " gf·cm, c1 = " << Num(o.law.c1_kes(), 5)
+            << " gf·cm²  (kappa0 = " << Num(units::SiCurvatureToKes(o.law.kappa0()), 4)
+            << " /cm)\n";
   std::cout << "profile rms: " << Num(o.report["rms_mm"].get<double>(), 3) << " mm\n";
   if (o.report.contains("bending_length_mm")) {
-    std::cout << "classic 41.5° test of this law: c = " << Num(o.report["bending_length_mm"].get<double>(), 4)
-              << " mm, G = " << Num(o.report["flexural_rigidity_uNm"].get<double>(), 4) << " µN·m = "
-              << Num(o.report["flexural_rigidity_mgcm"].get<double>(), 4) << " mg·cm (G/b1 = "
-              << Num(o.report["G_over_b1"].get<double>(), 3) << ")\n";
+    std::cout << "classic 41.5° test of this law: c = "
+              << Num(o.report["bending_length_mm"].get<double>(), 4)
+              << " mm, G = " << Num(o.report["flexural_rigidity_uNm"].get<double>(), 4)
+              << " µN·m = " << Num(o.report["flexural_rigidity_mgcm"].get<double>(), 4)
+              << " mg·cm (G/b1 = " << Num(o.report["G_over_b1"].get<double>(), 3) << ")\n";
   }
   std::cout << "wrote " << a.out << (a.plot.empty() ? "" : " and " + a.plot) << "\n";
 }
@@ -311,28 +357,37 @@ void RegisterFit(CLI::App& app) {
   auto a = std::make_shared<FitArgs>();
   CLI::App* sub = AddSubcommand(
       app, "fit", "Fit the bending law {b1, b2, c1} to cantilever profiles or photos of one strip",
-      "textile fit samples/profiles/pabst-fig8_L0*.profile.csv --gsm 200 -o fitted.json --plot fit.png\n"
-      "  textile fit samples/photos/pabst-fig8_L0*.jpg --rig samples/photos/pabst-fig8.rig-truth.json --gsm 200 -o fitted.json");
-  sub->add_option("inputs", a->inputs,
-                  "Profile CSV files (s_mm,x_mm,y_mm) or photos (PNG, JPEG, TIFF, BMP; need --rig or "
-                  "--mm-per-px) of the same strip")
+      "textile fit samples/profiles/pabst-fig8_L0*.profile.csv --gsm 200 -o fitted.json --plot "
+      "fit.png\n"
+      "  textile fit samples/photos/pabst-fig8_L0*.jpg --rig "
+      "samples/photos/pabst-fig8.rig-truth.json --gsm 200 -o fitted.json");
+  sub->add_option(
+         "inputs", a->inputs,
+         "Profile CSV files (s_mm,x_mm,y_mm) or photos (PNG, JPEG, TIFF, BMP; need --rig or "
+         "--mm-per-px) of the same strip")
       ->required();
   sub->add_option("--gsm", a->gsm, "Areal density of the fabric [g/m²]")->required();
-  sub->add_option("--method", a->method, "direct (elastica fit, default) or clapp (Clapp et al. 1990)")
+  sub->add_option("--method", a->method,
+                  "direct (elastica fit, default) or clapp (Clapp et al. 1990)")
       ->check(CLI::IsMember({"direct", "clapp"}));
   sub->add_option("-o,--out", a->out, "Material JSON to write (with the fit report)")->required();
-  sub->add_option("--plot", a->plot, "Write measured vs fitted profiles and the M-κ curve to a PNG");
+  sub->add_option("--plot", a->plot,
+                  "Write measured vs fitted profiles and the M-κ curve to a PNG");
   sub->add_option("--name", a->name, "Material name to store");
-  sub->add_option("--thickness-mm", a->thickness_mm,
-                  "Measured strip thickness [mm]: fixes the mid-line offset to t/2 (default: fitted)");
+  sub->add_option(
+      "--thickness-mm", a->thickness_mm,
+      "Measured strip thickness [mm]: fixes the mid-line offset to t/2 (default: fitted)");
   sub->add_flag("--no-offset", a->no_offset, "Force the curve through the edge (offset 0)");
   sub->add_flag("--fit-rotation", a->fit_rotation, "Also fit a small rig rotation");
-  sub->add_option("--robust-mm", a->robust_mm, "Cauchy loss scale per point [mm]; 0 = plain least squares (default 0.5)");
+  sub->add_option("--robust-mm", a->robust_mm,
+                  "Cauchy loss scale per point [mm]; 0 = plain least squares (default 0.5)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   AddPhotoFlags(sub, &a->photo);
   CLI::Option* thickness = sub->get_option("--thickness-mm");
-  sub->callback([a, thickness] {
+  CLI::Option* robust = sub->get_option("--robust-mm");
+  sub->callback([a, thickness, robust] {
     a->thickness_given = thickness->count() > 0;
+    a->robust_given = robust->count() > 0;
     Run(*a);
   });
 }

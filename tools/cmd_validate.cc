@@ -78,25 +78,29 @@ void Grade(double tol, double tol_mm, ModelCheck* k) {
 nlohmann::json ModelJson(const ModelCheck& k) {
   if (!k.run) return nullptr;
   const ProfileComparison& c = k.c;
-  return {{"rms_mm", units::MToMm(c.rms)},
-          {"max_mm", units::MToMm(c.max)},
-          {"tip_dx_mm", units::MToMm(c.tip_dx)},
-          {"tip_dy_mm", units::MToMm(c.tip_dy)},
-          {"tip_mm", units::MToMm(std::hypot(c.tip_dx, c.tip_dy))},
-          {"clamp_curvature_per_cm", std::isfinite(c.clamp_curvature)
-                                         ? nlohmann::json(units::SiCurvatureToKes(c.clamp_curvature))
-                                         : nlohmann::json()},
-          {"solves", k.solves},
-          {"pass", k.pass},
-          {"why", k.why}};
+  return {
+      {"rms_mm", units::MToMm(c.rms)},
+      {"max_mm", units::MToMm(c.max)},
+      {"tip_dx_mm", units::MToMm(c.tip_dx)},
+      {"tip_dy_mm", units::MToMm(c.tip_dy)},
+      {"tip_mm", units::MToMm(std::hypot(c.tip_dx, c.tip_dy))},
+      {"clamp_curvature_per_cm", std::isfinite(c.clamp_curvature)
+                                     ? nlohmann::json(units::SiCurvatureToKes(c.clamp_curvature))
+                                     : nlohmann::json()},
+      {"solves", k.solves},
+      {"pass", k.pass},
+      {"why", k.why}};
 }
 
 void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles,
           const BendingLaw& law, double tol_mm, bool pass, AtomicFile& out) {
   namespace chart = textile::chart;
-  chart::Panel p{.title = "Measured (dots) and simulated cantilevers: elastica (solid), shell (dashed)",
-                 .x_label = "x [mm]", .y_label = "y [mm]", .equal_aspect = true,
-                 .legend_corner = chart::Corner::kTopRight};  // the notes: the corner with the least ink
+  chart::Panel p{
+      .title = "Measured (dots) and simulated cantilevers: elastica (solid), shell (dashed)",
+      .x_label = "x [mm]",
+      .y_label = "y [mm]",
+      .equal_aspect = true,
+      .legend_corner = chart::Corner::kTopRight};  // the notes: the corner with the least ink
   std::vector<chart::Series> lines;
   const auto curve = [](const ProfileComparison& c, const std::string& label, bool dashed,
                         chart::Rgb color) {
@@ -127,7 +131,8 @@ void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles
   for (size_t i = 0; i < checks.size(); ++i) {
     const Check& k = checks[i];
     const std::string name = std::filesystem::path(k.source).filename().string();
-    chart::Series data{.label = name, .style = chart::Series::Style::kMarkers,
+    chart::Series data{.label = name,
+                       .style = chart::Series::Style::kMarkers,
                        .color = chart::PaletteColor(static_cast<int>(i))};
     for (size_t j = 0; j < profiles[i].size(); ++j) {
       data.x.push_back(units::MToMm(profiles[i].x[j]));
@@ -141,8 +146,10 @@ void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles
       rms += (rms.empty() ? "" : "/") + Num(units::MToMm(m->c.rms), 2);
       max += (max.empty() ? "" : "/") + Num(units::MToMm(m->c.max), 2);
     }
-    if (k.elastica.run) lines.push_back(curve(k.elastica.c, i == 0 ? "elastica" : "", false, {0.1, 0.1, 0.1}));
-    if (k.shell.run) lines.push_back(curve(k.shell.c, i == 0 ? "shell" : "", true, {0.85, 0.1, 0.1}));
+    if (k.elastica.run)
+      lines.push_back(curve(k.elastica.c, i == 0 ? "elastica" : "", false, {0.1, 0.1, 0.1}));
+    if (k.shell.run)
+      lines.push_back(curve(k.shell.c, i == 0 ? "shell" : "", true, {0.85, 0.1, 0.1}));
     const std::string note = stems[i].substr(common) + ": rms " + rms + ", max " + max + " mm";
     p.notes.push_back(note + (k.pass ? " ok" : " FAIL"));
   }
@@ -151,8 +158,8 @@ void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles
     p.notes.push_back("(elastica/shell)");
   p.notes.push_back("law b1 = " + Num(law.b1_kes(), 4) + ", b2 = " + Num(law.b2_kes(), 4) +
                     " gf·cm, c1 = " + Num(law.c1_kes(), 4) + " gf·cm²");
-  p.notes.push_back(std::string("verdict: ") + (pass ? "PASS" : "FAIL") + " (rms ≤ " +
-                    Num(tol_mm) + " mm, max and tip ≤ " + Num(kMaxOverRms * tol_mm) + " mm)");
+  p.notes.push_back(std::string("verdict: ") + (pass ? "PASS" : "FAIL") + " (rms ≤ " + Num(tol_mm) +
+                    " mm, max and tip ≤ " + Num(kMaxOverRms * tol_mm) + " mm)");
   chart::WritePng({.title = "textile validate", .width_px = 1100, .height_px = 800, .panels = {p}},
                   out);
 }
@@ -162,8 +169,10 @@ void Run(const ValidateArgs& a) {
     throw InputError("--gsm must be an areal density in [1, 10000] g/m², got " + Num(a.gsm));
   if (!std::isfinite(a.tolerance_mm) || a.tolerance_mm <= 0.0 || a.tolerance_mm > 50.0)
     throw InputError("--tolerance-mm must lie in (0, 50] mm, got " + Num(a.tolerance_mm));
-  if (!std::isfinite(a.width_mm) || a.width_mm <= 0.0 || a.width_mm > 200.0)
-    throw InputError("--width-mm must lie in (0, 200] mm, got " + Num(a.width_mm));
+  // At least 5 mm: the standard strip is 25 mm wide, and a shell of 0.1 mm did not settle
+  // (exit 3 after the fit instead of a refused flag).
+  if (!std::isfinite(a.width_mm) || a.width_mm < 5.0 || a.width_mm > 200.0)
+    throw InputError("--width-mm must lie in [5, 200] mm, got " + Num(a.width_mm));
   const bool run_elastica = a.model != "shell", run_shell = a.model != "elastica";
   const double rho = units::GsmToSi(a.gsm);
   const std::vector<LoadedProfile> loaded = LoadProfileInputs(a.inputs, a.photo.Options());
@@ -259,25 +268,32 @@ void Run(const ValidateArgs& a) {
       {"inputs", a.inputs},
       {"areal_density_gsm", a.gsm},
       {"law_kes", {{"b1", law.b1_kes()}, {"b2", law.b2_kes()}, {"c1", law.c1_kes()}}},
-      {"fit", {{"rms_mm", units::MToMm(fit.rms)},
-               {"offset_mm", units::MToMm(fit.offset)},
-               {"b1_sd_kes", std::isfinite(fit.b1_sd) ? nlohmann::json(units::SiStiffnessToKes(fit.b1_sd)) : nlohmann::json()},
-               {"b2_sd_kes", std::isfinite(fit.b2_sd) ? nlohmann::json(units::SiStiffnessToKes(fit.b2_sd)) : nlohmann::json()},
-               {"c1_sd_kes", std::isfinite(fit.c1_sd) ? nlohmann::json(units::SiQuadraticToKes(fit.c1_sd)) : nlohmann::json()},
-               {"observability", fit.observability}}},
-      {"models", {{"elastica", run_elastica ? "simulated" : "not run (--model shell)"},
-                  {"shell", run_shell ? "simulated: 3D shell, tensor bending, " + shell_notes +
-                                            ", strip " + Num(a.width_mm) + " mm wide"
-                                      : "not run (--model elastica)"}}},
-      {"tolerance", {{"rms_mm", a.tolerance_mm},
-                     {"max_mm", kMaxOverRms * a.tolerance_mm},
-                     {"tip_mm", kMaxOverRms * a.tolerance_mm}}},
+      {"fit",
+       {{"rms_mm", units::MToMm(fit.rms)},
+        {"offset_mm", units::MToMm(fit.offset)},
+        {"b1_sd_kes", std::isfinite(fit.b1_sd) ? nlohmann::json(units::SiStiffnessToKes(fit.b1_sd))
+                                               : nlohmann::json()},
+        {"b2_sd_kes", std::isfinite(fit.b2_sd) ? nlohmann::json(units::SiStiffnessToKes(fit.b2_sd))
+                                               : nlohmann::json()},
+        {"c1_sd_kes", std::isfinite(fit.c1_sd) ? nlohmann::json(units::SiQuadraticToKes(fit.c1_sd))
+                                               : nlohmann::json()},
+        {"observability", fit.observability}}},
+      {"models",
+       {{"elastica", run_elastica ? "simulated" : "not run (--model shell)"},
+        {"shell", run_shell ? "simulated: 3D shell, tensor bending, " + shell_notes + ", strip " +
+                                  Num(a.width_mm) + " mm wide"
+                            : "not run (--model elastica)"}}},
+      {"tolerance",
+       {{"rms_mm", a.tolerance_mm},
+        {"max_mm", kMaxOverRms * a.tolerance_mm},
+        {"tip_mm", kMaxOverRms * a.tolerance_mm}}},
       {"profiles", per},
       {"verdict", all_pass ? "pass" : "fail"},
       {"png", png_path},
       {"material", material_path}};
   if (all_pass || !a.strict) {
-    fitted.fit = {{"method", "direct"}, {"rms_mm", units::MToMm(fit.rms)}, {"validate", report_path}};
+    fitted.fit = {
+        {"method", "direct"}, {"rms_mm", units::MToMm(fit.rms)}, {"validate", report_path}};
     material_file.Write(MaterialToJson(fitted).dump(2) + "\n");
     Plot(checks, profiles, law, a.tolerance_mm, all_pass, png_file);
     report_file.Write(report.dump(2) + "\n");
@@ -294,10 +310,10 @@ void Run(const ValidateArgs& a) {
     PrintJson(report);
     return;
   }
-  std::cout << "fitted law: b1 = " << Num(law.b1_kes(), 5) << " gf·cm, b2 = " << Num(law.b2_kes(), 5)
-            << " gf·cm, c1 = " << Num(law.c1_kes(), 5) << " gf·cm² (fit rms "
-            << Num(units::MToMm(fit.rms), 3) << " mm, offset " << Num(units::MToMm(fit.offset), 3)
-            << " mm)\n"
+  std::cout << "fitted law: b1 = " << Num(law.b1_kes(), 5)
+            << " gf·cm, b2 = " << Num(law.b2_kes(), 5) << " gf·cm, c1 = " << Num(law.c1_kes(), 5)
+            << " gf·cm² (fit rms " << Num(units::MToMm(fit.rms), 3) << " mm, offset "
+            << Num(units::MToMm(fit.offset), 3) << " mm)\n"
             << "simulated at each fitted overhang with " << (run_elastica ? "the elastica" : "")
             << (run_elastica && run_shell ? " and " : "")
             << (run_shell ? "the shell (" + shell_notes + "; " + std::to_string(shell_solves) +
@@ -333,20 +349,22 @@ void RegisterValidate(CLI::App& app) {
       "(RMS, max, tip, verdict), report JSON + PNG",
       "textile validate samples/profiles/pabst-fig8_L0*.profile.csv --gsm 200 -o out/validate\n"
       "  textile validate strip_*.jpg --rig rig.json --gsm 200 -o out/validate");
-  sub->add_option("inputs", a->inputs,
-                  "Profile CSV files (s_mm,x_mm,y_mm) or photos (need --rig or --mm-per-px) of one strip")
+  sub->add_option(
+         "inputs", a->inputs,
+         "Profile CSV files (s_mm,x_mm,y_mm) or photos (need --rig or --mm-per-px) of one strip")
       ->required();
   sub->add_option("--gsm", a->gsm, "Areal density of the fabric [g/m²]")->required();
   sub->add_option("-o,--out", a->out_dir, "Folder for validate.json, validate.png and fitted.json")
       ->required();
   sub->add_option("--tolerance-mm", a->tolerance_mm,
                   "RMS deviation allowed per profile [mm] (max and tip: 3x); default 0.5");
-  sub->add_option("--model", a->model,
-                  "Models to simulate: both (default), elastica (exact, ms) or shell (the 3D engine, "
-                  "~0.25 s per profile)")
+  sub->add_option(
+         "--model", a->model,
+         "Models to simulate: both (default), elastica (exact, ms) or shell (the 3D engine, "
+         "~0.25 s per profile)")
       ->check(CLI::IsMember({"both", "elastica", "shell"}));
   sub->add_option("--width-mm", a->width_mm,
-                  "Strip width for the shell model [mm], in (0, 200]; default 25");
+                  "Strip width for the shell model [mm], in [5, 200]; default 25");
   sub->add_flag("--strict", a->strict, "A failed validation is an error (exit 3, nothing written)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   AddPhotoFlags(sub, &a->photo);

@@ -53,11 +53,12 @@ Profile ParseProfileCsv(const std::string& text, const std::string& source) {
     const auto where = [&] { return source + ":" + std::to_string(line_no) + ": "; };
     if (!header_seen) {
       std::string h;
-      for (char c : t) if (c != ' ' && c != '\t') h += c;
+      for (char c : t)
+        if (c != ' ' && c != '\t') h += c;
       if (h.rfind("\xEF\xBB\xBF", 0) == 0) h = h.substr(3);  // UTF-8 byte-order mark
       if (h != "s_mm,x_mm,y_mm") {
-        throw InputError(where() + "expected the header 's_mm,x_mm,y_mm', got '" +
-                         t.substr(0, 60) + "'");
+        throw InputError(where() + "expected the header 's_mm,x_mm,y_mm', got '" + t.substr(0, 60) +
+                         "'");
       }
       header_seen = true;
       continue;

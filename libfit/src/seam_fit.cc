@@ -43,23 +43,36 @@ bool ParseNumber(const std::string& field, double* v) {
   return !in.fail() && in.eof();
 }
 
+// The farthest sample from the seam line a fit takes [mm].
+constexpr double kMaxSeamDistanceMm = 1000.0;
+
 // The checks every sample must pass, wherever it came from; `where` prefixes the message.
 void CheckSample(const SeamSample& p, const std::string& where) {
-  if (!std::isfinite(p.d_mm) || !std::isfinite(p.factor) || (!std::isnan(p.sd) && !std::isfinite(p.sd)))
+  if (!std::isfinite(p.d_mm) || !std::isfinite(p.factor) ||
+      (!std::isnan(p.sd) && !std::isfinite(p.sd)))
     throw InputError(where + ": values must be finite numbers");
   if (p.d_mm < 0.0)
-    throw InputError(where + ": d_mm = " + Num(p.d_mm) + " is negative (distance from the seam line)");
+    throw InputError(where + ": d_mm = " + Num(p.d_mm) +
+                     " is negative (distance from the seam line)");
+  // A seam's influence spans centimetres (the ACPM sample's half-width is 100 mm); far larger
+  // distances are a unit mix-up, and 1e200 mm overflowed the least squares to NaN coefficients.
+  if (p.d_mm > kMaxSeamDistanceMm)
+    throw InputError(where + ": d_mm = " + Num(p.d_mm) + " is beyond " + Num(kMaxSeamDistanceMm) +
+                     " mm from the seam line (d in mm, not µm?)");
   if (!(p.factor >= 1e-6 && p.factor <= kMaxSeamFactor))
-    throw InputError(where + ": factor = " + Num(p.factor) + " must be in [1e-6, " + Num(kMaxSeamFactor) +
+    throw InputError(where + ": factor = " + Num(p.factor) + " must be in [1e-6, " +
+                     Num(kMaxSeamFactor) +
                      "] (stiffness relative to the plain fabric; more is likely a unit mix-up)");
   if (!std::isnan(p.sd) && !(p.sd > 0.0))
     throw InputError(where + ": sd = " + Num(p.sd) + " must be > 0");
   // The weights are 1/sd²: below 1e-9 of the factor they overflow the least squares (sd 1e-300
   // gave NaN coefficients); no measurement of a stiffness ratio is that exact.
   if (!std::isnan(p.sd) && p.sd < 1e-9 * p.factor)
-    throw InputError(where + ": sd = " + Num(p.sd) + " is below 1e-9 of the factor " + Num(p.factor));
+    throw InputError(where + ": sd = " + Num(p.sd) + " is below 1e-9 of the factor " +
+                     Num(p.factor));
   if (!std::isnan(p.sd) && p.sd > 1e6 * p.factor)  // weights underflowed: B_f = 0
-    throw InputError(where + ": sd = " + Num(p.sd) + " is over 1e6 times the factor " + Num(p.factor));
+    throw InputError(where + ": sd = " + Num(p.sd) + " is over 1e6 times the factor " +
+                     Num(p.factor));
 }
 
 struct GslMatrixDeleter {
@@ -97,7 +110,8 @@ std::vector<SeamSample> ParseSeamSamplesCsv(const std::string& text, const std::
       } else {
         // Quote at most 40 printable characters of whatever the line holds (binary garbage).
         std::string shown;
-        for (char ch : t.substr(0, 40)) shown += std::isprint(static_cast<unsigned char>(ch)) ? ch : '?';
+        for (char ch : t.substr(0, 40))
+          shown += std::isprint(static_cast<unsigned char>(ch)) ? ch : '?';
         throw InputError(where + ": expected the header d_mm,factor or d_mm,factor,sd, got '" +
                          shown + (t.size() > 40 ? "...'" : "'"));
       }
@@ -261,16 +275,16 @@ SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,
   // Factors that do not vary leave no variance to explain: the fit is perfect when it
   // reproduces them (r² = 1; it was NaN, printed "nan" and flagged as poor), undefined if not.
   const double round_off = 1e-20 * n * mean * mean;
-  fit.r2 = ss_tot > round_off   ? 1.0 - ss_res / ss_tot
+  fit.r2 = ss_tot > round_off    ? 1.0 - ss_res / ss_tot
            : ss_res <= round_off ? 1.0
                                  : std::numeric_limits<double>::quiet_NaN();
 
   if (fit.weighted && fit.dof > 0 && fit.chi2_probability < options.poor_probability) {
     fit.poor = true;
-    fit.poor_reason = "residuals too large for the stated sd: chi2/dof = " +
-                      Num(chi2 / fit.dof, 4) + ", Q(chi2, " + std::to_string(fit.dof) +
-                      ") = " + Num(fit.chi2_probability, 3) + " < " +
-                      Num(options.poor_probability);
+    fit.poor_reason =
+        "residuals too large for the stated sd: chi2/dof = " + Num(chi2 / fit.dof, 4) +
+        ", Q(chi2, " + std::to_string(fit.dof) + ") = " + Num(fit.chi2_probability, 3) + " < " +
+        Num(options.poor_probability);
   } else if (!fit.weighted && fit.dof > 0 && !(fit.r2 >= options.poor_r2)) {
     fit.poor = true;
     fit.poor_reason = "the quadratic explains only " +
@@ -330,8 +344,8 @@ std::string SeamFitSummary::BriefReport() const {
     if (k < kParams - 1) s << ",";
   }
   s << " (1-σ" << (weighted ? ", from the given sd" : ", from the scatter") << "); " << num_points
-    << " points, d in [" << Num(range_mm[0], 4) << ", " << Num(range_mm[1], 4)
-    << "] mm, rms " << Num(rms, 3) << ", r² " << (std::isfinite(r2) ? Num(r2, 5) : std::string("n/a"));
+    << " points, d in [" << Num(range_mm[0], 4) << ", " << Num(range_mm[1], 4) << "] mm, rms "
+    << Num(rms, 3) << ", r² " << (std::isfinite(r2) ? Num(r2, 5) : std::string("n/a"));
   if (weighted && dof > 0) s << ", chi²/dof " << Num(chi2 / dof, 3);
   if (poor) s << "; POOR FIT: " << poor_reason;
   return s.str();

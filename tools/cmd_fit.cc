@@ -236,8 +236,11 @@ void Run(const FitArgs& a) {
     throw InputError("--gsm " + Num(a.gsm) + " g/m² is implausible (1 .. 10000)");
   if (!(a.robust_mm == 0.0 || (a.robust_mm >= 0.001 && a.robust_mm <= 100.0)))
     throw InputError("--robust-mm must be 0 (off) or in [0.001, 100] mm");
-  if (a.thickness_given && !(a.thickness_mm > 0.0 && a.thickness_mm <= 20.0))
-    throw InputError("--thickness-mm must lie in (0, 20] mm, got " + Num(a.thickness_mm));
+  if (a.thickness_given && !(a.thickness_mm > 0.0 && a.thickness_mm <= 6.0))
+    throw InputError(
+        "--thickness-mm must lie in (0, 6] mm (a thicker strip's mid-line starts above what a "
+        "profile may rise), got " +
+        Num(a.thickness_mm));
   if (a.thickness_given && a.no_offset)
     throw InputError("--thickness-mm and --no-offset contradict each other (offset t/2 vs 0)");
   // Clapp's polynomial takes the profiles as they are: no offset, rotation or robust loss.

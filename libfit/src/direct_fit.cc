@@ -73,7 +73,8 @@ double NoiseFreeLength(const Profile& p) {
       last = i;
     }
   }
-  return std::max(length, chord);
+  // s_mm may start past the edge (the first points cut off): the overhang includes that part.
+  return std::max(0.0, p.s.front()) + std::max(length, chord);
 }
 
 }  // namespace

@@ -134,17 +134,20 @@ void CheckProfile(const Profile& p) {
     }
     if (p.y[i] > kMaxRiseM) {
       // A mid-line starts half a thickness up: near the edge, a thick strip is the likelier cause.
-      const std::string cause = p.s[i] - p.s.front() < 2 * kMaxRiseM
-                                    ? "; a strip thicker than " +
-                                          std::to_string(static_cast<int>(2e3 * kMaxRiseM)) +
-                                          " mm, whose mid-line starts higher, is not supported"
-                                    : "";
+      const std::string cause =
+          std::hypot(p.x[i] - p.x.front(), p.y[i] - p.y.front()) < 2 * kMaxRiseM
+              ? "; a strip thicker than " + std::to_string(static_cast<int>(2e3 * kMaxRiseM)) +
+                    " mm, whose mid-line starts higher, is not supported"
+              : "";
       throw InputError(src + ": " + row + " lies " + std::to_string(p.y[i] * 1e3) +
                        " mm above the platform, more than " +
                        std::to_string(static_cast<int>(1e3 * kMaxRiseM)) +
                        " mm; a hanging strip has y_mm <= 0 (is y pointing down?)" + cause);
     }
-    if (p.x[i] < max_x - std::max(fold_back, std::sin(kMaxTiltRad) * (p.s[i] - p.s.front()))) {
+    // The tilt's allowance grows with the distance from the first point, not with s, which noise
+    // inflates (a 60 mm strip's dense noisy points measured s = 545 mm).
+    const double from_start = std::hypot(p.x[i] - p.x.front(), p.y[i] - p.y.front());
+    if (p.x[i] < max_x - std::max(fold_back, std::sin(kMaxTiltRad) * from_start)) {
       if (max_x <= fold_back)  // never went right: an overhang to the left
         throw InputError(
             src + ": " + row + ": x_mm runs backwards from the edge (to " +

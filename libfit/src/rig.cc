@@ -209,7 +209,9 @@ void Rig::CheckForImage(int width, int height, const std::string& photo) const {
   if (lens) {
     const std::string why = LensProblemOverImage(*lens, width, height);
     if (!why.empty()) {
-      throw InputError(source + ": distortion: implausible lens model for " + photo + ": " + why);
+      throw InputError(source + ": distortion: lens model not undone over " + photo + ": " + why +
+                       " (an implausible model, or a wide angle that OpenCV's iterative "
+                       "undistortion cannot invert there)");
     }
   }
   const double s = MmPerPxAt({width / 2.0, height / 2.0});
@@ -274,7 +276,10 @@ Rig ParseRigJson(const std::string& text, const std::string& source) {
     if (rig.plain_scale) f.Fail("distortion", "a plain scale rig has no lens model");
     if (rig.image_size) {
       const std::string why = LensProblemOverImage(lens, rig.image_size->x(), rig.image_size->y());
-      if (!why.empty()) f.Fail("distortion", "implausible lens model: " + why);
+      if (!why.empty())
+        f.Fail("distortion", "lens model not undone over the image: " + why +
+                                 " (an implausible model, or a wide angle that OpenCV's iterative "
+                                 "undistortion cannot invert there)");
     }
     rig.lens = lens;
   }

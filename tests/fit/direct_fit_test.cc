@@ -186,6 +186,26 @@ TEST(DirectFit, FitsARigTiltedByTwoDegrees) {
   EXPECT_LT(MomentCurveError(*fit.law, truth, fit.kappa_max), 5e-3) << fit.BriefReport();
 }
 
+// A profile whose first points are cut off starts at s > 0: the overhang's start and bounds
+// include the part before it (a review found the noise-proof length forgetting it: 80 mm kept
+// from s = 45 mm fitted L = 71 mm, b1 half the truth, at exit 0).
+TEST(DirectFit, AProfileStartingPastTheEdgeKeepsItsLength) {
+  const BendingLaw truth = LawOf(kFig8);
+  const double rho = units::GsmToSi(kFig8.gsm);
+  const Profile full = MakeProfile(truth, rho, 0.08, 0.0, 0.0, 1);
+  Profile tail;
+  tail.source = "tail";
+  for (size_t i = 0; i < full.s.size(); ++i) {
+    if (full.s[i] < 0.045) continue;
+    tail.s.push_back(full.s[i]);
+    tail.x.push_back(full.x[i]);
+    tail.y.push_back(full.y[i]);
+  }
+  const DirectFitSummary fit = FitDirect({tail}, rho);
+  ASSERT_TRUE(fit.converged) << fit.message;
+  EXPECT_NEAR(fit.profiles[0].overhang, 0.08, 1e-3);
+}
+
 TEST(DirectFit, NoisyProfilesRecoverTheCurveAndHonestSigmas) {
   // σ = 0.1 mm on 80 points per profile, three overhangs: the target is 0.5 % on the
   // curve (median over fabrics); one seed of one fabric gets a 1 % bound here.

@@ -56,7 +56,27 @@ struct Outcome {
   double offset = 0.0;
   double kappa_max = 0.0;
   std::string brief;
+  std::string notes;  // what the user should know about a fit that succeeded ("; "-joined)
 };
+
+// The fitted offset below which a note says the profiles' origin is off [m]: noise and the
+// trace line (upper or lower edge) move it by tenths of a millimetre.
+constexpr double kOffsetNoteM = 0.0005;
+
+// Whether a fit with a rig rotation explains the data so much better than the fit without one
+// that the tilt is real: a likelihood-ratio test with one more parameter, (RSS₀ − RSS₁) / σ̂₁²
+// above 25 (five standard deviations of pure noise's χ²₁), and a tilt of at least 0.1°. A fit
+// without rotation that failed (a tilt of a degree can drive b1 into its bound) counts as
+// infinitely worse.
+bool TiltIsSignificant(const DirectFitSummary& level, const DirectFitSummary& tilted,
+                       size_t points) {
+  if (!tilted.converged || std::abs(tilted.rotation) < 0.1 * M_PI / 180.0) return false;
+  if (!level.converged) return true;
+  const double n = static_cast<double>(points);
+  const double rss0 = n * level.rms * level.rms, rss1 = n * tilted.rms * tilted.rms;
+  const double sigma2 = rss1 / std::max(1.0, n - 6.0);
+  return rss0 - rss1 > 25.0 * sigma2;
+}
 
 Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double rho) {
   DirectFitOptions o;
@@ -64,9 +84,45 @@ Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double
   o.offset = a.thickness_given ? units::MmToM(a.thickness_mm) / 2.0 : 0.0;
   o.fit_rotation = a.fit_rotation;
   o.robust_scale = units::MmToM(a.robust_mm);
-  const DirectFitSummary fit = FitDirect(profiles, rho, o);
+  DirectFitSummary fit = FitDirect(profiles, rho, o);
+  std::vector<std::string> notes;
+  if (!o.fit_rotation) {
+    // A rig that is not level (or a camera rolled against it) tilts every profile alike; half a
+    // degree already sent b1 2.5× off and one degree c1 to -800 gf·cm², with rms hardly worse.
+    // The fit with a rotation is tried too and kept when the data ask for it.
+    DirectFitOptions turned = o;
+    turned.fit_rotation = true;
+    DirectFitSummary tilted;
+    try {
+      tilted = FitDirect(profiles, rho, turned);
+    } catch (const InputError&) {
+      // Only the fit without rotation speaks for the input (profiles of different strips).
+    }
+    size_t points = 0;
+    for (const Profile& p : profiles) points += p.s.size();
+    if (TiltIsSignificant(fit, tilted, points)) {
+      notes.push_back("the profiles are tilted by " + Num(tilted.rotation * 180.0 / M_PI, 2) +
+                      "° (a rig not level or a camera rolled against it): fitted with that "
+                      "rotation, rms " +
+                      Num(tilted.rms * 1e3, 3) + " mm instead of " +
+                      (fit.converged ? Num(fit.rms * 1e3, 3) + " mm" : "no fit") + " without it");
+      fit = tilted;
+      o = turned;
+    }
+  }
   if (!fit.converged) throw ComputeError("fit: " + fit.message);
+  // The mid-line's height at the edge is half the strip's thickness (at most 3 mm: profiles
+  // rising higher are refused); a fitted offset outside that means the profiles' y origin is not
+  // the platform's top. The law does not depend on it (a shift in y is what the offset absorbs),
+  // the overlay and the edge position do.
+  if (o.fit_offset && (fit.offset < -kOffsetNoteM || fit.offset > 0.003)) {
+    notes.push_back("the fitted offset at the edge, " + Num(fit.offset * 1e3, 3) +
+                    " mm, is not half a strip's thickness (0 to 3 mm): the profiles' y = 0 is "
+                    "not the platform's top; the law does not depend on it, but check the "
+                    "extraction's platform edge");
+  }
   Outcome out;
+  for (const std::string& n : notes) out.notes += (out.notes.empty() ? "" : "; ") + n;
   out.law = *fit.law;
   out.offset = fit.offset;
   out.kappa_max = fit.kappa_max;
@@ -97,6 +153,8 @@ Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double
                 {"offset_mm", fit.offset * 1e3},
                 {"offset_fitted", o.fit_offset},
                 {"rotation_deg", fit.rotation * 180.0 / M_PI},
+                {"rotation_fitted", o.fit_rotation},
+                {"note", out.notes.empty() ? nlohmann::json() : nlohmann::json(out.notes)},
                 {"robust_scale_mm", a.robust_mm},
                 {"iterations", fit.iterations},
                 {"seconds", fit.seconds},
@@ -351,6 +409,7 @@ void Run(const FitArgs& a) {
               << " µN·m = " << Num(o.report["flexural_rigidity_mgcm"].get<double>(), 4)
               << " mg·cm (G/b1 = " << Num(o.report["G_over_b1"].get<double>(), 3) << ")\n";
   }
+  if (!o.notes.empty()) std::cout << "note: " << o.notes << "\n";
   std::cout << "wrote " << a.out << (a.plot.empty() ? "" : " and " + a.plot) << "\n";
 }
 
@@ -381,7 +440,9 @@ void RegisterFit(CLI::App& app) {
       "--thickness-mm", a->thickness_mm,
       "Measured strip thickness [mm]: fixes the mid-line offset to t/2 (default: fitted)");
   sub->add_flag("--no-offset", a->no_offset, "Force the curve through the edge (offset 0)");
-  sub->add_flag("--fit-rotation", a->fit_rotation, "Also fit a small rig rotation");
+  sub->add_flag(
+      "--fit-rotation", a->fit_rotation,
+      "Always fit a small rig rotation (without it, one is fitted when the data show a tilt)");
   sub->add_option("--robust-mm", a->robust_mm,
                   "Cauchy loss scale per point [mm]; 0 = plain least squares (default 0.5)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");

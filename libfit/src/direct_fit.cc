@@ -392,6 +392,9 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
     return t.str();
   };
   if (!out.b1_observed) obs << "b1 is poorly determined (" << pct(out.b1_sd, law.b1()) << "). ";
+  // (b2 beyond the data's curvatures was said above; here the data reach κ0 but do not pin b2.)
+  if (!out.b2_observed && k0 < out.kappa_max)
+    obs << "b2 is poorly determined (" << pct(out.b2_sd, law.b2()) << "). ";
   if (!out.c1_observed) {
     obs << "c1 is poorly determined (" << pct(out.c1_sd, law.c1())
         << "): these curvatures do not resolve the quadratic branch, the data are also "

@@ -234,6 +234,32 @@ TEST(DirectFit, FlagsB2AsUnobservedWhenKappa0IsBeyondTheData) {
   EXPECT_LT(MomentCurveError(*fit.law, truth, fit.kappa_max), 5e-3);
 }
 
+// A law whose κ0 lies within the data but whose b2 the data do not pin (a tilted rig fitted
+// without its rotation gave b2 = 0.070 ± 24 gf·cm): the observability says so, as it does for
+// b1 and c1 (it used to say nothing of b2).
+TEST(DirectFit, SaysWhenB2IsPoorlyDetermined) {
+  const BendingLaw truth = LawOf(kFig8);
+  const double rho = units::GsmToSi(kFig8.gsm);
+  const double tilt = -1.0 * std::numbers::pi / 180.0;
+  std::vector<Profile> data;
+  unsigned seed = 1;
+  for (double L : {0.04, 0.06, 0.08}) {
+    Profile p = MakeProfile(truth, rho, L, 1e-4, 0.0, seed++);
+    for (size_t i = 0; i < p.x.size(); ++i) {
+      const double x = p.x[i], y = p.y[i];
+      p.x[i] = std::cos(tilt) * x - std::sin(tilt) * y;
+      p.y[i] = std::sin(tilt) * x + std::cos(tilt) * y;
+    }
+    data.push_back(p);
+  }
+  const DirectFitSummary fit = FitDirect(data, rho);
+  ASSERT_TRUE(fit.converged) << fit.message;
+  ASSERT_LT(fit.law->kappa0(), fit.kappa_max) << fit.BriefReport();
+  EXPECT_FALSE(fit.b2_observed) << fit.BriefReport();
+  EXPECT_NE(fit.observability.find("b2 is poorly determined"), std::string::npos)
+      << fit.observability;
+}
+
 TEST(DirectFit, RefusesProfilesOfDifferentStrips) {
   std::vector<Profile> data;
   for (double L : {0.05, 0.07}) data.push_back(MakeProfile(LawOf(kFig8), 0.2, L, 0.05e-3, 0.0, 4));

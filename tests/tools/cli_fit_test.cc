@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -172,6 +173,89 @@ TEST(CliFit, ClappRoundTripRecoversTheMomentCurve) {
   const auto fit = FitRoundTrip("clapp", Scratch("cli_fit_clapp"), 0.05, {0.25, 0.5, 0.75, 1.0});
   ASSERT_FALSE(fit.is_null());
   EXPECT_LT(fit.at("rms_mm").get<double>(), 0.5);
+}
+
+// Synthetic noisy fig8 profiles (40, 60, 80 mm) turned by `deg` about the edge and shifted by
+// `dy_mm`, as a rig that is not level or an origin off the platform would give them; returns
+// the paths, shell-quoted, ready for `textile fit`.
+std::string TurnedProfiles(const fs::path& dir, double deg, double dy_mm) {
+  const auto r = Textile("synth-profile --material " + kFig8 + " --overhang-mm 40 60 80 -o " +
+                         Quote(dir / "raw") + " --noise-mm 0.1 --json");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  if (r.exit_code != 0) return "";
+  const double a = deg * M_PI / 180.0;
+  std::string paths;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  for (const auto& p : j.at("profiles")) {
+    std::istringstream in(ReadAll(p.at("path").get<std::string>()));
+    std::vector<std::array<double, 2>> xy;
+    std::string line;
+    while (std::getline(in, line)) {
+      double s, x, y;
+      if (line.empty() || line[0] == '#' ||
+          std::sscanf(line.c_str(), "%lf,%lf,%lf", &s, &x, &y) != 3)
+        continue;
+      xy.push_back({std::cos(a) * x - std::sin(a) * y, std::sin(a) * x + std::cos(a) * y + dy_mm});
+    }
+    const fs::path out = dir / fs::path(p.at("path").get<std::string>()).filename();
+    WriteProfile(out, xy);
+    paths += Quote(out) + " ";
+  }
+  return paths;
+}
+
+// Law and report of `textile fit` on `profiles` (exit 0 asserted by the caller).
+struct FitRun {
+  testing::CliResult run;
+  nlohmann::json material;
+};
+FitRun FitTo(const std::string& profiles, const fs::path& material) {
+  FitRun f{Textile("fit " + profiles + "--gsm 200 -o " + Quote(material)), {}};
+  if (f.run.exit_code == 0) f.material = nlohmann::json::parse(ReadAll(material));
+  return f;
+}
+
+// A rig that is not level: without a rotation a tilt of half a degree sent b1 2.5× off and one
+// degree c1 to -800 gf·cm² (rms hardly worse, exit 0). The fit now tries a rotation too, keeps
+// it when the data ask for it and says so; level profiles keep the fit without it.
+TEST(CliFit, ATiltedRigIsFittedWithItsRotationAndSaysSo) {
+  const auto dir = Scratch("cli_fit_tilt");
+  const FitRun level = FitTo(TurnedProfiles(dir / "level", 0.0, 0.0), dir / "level.json");
+  ASSERT_EQ(level.run.exit_code, 0) << level.run.err;
+  EXPECT_EQ(level.run.out.find("note:"), std::string::npos) << level.run.out;
+  EXPECT_FALSE(level.material.at("fit").at("rotation_fitted").get<bool>());
+  EXPECT_TRUE(level.material.at("fit").at("note").is_null());
+  const double b1 = level.material.at("bending").at("b1").get<double>();
+  for (double deg : {0.6, -1.0}) {
+    const FitRun tilted =
+        FitTo(TurnedProfiles(dir / std::to_string(deg), deg, 0.0), dir / "tilted.json");
+    ASSERT_EQ(tilted.run.exit_code, 0) << tilted.run.err;
+    EXPECT_NE(tilted.run.out.find("note: the profiles are tilted by"), std::string::npos)
+        << tilted.run.out;
+    const nlohmann::json& fit = tilted.material.at("fit");
+    EXPECT_TRUE(fit.at("rotation_fitted").get<bool>());
+    EXPECT_NEAR(fit.at("rotation_deg").get<double>(), deg, 0.1);
+    EXPECT_NE(fit.at("note").get<std::string>().find("tilted"), std::string::npos);
+    EXPECT_NEAR(tilted.material.at("bending").at("b1").get<double>(), b1, 0.05 * b1);
+    EXPECT_LT(std::abs(tilted.material.at("bending").at("c1").get<double>()), 0.1);
+  }
+}
+
+// Profiles whose y = 0 is not the platform's top: the fitted offset absorbs the shift (the law
+// is the same) and a note says the offset is no half thickness.
+TEST(CliFit, AnOffsetThatIsNoHalfThicknessGetsANote) {
+  const auto dir = Scratch("cli_fit_offset_note");
+  const FitRun level = FitTo(TurnedProfiles(dir / "level", 0.0, 0.0), dir / "level.json");
+  ASSERT_EQ(level.run.exit_code, 0) << level.run.err;
+  const FitRun low = FitTo(TurnedProfiles(dir / "low", 0.0, -20.0), dir / "low.json");
+  ASSERT_EQ(low.run.exit_code, 0) << low.run.err;
+  EXPECT_NE(low.run.out.find("note: the fitted offset at the edge, -"), std::string::npos)
+      << low.run.out;
+  EXPECT_NEAR(low.material.at("fit").at("offset_mm").get<double>(), -20.0, 0.5);
+  for (const char* k : {"b1", "b2", "c1"}) {
+    const double want = level.material.at("bending").at(k).get<double>();
+    EXPECT_NEAR(low.material.at("bending").at(k).get<double>(), want, 1e-3 * std::abs(want)) << k;
+  }
 }
 
 TEST(CliFit, JsonPrintsOneObjectWithTheMaterial) {

@@ -742,8 +742,10 @@ std::pair<int, int> LongestRun(const SectionSet& set, int max_gap) {
 // The strip's measured stretch: the longest run, without unmeasured sections at its ends and
 // without a frayed end, where the strip's solid body gives way to fibres (a brush of bright
 // fibres is as contrasted as the strip but has no solid core). *end_width is the typical width
-// just before the end [px]. {-1, -2} if nothing usable.
-std::pair<int, int> TrimmedRun(const SectionSet& set, TraceLine line, double* end_width) {
+// just before the end [px]; *measured_from (if given) the run's first station before the
+// unusable stations of `line` at its start were skipped. {-1, -2} if nothing usable.
+std::pair<int, int> TrimmedRun(const SectionSet& set, TraceLine line, double* end_width,
+                               int* measured_from = nullptr) {
   auto [first, last] = LongestRun(set, std::max(15, static_cast<int>(1.5 * set.width)));
   if (last - first < 10) return {-1, -2};
   {
@@ -767,6 +769,7 @@ std::pair<int, int> TrimmedRun(const SectionSet& set, TraceLine line, double* en
   }
   if (widths.empty()) return {-1, -2};
   *end_width = Median(widths);
+  if (measured_from) *measured_from = first;
   while (first < last - 10 && !set.s[first].Usable(line)) ++first;
   return {first, last};
 }
@@ -1318,8 +1321,50 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
     set = TrackStrip(gray, mid, 1, coarse, direction, strip.polarity, t_full, root_ext, &tracked);
   }
   double w_end = 0.0;
-  const std::pair<int, int> run = TrimmedRun(set, options.trace, &w_end);
+  int measured_from = 0;
+  const std::pair<int, int> run = TrimmedRun(set, options.trace, &w_end, &measured_from);
   if (run.second - run.first < 10) return fail("no strip found: its edges could not be measured");
+  // The traced line must be measured along enough of the strip: its gaps are bridged by
+  // interpolation, but a line measured nowhere (the upper edge of a very thick strip) has
+  // nothing to bridge, and one measured on a few sections would follow the guide, not the
+  // strip. A quarter of the stations at least; on the real photos a third of the sections
+  // lose their upper edge to fibres, which leaves two thirds.
+  {
+    const auto usable = [&](TraceLine line) {
+      int n = 0;
+      for (int i = measured_from; i <= run.second; ++i) n += set.s[i].Usable(line);
+      return n;
+    };
+    const int stations = run.second - measured_from + 1;
+    const auto enough = [&](int n) { return n >= 10 && 4 * n >= stations; };
+    const int have = usable(options.trace);
+    if (!enough(have)) {
+      const auto name = [](TraceLine line) {
+        return std::string(line == TraceLine::kUpper   ? "upper"
+                           : line == TraceLine::kLower ? "lower"
+                                                       : "mid");
+      };
+      const auto what = [&](TraceLine line) {
+        return line == TraceLine::kMid ? std::string("mid-line (both edges)")
+                                       : name(line) + " edge";
+      };
+      std::string m = "the strip's " + what(options.trace) + " is measured on only " +
+                      std::to_string(have) + " of its " + std::to_string(stations) +
+                      " cross-sections (a quarter needed: a very thick strip, a faint or frayed "
+                      "edge?)";
+      std::string others;
+      for (TraceLine line : {TraceLine::kLower, TraceLine::kUpper, TraceLine::kMid}) {
+        if (line == options.trace) continue;
+        const int n = usable(line);
+        if (enough(n)) {
+          others += (others.empty() ? "" : ", ") + ("--trace " + name(line)) + " (" +
+                    std::to_string(n) + ")";
+        }
+      }
+      if (!others.empty()) m += "; measured enough: " + others;
+      return fail(m);
+    }
+  }
   r.contrast = set.contrast;
   r.noise = set.noise;
   r.width_px = set.width;

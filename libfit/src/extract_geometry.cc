@@ -19,9 +19,13 @@ double Median(std::vector<double> v) {
 }
 
 std::vector<Vec2> SmoothPolyline(const std::vector<Vec2>& p, double sigma) {
-  if (sigma <= 0.0 || p.size() < 3) return p;
+  // A NaN or infinite sigma would make the window's reach undefined (ceil(3 NaN) cast to int):
+  // nothing sensible to smooth with, so the input is returned as it is.
+  if (!(sigma > 0.0) || !std::isfinite(sigma) || p.size() < 3) return p;
   const int n = static_cast<int>(p.size());
-  const int reach = static_cast<int>(std::ceil(3.0 * sigma));
+  // No wider than the sequence (the window is truncated there anyway): a huge sigma must not
+  // overflow the int either.
+  const int reach = static_cast<int>(std::min<double>(std::ceil(3.0 * sigma), n));
   std::vector<double> w(reach + 1);
   for (int k = 0; k <= reach; ++k) w[k] = std::exp(-0.5 * k * k / (sigma * sigma));
   std::vector<Vec2> out(n);

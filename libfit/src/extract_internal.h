@@ -17,7 +17,8 @@ using Vec2 = Eigen::Vector2d;
 double Median(std::vector<double> v);
 
 // Gaussian smoothing of a sequence, with the window truncated symmetrically at the ends so that
-// straight runs stay straight up to the last point. sigma in samples; <= 0 returns the input.
+// straight runs stay straight up to the last point. sigma in samples; <= 0, NaN or infinite
+// returns the input.
 std::vector<Vec2> SmoothPolyline(const std::vector<Vec2>& p, double sigma);
 
 // Points every `step` along a polyline's arc length, from its first point to its last (which is

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 
 #include "deadline.h"
@@ -236,10 +237,18 @@ CalibrationSummary CalibrateRig(const std::vector<cv::Mat>& boards,
     }
     rig.lens = lens;
     s.lens_model = true;
-    // The first board's corners without distortion, in the same camera's pixels.
-    std::vector<cv::Point2f> undistorted;
-    cv::undistortPoints(first, undistorted, K, dist, cv::noArray(), K);
-    first = undistorted;
+    // The first board's corners without distortion, in the same camera's pixels, undone as
+    // extraction undoes the photos (Lens::Undistort; the check above made sure it converges
+    // over the whole photo).
+    for (cv::Point2f& c : first) {
+      const std::optional<Eigen::Vector2d> ideal = lens.Undistort({c.x, c.y});
+      if (!ideal) {
+        s.message = "lens calibration: the fitted model cannot be undone at a corner of " +
+                    sources[0] + " (add boards in other poses, or --no-lens)";
+        return s;
+      }
+      c = cv::Point2f(static_cast<float>(ideal->x()), static_cast<float>(ideal->y()));
+    }
   }
   if (past_cap("before the homography")) return s;
   // Plane <- image, least squares over all corners (no outliers on a found board).

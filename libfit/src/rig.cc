@@ -2,8 +2,10 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
@@ -69,6 +71,9 @@ class Fields {
 // distorting it back must return it within this distance [px] (a tenth of the extraction's
 // sub-pixel scatter). Real lenses meet it by orders of magnitude.
 constexpr double kLensRoundTripPx = 0.05;
+// The most a lens model may magnify (or shrink) its image locally, relative to the optical
+// axis: strong wide angles reach 2 (k1 = -0.4, k2 = 0.15 at r = 1.5: 1.3).
+constexpr double kLensMaxScale = 10.0;
 // Grid cells per side on which the lens model is checked over a photo.
 constexpr int kLensGridCells = 24;
 
@@ -87,27 +92,184 @@ json Matrix3ToJson(const Eigen::Matrix3d& m) {
   return rows;
 }
 
+// Lens::Undistort: converged when the distorted guess is this close to the observed point
+// [normalised units]; at most this many Newton steps, each halved at most kMaxHalvings times.
+constexpr double kUndistortTolerance = 1e-10;
+constexpr int kMaxNewtonSteps = 100;
+constexpr int kMaxHalvings = 40;
+// Points along the ray from the optical axis to an undistorted point at which the model must
+// keep its orientation (Jacobian determinant > 0).
+constexpr int kFoldSamples = 32;
+
+enum class UndoStatus { kConverged, kNoConvergence, kFolded };
+
+// OpenCV's sensor tilt (computeTiltProjectionMatrix in its distortion_model.hpp): the
+// projective map of the distorted normalised coordinates onto a sensor tilted by τx, τy.
+Eigen::Matrix3d TiltProjection(double tau_x, double tau_y) {
+  const double cx = std::cos(tau_x), sx = std::sin(tau_x);
+  const double cy = std::cos(tau_y), sy = std::sin(tau_y);
+  Eigen::Matrix3d rot_x, rot_y, proj_z;
+  rot_x << 1, 0, 0, 0, cx, sx, 0, -sx, cx;
+  rot_y << cy, 0, -sy, 0, 1, 0, sy, 0, cy;
+  const Eigen::Matrix3d rot_xy = rot_y * rot_x;
+  proj_z << rot_xy(2, 2), 0, -rot_xy(0, 2), 0, rot_xy(2, 2), -rot_xy(1, 2), 0, 0, 1;
+  return proj_z * rot_xy;
+}
+
+Eigen::Vector2d NormalisedFromPixel(const Eigen::Matrix3d& K, const Eigen::Vector2d& px) {
+  const double y = (px.y() - K(1, 2)) / K(1, 1);
+  return {(px.x() - K(0, 2) - K(0, 1) * y) / K(0, 0), y};
+}
+
+Eigen::Vector2d PixelFromNormalised(const Eigen::Matrix3d& K, const Eigen::Vector2d& x) {
+  return {K(0, 0) * x.x() + K(0, 1) * x.y() + K(0, 2), K(1, 1) * x.y() + K(1, 2)};
+}
+
+// Solves DistortNormalized(x) = target for x by damped Newton, from x = target.
+UndoStatus UndoLens(const std::vector<double>& d, const Eigen::Vector2d& target,
+                    Eigen::Vector2d* x_out) {
+  Eigen::Vector2d x = target;
+  Eigen::Matrix2d J;
+  Eigen::Vector2d f = DistortNormalized(d, x, &J) - target;
+  double residual = f.norm();
+  for (int step = 0; step <= kMaxNewtonSteps && std::isfinite(residual); ++step) {
+    if (residual < kUndistortTolerance) {
+      *x_out = x;
+      // The physical pre-image is reached from the optical axis (where the model is about the
+      // identity) without the model folding over on the way: its Jacobian determinant stays
+      // positive along the ray. A root beyond a fold is another point that the lens would put
+      // on the same pixel (k1 = -5 puts r = 0.6 on the opposite side, with det > 0 there).
+      for (int k = 1; k <= kFoldSamples; ++k) {
+        Eigen::Matrix2d J_ray;
+        DistortNormalized(d, x * (static_cast<double>(k) / kFoldSamples), &J_ray);
+        if (!(J_ray.determinant() > 0.0)) return UndoStatus::kFolded;
+      }
+      return UndoStatus::kConverged;
+    }
+    const double det = J.determinant();
+    if (!(std::abs(det) > 1e-300) || step == kMaxNewtonSteps) break;
+    const Eigen::Vector2d dx = -J.inverse() * f;
+    // Halve the step until the residual falls (damping far from the root, or near a fold).
+    double lambda = 1.0;
+    bool fell = false;
+    for (int h = 0; h <= kMaxHalvings; ++h, lambda *= 0.5) {
+      Eigen::Matrix2d J_try;
+      const Eigen::Vector2d x_try = x + lambda * dx;
+      const Eigen::Vector2d f_try = DistortNormalized(d, x_try, &J_try) - target;
+      if (f_try.norm() < residual) {
+        x = x_try, f = f_try, J = J_try, residual = f_try.norm();
+        fell = true;
+        break;
+      }
+    }
+    if (!fell) break;
+  }
+  *x_out = x;
+  return UndoStatus::kNoConvergence;
+}
+
 }  // namespace
 
+Eigen::Vector2d DistortNormalized(const std::vector<double>& distortion, const Eigen::Vector2d& x,
+                                  Eigen::Matrix2d* jacobian) {
+  double c[14] = {0};
+  for (size_t i = 0; i < std::min<size_t>(14, distortion.size()); ++i) c[i] = distortion[i];
+  const double k1 = c[0], k2 = c[1], p1 = c[2], p2 = c[3], k3 = c[4], k4 = c[5], k5 = c[6],
+               k6 = c[7], s1 = c[8], s2 = c[9], s3 = c[10], s4 = c[11];
+  const double u = x.x(), v = x.y();
+  const double r2 = u * u + v * v, r4 = r2 * r2, r6 = r4 * r2;
+  // Radial factor a / b and its derivative with respect to r².
+  const double a = 1.0 + k1 * r2 + k2 * r4 + k3 * r6;
+  const double b = 1.0 + k4 * r2 + k5 * r4 + k6 * r6;
+  const double radial = a / b;
+  const double d_radial =
+      ((k1 + 2.0 * k2 * r2 + 3.0 * k3 * r4) * b - a * (k4 + 2.0 * k5 * r2 + 3.0 * k6 * r4)) /
+      (b * b);
+  const Eigen::Vector2d xd(
+      u * radial + 2.0 * p1 * u * v + p2 * (r2 + 2.0 * u * u) + s1 * r2 + s2 * r4,
+      v * radial + p1 * (r2 + 2.0 * v * v) + 2.0 * p2 * u * v + s3 * r2 + s4 * r4);
+  const double prism_x = s1 + 2.0 * s2 * r2, prism_y = s3 + 2.0 * s4 * r2;  // d/d(r²)
+  Eigen::Matrix2d J;
+  J(0, 0) = radial + 2.0 * u * u * d_radial + 2.0 * p1 * v + 6.0 * p2 * u + 2.0 * u * prism_x;
+  J(0, 1) = 2.0 * u * v * d_radial + 2.0 * p1 * u + 2.0 * p2 * v + 2.0 * v * prism_x;
+  J(1, 0) = 2.0 * u * v * d_radial + 2.0 * p1 * u + 2.0 * p2 * v + 2.0 * u * prism_y;
+  J(1, 1) = radial + 2.0 * v * v * d_radial + 6.0 * p1 * v + 2.0 * p2 * u + 2.0 * v * prism_y;
+  Eigen::Vector2d out = xd;
+  if (c[12] != 0.0 || c[13] != 0.0) {
+    // Tilted sensor: a projective map of the distorted coordinates, chained into J.
+    const Eigen::Matrix3d T = TiltProjection(c[12], c[13]);
+    const Eigen::Vector3d h = T * xd.homogeneous();
+    out = h.head<2>() / h.z();
+    const Eigen::Matrix2d dT =
+        (T.topLeftCorner<2, 2>() * h.z() - h.head<2>() * T.block<1, 2>(2, 0)) / (h.z() * h.z());
+    J = dT * J;
+  }
+  if (jacobian) *jacobian = J;
+  return out;
+}
+
+Eigen::Vector2d Lens::Distort(const Eigen::Vector2d& ideal_px) const {
+  return PixelFromNormalised(
+      camera_matrix, DistortNormalized(distortion, NormalisedFromPixel(camera_matrix, ideal_px)));
+}
+
+std::optional<Eigen::Vector2d> Lens::Undistort(const Eigen::Vector2d& px) const {
+  Eigen::Vector2d x;
+  if (UndoLens(distortion, NormalisedFromPixel(camera_matrix, px), &x) != UndoStatus::kConverged)
+    return std::nullopt;
+  return PixelFromNormalised(camera_matrix, x);
+}
+
 std::string LensProblemOverImage(const Lens& lens, int width, int height) {
-  cv::Mat K, D(lens.distortion, true);
-  cv::eigen2cv(lens.camera_matrix, K);
   const int n = kLensGridCells;
-  std::vector<cv::Point2d> px, normalized, back;
+  const std::string photo =
+      " of a " + std::to_string(width) + "x" + std::to_string(height) + " px photo";
+  std::vector<cv::Point2d> px;
+  std::vector<Eigen::Vector2d> normalized;
   for (int j = 0; j <= n; ++j) {
     for (int i = 0; i <= n; ++i) {
-      px.emplace_back(-0.5 + width * static_cast<double>(i) / n,
-                      -0.5 + height * static_cast<double>(j) / n);
+      const Eigen::Vector2d p(-0.5 + width * static_cast<double>(i) / n,
+                              -0.5 + height * static_cast<double>(j) / n);
+      // Undone as Rig::PlaneFromImage does it.
+      Eigen::Vector2d x;
+      switch (UndoLens(lens.distortion, NormalisedFromPixel(lens.camera_matrix, p), &x)) {
+        case UndoStatus::kConverged:
+          break;
+        case UndoStatus::kNoConvergence:
+          return "it cannot be undone at " + Px(p.x(), p.y()) + photo +
+                 " (no undistorted point is put there: Newton's method does not converge)";
+        case UndoStatus::kFolded:
+          return "it folds the photo over near " + Px(p.x(), p.y()) + photo;
+      }
+      // Invertible but absurd (k1 = 1e6 squeezes the photo into a few pixels round the axis):
+      // no lens magnifies or shrinks its image locally by more than kLensMaxScale.
+      Eigen::Matrix2d J;
+      DistortNormalized(lens.distortion, x, &J);
+      const double scale = std::sqrt(J.determinant());
+      if (!(scale <= kLensMaxScale && scale >= 1.0 / kLensMaxScale)) {
+        std::ostringstream m;
+        m << "it scales the photo by " << std::setprecision(3) << scale << " near "
+          << Px(p.x(), p.y()) << photo << " (a lens stays within " << 1.0 / kLensMaxScale << " to "
+          << kLensMaxScale << ")";
+        return m.str();
+      }
+      px.emplace_back(p.x(), p.y());
+      normalized.push_back(x);
     }
   }
-  // Undistorted as Rig::PlaneFromImage does it, then distorted back by the forward model.
+  // Distorted back by OpenCV's own forward model (without the skew, added after): the model
+  // undone is the one OpenCV calibrated.
+  std::vector<cv::Point2d> back;
   try {
-    cv::undistortPoints(
-        px, normalized, K, D, cv::noArray(), cv::noArray(),
-        cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 50, 1e-9));
+    Eigen::Matrix3d K0 = lens.camera_matrix;
+    K0(0, 1) = 0.0;
+    cv::Mat K, D(lens.distortion, true);
+    cv::eigen2cv(K0, K);
     std::vector<cv::Point3d> rays;
-    for (const auto& q : normalized) rays.emplace_back(q.x, q.y, 1.0);
+    for (const auto& q : normalized) rays.emplace_back(q.x(), q.y(), 1.0);
     cv::projectPoints(rays, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, D, back);
+    const double skew = lens.camera_matrix(0, 1) / lens.camera_matrix(1, 1);
+    for (auto& q : back) q.x += skew * (q.y - lens.camera_matrix(1, 2));
   } catch (const cv::Exception& e) {
     return "OpenCV cannot apply it (" + e.err + ")";
   }
@@ -123,8 +285,8 @@ std::string LensProblemOverImage(const Lens& lens, int width, int height) {
   }
   if (!(miss <= kLensRoundTripPx)) {
     std::ostringstream m;
-    m << "it cannot be undone at " << Px(px[worst].x, px[worst].y) << " of a " << width << "x"
-      << height << " px photo (undistorted and distorted back, it comes out at "
+    m << "it cannot be undone at " << Px(px[worst].x, px[worst].y) << photo
+      << " (undistorted and distorted back, it comes out at "
       << (std::isinf(miss) ? std::string("infinity") : Px(back[worst].x, back[worst].y)) << ")";
     return m.str();
   }
@@ -132,12 +294,12 @@ std::string LensProblemOverImage(const Lens& lens, int width, int height) {
   // places to one.
   for (int j = 0; j <= n; ++j) {
     for (int i = 0; i <= n; ++i) {
-      const cv::Point2d& q = normalized[j * (n + 1) + i];
-      const bool right = i < n && !(normalized[j * (n + 1) + i + 1].x > q.x);
-      const bool down = j < n && !(normalized[(j + 1) * (n + 1) + i].y > q.y);
+      const Eigen::Vector2d& q = normalized[j * (n + 1) + i];
+      const bool right = i < n && !(normalized[j * (n + 1) + i + 1].x() > q.x());
+      const bool down = j < n && !(normalized[(j + 1) * (n + 1) + i].y() > q.y());
       if (right || down) {
         return "it folds the photo over near " + Px(px[j * (n + 1) + i].x, px[j * (n + 1) + i].y) +
-               " of a " + std::to_string(width) + "x" + std::to_string(height) + " px photo";
+               photo;
       }
     }
   }
@@ -164,13 +326,9 @@ Rig Rig::FromScale(double mm_per_px, const std::string& source) {
 Eigen::Vector2d Rig::PlaneFromImage(const Eigen::Vector2d& px) const {
   Eigen::Vector2d p = px;
   if (lens) {
-    cv::Mat K, D(lens->distortion, true);
-    cv::eigen2cv(lens->camera_matrix, K);
-    std::vector<cv::Point2d> in{{px.x(), px.y()}}, out;
-    cv::undistortPoints(
-        in, out, K, D, cv::noArray(), K,
-        cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 50, 1e-9));
-    p = {out[0].x, out[0].y};
+    const std::optional<Eigen::Vector2d> ideal = lens->Undistort(px);
+    if (!ideal) return Eigen::Vector2d::Constant(std::nan(""));
+    p = *ideal;
   }
   const Eigen::Vector3d h = plane_from_image * p.homogeneous();
   if (!(std::abs(h.z()) > 1e-12)) return Eigen::Vector2d::Constant(std::nan(""));
@@ -210,8 +368,7 @@ void Rig::CheckForImage(int width, int height, const std::string& photo) const {
     const std::string why = LensProblemOverImage(*lens, width, height);
     if (!why.empty()) {
       throw InputError(source + ": distortion: lens model not undone over " + photo + ": " + why +
-                       " (an implausible model, or a wide angle that OpenCV's iterative "
-                       "undistortion cannot invert there)");
+                       " (not one to one there: an implausible model)");
     }
   }
   const double s = MmPerPxAt({width / 2.0, height / 2.0});
@@ -278,8 +435,7 @@ Rig ParseRigJson(const std::string& text, const std::string& source) {
       const std::string why = LensProblemOverImage(lens, rig.image_size->x(), rig.image_size->y());
       if (!why.empty())
         f.Fail("distortion", "lens model not undone over the image: " + why +
-                                 " (an implausible model, or a wide angle that OpenCV's iterative "
-                                 "undistortion cannot invert there)");
+                                 " (not one to one there: an implausible model)");
     }
     rig.lens = lens;
   }

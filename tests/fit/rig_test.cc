@@ -6,7 +6,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "textile/sim/error.h"
 
@@ -104,7 +108,7 @@ TEST(Rig, ChecksThePhotoAgainstTheCalibration) {
   EXPECT_THROW(horizon.CheckForImage(2000, 1500, "a.jpg"), InputError);
 }
 
-// Lens models that OpenCV cannot undo over the photo gave a profile identical to no lens
+// Lens models that are not one to one over the photo gave a profile identical to no lens
 // (k1 = -5), or a crash in extraction (k6 = 1e9). They are refused naming the field, at parse
 // time when the rig gives image_size, else when it meets a photo; real lenses pass.
 TEST(Rig, RefusesLensModelsThatCannotBeUndoneOverThePhoto) {
@@ -140,6 +144,115 @@ TEST(Rig, RefusesLensModelsThatCannotBeUndoneOverThePhoto) {
   barrel.distortion = {-0.3, 0, 0, 0, 0};
   EXPECT_EQ(LensProblemOverImage(barrel, 800, 600), "");
   EXPECT_NE(LensProblemOverImage(barrel, 2000, 1500), "");
+}
+
+// OpenCV's projectPoints of the ray through normalised coordinates x [px].
+Eigen::Vector2d OpenCvDistort(const Lens& lens, const Eigen::Vector2d& x) {
+  cv::Mat K, D(lens.distortion, true);
+  cv::eigen2cv(lens.camera_matrix, K);
+  std::vector<cv::Point2d> out;
+  cv::projectPoints(std::vector<cv::Point3d>{{x.x(), x.y(), 1.0}}, cv::Vec3d(0, 0, 0),
+                    cv::Vec3d(0, 0, 0), K, D, out);
+  return {out[0].x, out[0].y};
+}
+
+Eigen::Vector2d Normalised(const Lens& lens, const Eigen::Vector2d& px) {
+  const Eigen::Matrix3d& K = lens.camera_matrix;
+  return {(px.x() - K(0, 2)) / K(0, 0), (px.y() - K(1, 2)) / K(1, 1)};
+}
+
+// Every coefficient of OpenCV's model (radial rational, tangential, thin prism, tilt): the
+// forward model is OpenCV's, and its Jacobian is the finite difference of it.
+TEST(Lens, DistortionIsOpenCvsModelWithItsJacobian) {
+  Lens lens;
+  lens.camera_matrix << 1800, 0, 1010, 0, 1750, 740, 0, 0, 1;
+  lens.distortion = {-0.21, 0.08,  0.0012, -0.0007, -0.015, 0.05, -0.01,
+                     0.004, 0.002, -0.001, 0.0015,  0.0005, 0.01, -0.02};
+  for (const size_t n : {4, 5, 8, 12, 14}) {
+    Lens l = lens;
+    l.distortion.resize(n);
+    for (const Eigen::Vector2d& x : {Eigen::Vector2d(0.3, -0.2), Eigen::Vector2d(-0.55, 0.41),
+                                     Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(0.7, 0.5)}) {
+      // Against OpenCV: rounding only (1e-9 px at 1800 px per unit).
+      const Eigen::Vector2d px =
+          l.Distort(l.camera_matrix.topLeftCorner<2, 2>() * x + l.camera_matrix.block<2, 1>(0, 2));
+      EXPECT_LT((px - OpenCvDistort(l, x)).norm(), 1e-9)
+          << n << " coefficients at " << x.transpose();
+      // Central differences of step 1e-6: truncation ~1e-12, rounding ~1e-10.
+      Eigen::Matrix2d J;
+      DistortNormalized(l.distortion, x, &J);
+      const double h = 1e-6;
+      for (int k = 0; k < 2; ++k) {
+        const Eigen::Vector2d e = h * Eigen::Vector2d::Unit(k);
+        const Eigen::Vector2d fd =
+            (DistortNormalized(l.distortion, x + e) - DistortNormalized(l.distortion, x - e)) /
+            (2 * h);
+        EXPECT_LT((J.col(k) - fd).norm(), 1e-8) << n << " coefficients, column " << k;
+      }
+    }
+  }
+}
+
+// Where OpenCV's fixed-point iteration converges (a mild lens), Newton's method finds the same
+// undistorted points, to 1e-6 px.
+TEST(Lens, UndistortAgreesWithOpenCvOnAMildLens) {
+  Lens lens;
+  lens.camera_matrix << 3000, 0, 2000, 0, 3000, 1500, 0, 0, 1;
+  lens.distortion = {-0.1, 0.01, 0.001, -0.001, 0.002};
+  cv::Mat K, D(lens.distortion, true);
+  cv::eigen2cv(lens.camera_matrix, K);
+  std::vector<cv::Point2d> px, ocv;
+  for (int j = 0; j <= 10; ++j)
+    for (int i = 0; i <= 10; ++i) px.emplace_back(-0.5 + 400.0 * i, -0.5 + 300.0 * j);
+  cv::undistortPoints(
+      px, ocv, K, D, cv::noArray(), K,
+      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 1000, 1e-14));
+  double worst = 0.0;
+  for (size_t k = 0; k < px.size(); ++k) {
+    const std::optional<Eigen::Vector2d> ours = lens.Undistort({px[k].x, px[k].y});
+    ASSERT_TRUE(ours) << px[k];
+    worst = std::max(worst, (*ours - Eigen::Vector2d(ocv[k].x, ocv[k].y)).norm());
+  }
+  EXPECT_LT(worst, 1e-6);
+}
+
+// A strong wide angle (fx = 700 px on a 1400 x 1000 photo, k1 = -0.4, k2 = 0.15) is one to
+// one over its photo (r_d = r - 0.4 r³ + 0.15 r⁵ rises everywhere), but OpenCV's iterative
+// undistortion does not converge at its corners, and such rigs were refused. Newton's method
+// undoes it to 1e-7 px.
+TEST(Lens, StrongWideAngleIsUndoneToTheCorners) {
+  Lens lens;
+  lens.camera_matrix << 700, 0, 699.5, 0, 700, 499.5, 0, 0, 1;
+  lens.distortion = {-0.4, 0.15, 0, 0, 0};
+  EXPECT_EQ(LensProblemOverImage(lens, 1400, 1000), "");
+  for (const Eigen::Vector2d& corner :
+       {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(1399.5, -0.5), Eigen::Vector2d(-0.5, 999.5),
+        Eigen::Vector2d(1399.5, 999.5)}) {
+    const std::optional<Eigen::Vector2d> ideal = lens.Undistort(corner);
+    ASSERT_TRUE(ideal) << corner.transpose();
+    // Back through OpenCV's own forward model.
+    const Eigen::Vector2d back = OpenCvDistort(lens, Normalised(lens, *ideal));
+    EXPECT_LT((back - corner).norm(), 0.01) << corner.transpose();
+    // The corner lies at r_d = 1.23 normalised; undistorted, further out (barrel).
+    EXPECT_GT(Normalised(lens, *ideal).norm(), Normalised(lens, corner).norm() + 0.1);
+  }
+  // And a rig with it maps the photo (it was refused: "lens model not undone").
+  Rig rig;
+  rig.plane_from_image = Eigen::Vector3d(0.1, 0.1, 1.0).asDiagonal();
+  rig.lens = lens;
+  EXPECT_NO_THROW(rig.CheckForImage(1400, 1000, "wide.jpg"));
+  EXPECT_TRUE(rig.PlaneFromImage({-0.5, -0.5}).allFinite());
+}
+
+// A point the lens puts nowhere in reach (k1 = -5: r_d = r - 5 r³ is at most 0.17) has no
+// undistorted point; Newton's method says so instead of returning a wrong one.
+TEST(Lens, UndistortFailsWhereTheModelIsNotInvertible) {
+  Lens lens;
+  lens.camera_matrix << 2000, 0, 1000, 0, 2000, 750, 0, 0, 1;
+  lens.distortion = {-5, 0, 0, 0, 0};
+  EXPECT_TRUE(lens.Undistort({1100.0, 750.0}));  // r_d = 0.05: still one to one
+  EXPECT_FALSE(lens.Undistort({1999.5, 1499.5}));
+  EXPECT_NE(LensProblemOverImage(lens, 2000, 1500), "");
 }
 
 TEST(Rig, RefusesBadFiles) {

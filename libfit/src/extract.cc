@@ -993,6 +993,12 @@ double FindTip(const cv::Mat& gray, const Vec2& centre, const Vec2& tangent, con
   return 0.0;
 }
 
+// --edge-px may lie at most this many strip widths plus kEdgeFarPx from the traced line (or
+// its straight continuation back from its start): a platform's corner lies half a width under
+// the mid-line, a width under the upper edge.
+constexpr double kEdgeFarWidths = 3.0;
+constexpr double kEdgeFarPx = 10.0;
+
 std::string Fmt(double v, int precision = 3) {
   std::ostringstream s;
   s.setf(std::ios::fixed);
@@ -1430,6 +1436,34 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   }
 
   // ---- 7. Origin and horizontal.
+  if (options.edge_px) {
+    // The edge is where the strip leaves its support: on the traced line (a clamp) or a
+    // thickness under it (a platform's corner), or on its straight continuation back from
+    // where the sections start. Farther than a few strip widths from all of these it is a
+    // mistake (reduced-image pixels, x and y swapped, another photo's edge) that would move
+    // the whole profile: refused.
+    const Vec2 e = *options.edge_px;
+    const Vec2 back = (trace.front() - trace[std::min<size_t>(10, trace.size() - 1)]).normalized();
+    double miss = (e - trace.front()).norm();
+    const double along = (e - trace.front()).dot(back);
+    if (along > 0.0) miss = std::min(miss, (e - trace.front() - along * back).norm());
+    for (size_t k = 1; k < trace.size(); ++k) {
+      const Vec2 d = trace[k] - trace[k - 1];
+      const double f =
+          std::clamp((e - trace[k - 1]).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
+      miss = std::min(miss, (e - trace[k - 1] - f * d).norm());
+    }
+    const double limit = kEdgeFarWidths * set.width + kEdgeFarPx;
+    if (!(miss <= limit)) {
+      throw InputError("--edge-px " + Fmt(e.x(), 1) + "," + Fmt(e.y(), 1) + " lies " +
+                       Fmt(miss, 0) + " px from the strip in " + source + " (more than " +
+                       Fmt(kEdgeFarWidths, 0) + " strip widths + " + Fmt(kEdgeFarPx, 0) +
+                       " px = " + Fmt(limit, 0) + " px; its held end is at " +
+                       Fmt(trace.front().x(), 0) + "," + Fmt(trace.front().y(), 0) +
+                       "): the edge is where the strip leaves the platform or clamp, in "
+                       "full-resolution pixels (x right, y down)");
+    }
+  }
   double level = options.level_deg ? *options.level_deg * kDeg : 0.0;
   if (platform.found) {
     r.rig_type = "platform";

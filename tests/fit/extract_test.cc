@@ -493,6 +493,35 @@ TEST(ExtractGeometry, SmoothPolylineReturnsTheInputForANonFiniteSigma) {
   for (const Eigen::Vector2d& p : wide) EXPECT_TRUE(p.allFinite());
 }
 
+// --edge-px inside the photo but far from the strip (here 200 px above the platform's corner)
+// moved the whole profile without a word. It is refused past 3 strip widths + 10 px from the
+// traced line (or its continuation back from the held end), naming the held end; a corner
+// given a few pixels off is fine.
+TEST(ExtractFailures, EdgeFarFromTheStripIsRefused) {
+  PhotoScene s;
+  s.holder = PhotoScene::Holder::kPlatform;
+  s.root_x = 500.0;
+  s.root_y = 300.0;
+  const SyntheticPhoto photo = testing::Render(s);
+  ExtractOptions near;
+  near.edge_px = photo.origin + Eigen::Vector2d(-3.0, 4.0);
+  EXPECT_TRUE(Extract(photo.gray, near).success);
+  ExtractOptions behind;  // on the platform, 300 px behind its corner under the strip
+  behind.edge_px = photo.origin - Eigen::Vector2d(300.0, 0.0);
+  EXPECT_TRUE(Extract(photo.gray, behind).success);
+  ExtractOptions far;
+  far.edge_px = photo.origin - Eigen::Vector2d(0.0, 200.0);
+  try {
+    Extract(photo.gray, far);
+    ADD_FAILURE() << "accepted an edge 200 px above the strip";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("--edge-px"), std::string::npos) << m;
+    EXPECT_NE(m.find("from the strip"), std::string::npos) << m;
+    EXPECT_NE(m.find("held end"), std::string::npos) << m;
+  }
+}
+
 TEST(ExtractFailures, BadInputThrows) {
   const cv::Mat gray = testing::Render(BorderScene()).gray;
   cv::Mat colour;

@@ -23,12 +23,25 @@ using internal::ProfileModel;
 // A constant whose 1-σ exceeds this fraction of its value is "not determined by the data".
 constexpr double kUndeterminedRelSd = 0.5;
 
-// Weight of the prior [mm per unit of ln b or ln κ0].
+// Weight of the prior [mm per unit of ln b or ln κ0] at the noise it was set for, σ = 0.1 mm.
+// Its pull on the estimate goes with (weight/σ)², so it is scaled with the fit's rms
+// (kPriorPerRms, at least kPriorFloor) to keep the same relative pull: at a fixed 1e-2 mm it
+// moved c1 of noise-free 200-250 mm strips 30 % or more off the truth, far outside their sd, and
+// on σ = 0.5 mm data it was too weak to keep b1 of a soft shirting off its lower bound.
 constexpr double kPriorWeight = 1e-2;
+constexpr double kPriorPerRms = 0.1;
+constexpr double kPriorFloor = 1e-3;
+
+// Largest spacing of the model curve's elastica samples [m]: its cubic Hermite interpolation
+// must follow the clamp's bend (a 250 mm strip at 41 samples, 6 mm apart, put c1 15 % off; 2 mm
+// recover it to 0.2 %). Overhangs up to 80 mm keep options.curve_samples.
+constexpr double kMaxSampleSpacing = 2e-3;
 
 class LawPrior : public ceres::SizedCostFunction<2, 3> {
  public:
   LawPrior(double weight, double log_kappa_ref) : w_(weight), log_kappa_ref_(log_kappa_ref) {}
+  double weight() const { return w_; }
+  void set_weight(double w) { w_ = w; }
   bool Evaluate(double const* const* p, double* r, double** jac) const override {
     r[0] = w_ * (p[0][1] - p[0][0]);
     r[1] = w_ * (p[0][2] - log_kappa_ref_);
@@ -160,8 +173,11 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
   ceres::Problem problem(problem_options);
   std::vector<std::unique_ptr<ProfileModel>> models;
   for (size_t i = 0; i < profiles.size(); ++i) {
-    models.push_back(std::make_unique<ProfileModel>(profiles[i], areal_density,
-                                                    options.curve_samples, options.elastica_tol));
+    const int samples =
+        std::max(options.curve_samples,
+                 std::min(2001, static_cast<int>(std::ceil(lengths[i] / kMaxSampleSpacing)) + 1));
+    models.push_back(
+        std::make_unique<ProfileModel>(profiles[i], areal_density, samples, options.elastica_tol));
     ProfileModel* m = models.back().get();
     for (int j = 0; j < m->num_points(); ++j) {
       ceres::LossFunction* loss =
@@ -199,7 +215,8 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
   // directions the data leave free (b1 = b2 makes κ0 free; κ0 beyond the data makes b2 free)
   // and is negligible elsewhere (1e-2 mm per unit of ln, against hundreds of points whose
   // residuals move millimetres per unit of ln).
-  problem.AddResidualBlock(new LawPrior(kPriorWeight, law_p[2]), nullptr, law_p.data());
+  auto* prior = new LawPrior(kPriorWeight, law_p[2]);
+  problem.AddResidualBlock(prior, nullptr, law_p.data());
   if (!options.fit_offset && !options.fit_rotation) {
     problem.SetParameterBlockConstant(rig.data());
   } else if (!options.fit_offset || !options.fit_rotation) {
@@ -220,6 +237,43 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
   solver_options.minimizer_progress_to_stdout = debug;
   ceres::Solver::Summary solver_summary;
   ceres::Solve(solver_options, &problem, &solver_summary);
+  // Data more or less precise than the prior's σ = 0.1 mm: again, with the prior scaled to
+  // their rms (from the first solve's result, a few iterations).
+  if (solver_summary.IsSolutionUsable() &&
+      solver_summary.termination_type != ceres::NO_CONVERGENCE) {
+    double sum2 = 0.0;
+    int n = 0;
+    bool ok = true;
+    for (size_t i = 0; i < models.size() && ok; ++i) {
+      ok = models[i]->Update(law_p.data(), &lengths[i], rig.data(), false);
+      for (int j = 0; ok && j < models[i]->num_points(); ++j, ++n)
+        sum2 += models[i]->residual(j) * models[i]->residual(j);  // [mm²]
+    }
+    const double w = std::max(kPriorFloor, kPriorPerRms * std::sqrt(sum2 / std::max(1, n)));
+    if (ok && (w < 0.5 * prior->weight() || w > 2.0 * prior->weight())) {
+      prior->set_weight(w);
+      const int first_iterations = static_cast<int>(solver_summary.iterations.size());
+      const double first_seconds = solver_summary.total_time_in_seconds;
+      solver_options.max_num_iterations = std::max(1, options.max_iterations - first_iterations);
+      solver_options.max_solver_time_in_seconds =
+          std::max(1e-3, options.max_seconds - first_seconds);
+      const auto first_law = law_p;
+      const auto first_lengths = lengths;
+      const auto first_rig = rig;
+      ceres::Solver::Summary second;
+      ceres::Solve(solver_options, &problem, &second);
+      if (second.IsSolutionUsable() && second.termination_type != ceres::NO_CONVERGENCE) {
+        second.iterations.insert(second.iterations.begin(), solver_summary.iterations.begin(),
+                                 solver_summary.iterations.end());
+        solver_summary = second;
+      } else {
+        // A refinement that does not settle (profiles no law fits, which the check below
+        // names) keeps the first solve's result.
+        law_p = first_law, lengths = first_lengths, rig = first_rig;
+        prior->set_weight(kPriorWeight);
+      }
+    }
+  }
 
   DirectFitSummary out;
   out.iterations = static_cast<int>(solver_summary.iterations.size());

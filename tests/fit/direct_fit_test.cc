@@ -141,7 +141,13 @@ TEST(DirectFit, FitsStripsThatHangNearlyVertically) {
     ASSERT_TRUE(fit.converged) << L << ": " << fit.message;
     EXPECT_NEAR(fit.profiles[0].overhang, L, 1e-4) << L;
     EXPECT_LT(fit.rms, 1e-5) << L;
-    EXPECT_LT(MomentCurveError(*fit.law, truth, fit.kappa_max), 0.05)
+    // Recovered as well as short strips now: the model curve sampled at least every 2 mm and
+    // the prior scaled to the data's rms (before: c1 33 % off for 200 + 250 mm, 2-2.4× for single
+    // strips in a review). (Its sd, from residuals that
+    // are the model's round-off here, not noise, means little on noise-free data.)
+    EXPECT_LT(MomentCurveError(*fit.law, truth, fit.kappa_max), 2e-3)
+        << L << " " << fit.BriefReport();
+    EXPECT_NEAR(fit.law->c1(), truth.c1(), 0.03 * std::abs(truth.c1()))
         << L << " " << fit.BriefReport();
   }
 }

@@ -109,6 +109,16 @@ TEST(AcpmShell, SeamAlongThePushStiffensTheRaysNearItSymmetrically) {
   EXPECT_GT(shell.overhang[2], shell.plain_overhang);
 }
 
+// One ray of the ACPM push with a C-plain seam across the strip, `position` [m] behind the front.
+AcpmOptions OneRayAcrossCPlainSeam(double position) {
+  AcpmOptions options;
+  options.num_rays = 1;
+  options.seam.direction = AcpmSeamDirection::kAcross;
+  options.seam.profile = SeamPreset("C-plain");
+  options.seam.position = position;
+  return options;
+}
+
 TEST(AcpmShell, AcrossSeamBehindTheEdgeStiffensTheOverhang) {
   // A C-plain seam 100 mm behind the front: the plain Fig. 8 strip is cut at 33.6 mm, with
   // the seam line still 66 mm back on the platform, where S(d) (reaching d_max + fade =
@@ -119,11 +129,7 @@ TEST(AcpmShell, AcrossSeamBehindTheEdgeStiffensTheOverhang) {
   // stretched over the longer overhang) with the plain run's extrapolation as a correction,
   // measured +/- 1 %, so 3 %.
   const Material m = Fabric(0.1, 0.0892, -0.0092, 200);
-  AcpmOptions options;
-  options.num_rays = 1;
-  options.seam.direction = AcpmSeamDirection::kAcross;
-  options.seam.profile = SeamPreset("C-plain");
-  options.seam.position = 0.1;
+  AcpmOptions options = OneRayAcrossCPlainSeam(0.1);
   options.model = AcpmModelKind::kElastica;
   const AcpmResult elastica = RunAcpm(m, options);
   ASSERT_GT(elastica.rays[0].overhang, 0.055);  // docs/acpm.md: 61.7 mm
@@ -139,11 +145,7 @@ TEST(AcpmShell, AcrossSeamFarBehindTheEdgeChangesNothing) {
   // Past d_max + fade (120 mm) behind the crossing the seam no longer reaches the overhang:
   // the seamed push and the plain one are cut at the same overhang.
   const Material m = Fabric(0.1, 0.0892, -0.0092, 200);
-  AcpmOptions options;
-  options.num_rays = 1;
-  options.seam.direction = AcpmSeamDirection::kAcross;
-  options.seam.profile = SeamPreset("C-plain");
-  options.seam.position = 0.2;
+  AcpmOptions options = OneRayAcrossCPlainSeam(0.2);
   ShellAcpmSettings settings;
   settings.extrapolate = false;
   const AcpmCrossings seamed = ShellAcpmCrossings(m, options, options.RayPositions(), settings);

@@ -105,16 +105,25 @@ void Run(const CalibrateArgs& a) {
       boards.push_back({{"photo", d.source}, {"found", d.found}, {"square_px", d.square_px},
                         {"image_size_px", {d.image_size.width, d.image_size.height}}});
     }
-    PrintJson({{"rig_file", a.out},
-               {"boards", boards},
-               {"lens_model", c.lens_model},
-               {"reprojection_error_px", c.rms_error_px},
-               {"max_error_px", c.max_error_px},
-               {"reprojection_error_mm", c.rms_error_mm},
-               {"max_error_mm", c.max_error_mm},
-               {"lens_rms_px", c.lens_model ? nlohmann::json(c.lens_rms_px) : nlohmann::json()},
-               {"mm_per_px", c.mm_per_px},
-               {"seconds", c.seconds}});
+    nlohmann::json lens_models = nlohmann::json::array();
+    for (const auto& m : c.lens_candidates) {
+      lens_models.push_back({{"terms", m.terms}, {"rms_px", m.rms_px}, {"p_value", m.p_value}});
+    }
+    PrintJson(
+        {{"rig_file", a.out},
+         {"boards", boards},
+         {"lens_model", c.lens_model},
+         {"reprojection_error_px", c.rms_error_px},
+         {"max_error_px", c.max_error_px},
+         {"reprojection_error_mm", c.rms_error_mm},
+         {"max_error_mm", c.max_error_mm},
+         {"lens_rms_px", c.lens_terms.empty() ? nlohmann::json() : nlohmann::json(c.lens_rms_px)},
+         {"lens_terms", c.lens_terms.empty() ? nlohmann::json() : nlohmann::json(c.lens_terms)},
+         {"distortion", c.lens_model ? nlohmann::json(c.rig.lens->distortion) : nlohmann::json()},
+         {"distortion_sigma", c.lens_model ? nlohmann::json(c.distortion_sigma) : nlohmann::json()},
+         {"lens_models", lens_models},
+         {"mm_per_px", c.mm_per_px},
+         {"seconds", c.seconds}});
     return;
   }
   std::cout << c.BriefReport() << "\nwrote " << a.out << (a.overlay.empty() ? "" : " and " + a.overlay)

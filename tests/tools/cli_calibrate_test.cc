@@ -54,6 +54,32 @@ TEST(CliCalibrate, BoardGivesARigThatExtractReads) {
   EXPECT_NEAR(nlohmann::json::parse(x.out)["photos"][0]["length_mm"].get<double>(), 50.0, 0.8);
 }
 
+// Several boards: the lens fit says which distortion terms the boards determine, with their
+// 1-σ, and which were left out (text: a "lens:" line; JSON: lens_terms, lens_models).
+TEST(CliCalibrate, SeveralBoardsReportTheLensTermsKept) {
+  const fs::path dir = Scratch("cli_calibrate_lens");
+  const double square = Render(dir);
+  const auto second = Textile(
+      "render-photo --material samples/materials/pabst-fig8.json --overhang-mm 50 --size 800x600 "
+      "--mm-per-px 0.16 --difficulty medium --seed 5 -o " +
+      Quote(dir / "other.png"));
+  ASSERT_EQ(second.exit_code, 0) << second.err;
+  const std::string args = "calibrate " + Quote(dir / "strip.board.png") + " " +
+                           Quote(dir / "other.board.png") + " --board 9x6 --square-mm " +
+                           std::to_string(square) + " -o " + Quote(dir / "rig.json");
+  const auto text = Textile(args);
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("\nlens: "), std::string::npos) << text.out;
+  const auto r = Textile(args + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_TRUE(j.at("lens_terms").is_string());
+  ASSERT_FALSE(j.at("lens_models").empty());
+  EXPECT_TRUE(j.at("lens_rms_px").is_number());
+  EXPECT_EQ(j.at("lens_models").back().at("terms"), j.at("lens_terms"));
+  EXPECT_EQ(j.at("lens_model").get<bool>(), j.at("lens_terms") != "none");
+}
+
 TEST(CliCalibrate, RefusesWhatItCannotUse) {
   const fs::path dir = Scratch("cli_calibrate_bad");
   Render(dir);

@@ -32,7 +32,8 @@ struct CalibrateOptions {
   int cols = 0, rows = 0;      // inner corners along a row and down a column (e.g. 9 x 6)
   double square_mm = 0.0;      // side of a square [mm]
   double max_error_px = 1.0;   // refuse a calibration whose RMS reprojection error is larger [px]
-  bool lens = true;            // with several boards, also fit lens distortion (k1, k2, p1, p2, k3)
+  bool lens = true;            // with several boards, also fit lens distortion (k1, k2, p1, p2,
+                               // k3, as many as the boards determine)
   int detect_side_px = 2000;   // long side of the reduced image the corners are found on [px]
   double max_seconds = 60.0;   // wall-time cap, read after each board and after the lens fit [s]
 
@@ -60,6 +61,19 @@ struct CalibrationSummary {
   double rms_error_mm = 0.0;      // found corners mapped to the plane vs the true grid, RMS [mm]
   double max_error_mm = 0.0;
   double lens_rms_px = 0.0;       // cv::calibrateCamera's RMS over all boards, if fitted [px]
+  // The lens fit (several boards): nested models none, k1, (k1, k2), (k1, k2, p1, p2) and
+  // (k1, k2, p1, p2, k3) are fitted; the simplest whose RMS the full model does not lower
+  // significantly (F-test at 1 %) and by 5 % is kept. lens_rms_px is the kept model's.
+  std::string lens_terms;         // the kept model's terms ("none": no lens in the rig); empty
+                                  // when no lens was fitted
+  double lens_full_rms_px = 0.0;  // RMS over all boards of the full model [px]
+  std::vector<double> distortion_sigma;  // 1-σ of k1, k2, p1, p2, k3 (0 for terms not kept)
+  struct LensCandidate {
+    std::string terms;
+    double rms_px = 0.0;   // over all boards [px]
+    double p_value = 1.0;  // of the full model's improvement on it (F-test)
+  };
+  std::vector<LensCandidate> lens_candidates;  // tried, simplest first, up to the kept one
   double mm_per_px = 0.0;         // local scale at the board's centre [mm/px]
   std::vector<BoardDetection> detections;
   double seconds = 0.0;

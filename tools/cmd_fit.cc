@@ -1,11 +1,13 @@
 // textile fit: cantilever profiles -> the bending law {b1, b2, c1}, by the direct elastica fit
 // (default) or by Clapp et al.'s method; writes a material file with a `fit` report.
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <optional>
 #include <sstream>
+#include <tuple>
 
 #include "common/atomic_file.h"
 #include "common/chart.h"
@@ -63,19 +65,38 @@ struct Outcome {
 // trace line (upper or lower edge) move it by tenths of a millimetre.
 constexpr double kOffsetNoteM = 0.0005;
 
+// Smallest tilt the fit adopts [rad]. Below it the rotation fitted to photos is the extraction's
+// correlated residuals, not a tilt (the shipped photos: −0.04°, which would move c1 by 30 %).
+constexpr double kMinTiltRad = 0.1 * M_PI / 180.0;
+
 // Whether a fit with a rig rotation explains the data so much better than the fit without one
-// that the tilt is real: a likelihood-ratio test with one more parameter, (RSS₀ − RSS₁) / σ̂₁²
-// above 25 (five standard deviations of pure noise's χ²₁), and a tilt of at least 0.1°. A fit
-// without rotation that failed (a tilt of a degree can drive b1 into its bound) counts as
-// infinitely worse.
-bool TiltIsSignificant(const DirectFitSummary& level, const DirectFitSummary& tilted,
-                       size_t points) {
-  if (!tilted.converged || std::abs(tilted.rotation) < 0.1 * M_PI / 180.0) return false;
+// that the tilt is real: a likelihood-ratio test on the objective both minimise (the robust
+// loss, so that stray points neither hide a tilt nor fake one), 2 (F₀ − F₁) / σ̂₁² above 9
+// (three standard deviations of noise's χ²₁), σ̂₁² = 2 F₁ / (residuals − free parameters), and a
+// tilt of at least kMinTiltRad. A fit without rotation that failed (a tilt of a degree can drive
+// b1 into its bound) counts as infinitely worse.
+bool TiltIsSignificant(const DirectFitSummary& level, const DirectFitSummary& tilted) {
+  if (!tilted.converged || std::abs(tilted.rotation) < kMinTiltRad) return false;
   if (!level.converged) return true;
-  const double n = static_cast<double>(points);
-  const double rss0 = n * level.rms * level.rms, rss1 = n * tilted.rms * tilted.rms;
-  const double sigma2 = rss1 / std::max(1.0, n - 6.0);
-  return rss0 - rss1 > 25.0 * sigma2;
+  const double dof = std::max(1, tilted.num_residuals - tilted.num_free_parameters);
+  const double sigma2 = 2.0 * tilted.cost / dof;
+  return 2.0 * (level.cost - tilted.cost) > 9.0 * sigma2;
+}
+
+// The largest change of b1 or b2 between the level fit and the fit with a rotation, in the
+// latter's standard deviations (0 where an sd is not available), and which constant it is.
+std::pair<double, std::string> LawShiftInSds(const DirectFitSummary& level,
+                                             const DirectFitSummary& tilted) {
+  std::pair<double, std::string> worst{0.0, ""};
+  const std::array<std::tuple<double, double, double, const char*>, 2> pairs = {
+      std::tuple{level.law->b1(), tilted.law->b1(), tilted.b1_sd, "b1"},
+      std::tuple{level.law->b2(), tilted.law->b2(), tilted.b2_sd, "b2"}};
+  for (const auto& [a, b, sd, name] : pairs) {
+    if (!(sd > 0.0) || !std::isfinite(sd)) continue;
+    const double z = std::abs(a - b) / sd;
+    if (z > worst.first) worst = {z, name};
+  }
+  return worst;
 }
 
 Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double rho) {
@@ -98,9 +119,7 @@ Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double
     } catch (const InputError&) {
       // Only the fit without rotation speaks for the input (profiles of different strips).
     }
-    size_t points = 0;
-    for (const Profile& p : profiles) points += p.s.size();
-    if (TiltIsSignificant(fit, tilted, points)) {
+    if (TiltIsSignificant(fit, tilted)) {
       notes.push_back("the profiles are tilted by " + Num(tilted.rotation * 180.0 / M_PI, 2) +
                       "° (a rig not level or a camera rolled against it): fitted with that "
                       "rotation, rms " +
@@ -108,18 +127,31 @@ Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double
                       (fit.converged ? Num(fit.rms * 1e3, 3) + " mm" : "no fit") + " without it");
       fit = tilted;
       o = turned;
+    } else if (fit.converged && tilted.converged && std::abs(tilted.rotation) >= kMinTiltRad) {
+      // A tilt the data do not show clearly can still move the law by more than its sds (a
+      // 0.2-0.3° tilt: b1 8-80 % high): say what it would change.
+      const auto [z, name] = LawShiftInSds(fit, tilted);
+      if (z > 2.0) {
+        const double level_b = name == "b1" ? fit.law->b1() : fit.law->b2();
+        const double tilted_b = name == "b1" ? tilted.law->b1() : tilted.law->b2();
+        notes.push_back("a tilt of " + Num(tilted.rotation * 180.0 / M_PI, 2) +
+                        "°, which the data do not show clearly, would change " + name + " by " +
+                        Num(100.0 * (tilted_b - level_b) / level_b, 2) + " % (" + Num(z, 2) +
+                        " sd): if the rig is not known to be level within 0.1°, "
+                        "fit with --fit-rotation");
+      }
     }
   }
   if (!fit.converged) throw ComputeError("fit: " + fit.message);
   // The mid-line's height at the edge is half the strip's thickness (at most 3 mm: profiles
-  // rising higher are refused); a fitted offset outside that means the profiles' y origin is not
-  // the platform's top. The law does not depend on it (a shift in y is what the offset absorbs),
-  // the overlay and the edge position do.
+  // rising higher are refused); a fitted offset outside that means the profiles' origin is not
+  // the platform's edge. A shift in y alone is what the offset absorbs (the law unchanged); one
+  // in x changes the law (2 mm: b2 2.3× low), which no offset can tell apart.
   if (o.fit_offset && (fit.offset < -kOffsetNoteM || fit.offset > 0.003)) {
     notes.push_back("the fitted offset at the edge, " + Num(fit.offset * 1e3, 3) +
                     " mm, is not half a strip's thickness (0 to 3 mm): the profiles' y = 0 is "
-                    "not the platform's top; the law does not depend on it, but check the "
-                    "extraction's platform edge");
+                    "not the platform's top, or x = 0 is not its edge (a shift in y alone leaves "
+                    "the law as it is, one in x does not): check the platform edge");
   }
   Outcome out;
   for (const std::string& n : notes) out.notes += (out.notes.empty() ? "" : "; ") + n;
@@ -137,7 +169,7 @@ Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double
                    {"max_mm", r.max * 1e3},
                    {"clamp_curvature_per_cm", units::SiCurvatureToKes(r.clamp_curvature)}});
     out.comparisons.push_back(
-        CompareWithElastica(out.law, rho, profiles[i], r.overhang, fit.offset));
+        CompareWithElastica(out.law, rho, profiles[i], r.overhang, fit.offset, fit.rotation));
   }
   out.report = {{"method", "direct"},
                 {"b1_sd", OrNull(units::SiStiffnessToKes(fit.b1_sd))},

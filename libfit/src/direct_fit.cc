@@ -250,7 +250,7 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
         sum2 += models[i]->residual(j) * models[i]->residual(j);  // [mm²]
     }
     const double w = std::max(kPriorFloor, kPriorPerRms * std::sqrt(sum2 / std::max(1, n)));
-    if (ok && (w < 0.5 * prior->weight() || w > 2.0 * prior->weight())) {
+    if (ok && std::abs(std::log(w / prior->weight())) > std::log(1.25)) {
       prior->set_weight(w);
       const int first_iterations = static_cast<int>(solver_summary.iterations.size());
       const double first_seconds = solver_summary.total_time_in_seconds;
@@ -320,6 +320,7 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
     out.profiles.push_back(r);
   }
   out.rms = std::sqrt(sum2 / count);
+  out.cost = solver_summary.final_cost;
   out.offset = rig[0];
   out.rotation = rig[1];
 
@@ -385,6 +386,8 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
     Eigen::MatrixXd Jf(n_res, free_cols.size());
     for (size_t k = 0; k < free_cols.size(); ++k) Jf.col(k) = J.col(free_cols[k]);
     const int dof = std::max(1, n_res - static_cast<int>(free_cols.size()));
+    out.num_residuals = n_res;
+    out.num_free_parameters = static_cast<int>(free_cols.size());
     const double sigma2 = sum2 * 1e6 / dof;  // [mm²]: residuals are in mm
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(Jf, Eigen::ComputeThinV);
     const auto& sv = svd.singularValues();

@@ -13,7 +13,7 @@ namespace textile {
 
 ProfileComparison CompareWithElastica(const BendingLaw& law, double areal_density,
                                       const Profile& measured, double overhang, double offset,
-                                      int curve_samples) {
+                                      double rotation, int curve_samples) {
   CheckProfile(measured);
   if (!(overhang > 0.0) || !std::isfinite(overhang)) {
     throw InputError(measured.source + ": overhang must be a finite length > 0");
@@ -22,7 +22,7 @@ ProfileComparison CompareWithElastica(const BendingLaw& law, double areal_densit
   // The model's parametrisation (ln b1, ln b2, ln κ0) holds every law but c1 = 0 with b1 ≠ b2
   // exactly; that one is approximated by κ0 = 1e6 /m, far beyond any textile curvature.
   const auto p = internal::ParametersFromLaw(law);
-  const double rig[2] = {offset, 0.0};
+  const double rig[2] = {offset, rotation};
   if (!model.Update(p.data(), &overhang, rig, false)) {
     throw ComputeError(measured.source + ": the elastica did not converge for this law");
   }

@@ -86,6 +86,12 @@ struct DirectFitSummary {
   double rotation = 0.0;  // fitted rig rotation [rad]
   double rms = 0.0;       // over all points [m]
   std::vector<ProfileFitReport> profiles;
+  // The objective minimised, ½ Σ ρ(r²) over the points' robust loss and the tips' plain
+  // residuals (plus the negligible prior) [mm²], with the number of residuals and of free
+  // parameters: what comparing two fits of the same data needs.
+  double cost = 0.0;
+  int num_residuals = 0;
+  int num_free_parameters = 0;
 
   int iterations = 0;
   double seconds = 0.0;

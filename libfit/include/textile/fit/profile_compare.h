@@ -26,10 +26,11 @@ struct ProfileComparison {
 
 // Simulates the strip (law [SI], areal density [kg/m²], overhang [m]) and compares it with
 // the measured profile, the simulation lifted by `offset` [m] (the mid-line's height at the
-// edge). Throws ComputeError if the elastica fails, InputError for bad arguments.
+// edge) and turned by `rotation` [rad] about the edge (a fitted rig tilt). Throws ComputeError if
+// the elastica fails, InputError for bad arguments.
 ProfileComparison CompareWithElastica(const BendingLaw& law, double areal_density,
                                       const Profile& measured, double overhang, double offset,
-                                      int curve_samples = 201);
+                                      double rotation = 0.0, int curve_samples = 201);
 
 // The same comparison against a simulated curve given as points (x_k, y_k) [m] in the
 // profile's frame before the offset, from the edge to the free end (at least 2), e.g. the shell

@@ -233,6 +233,19 @@ TEST(CliBench, ProgressLinesWithTheFlag) {
   EXPECT_EQ(r.err.rfind("bench: running hinge-curve (quick)\n", 0), 0u) << r.err;
 }
 
+// The quick photo benchmark's summary table: a column without values (the easy photos are
+// PNGs, whose decode time is not measured) printed "nan" on stdout; cli.md allows no NaN.
+TEST(CliBench, ExtractAccuracySummaryPrintsNoNan) {
+  const auto d = Scratch("CliBench.ExtractAccuracy");
+  const auto r = RunTextile("bench extract-accuracy --quick -o '" + d.string() + "'",
+                            "bench_extract_accuracy");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_NE(r.out.find("decode_ms"), std::string::npos) << r.out;
+  std::string lower = r.out;
+  std::transform(lower.begin(), lower.end(), lower.begin(), ::tolower);
+  EXPECT_EQ(lower.find("nan"), std::string::npos) << r.out;
+}
+
 // Pabst Fig. 10 (docs/bending.md, "hinge-curve"): one curve per fabric and model, and the shapes
 // the paper describes. Physics only: no timing.
 TEST(CliBench, HingeCurveQuickWritesPabstFig10Curves) {

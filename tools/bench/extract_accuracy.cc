@@ -195,11 +195,22 @@ Benchmark ExtractAccuracyBenchmark() {
               const auto worst = [](const std::vector<double>& v) {
                 return v.empty() ? NAN : *std::max_element(v.begin(), v.end());
               };
+              // A column with no value (no photo of this plan decoded, or none extracted) is
+              // "-", not "nan" (cli.md: no NaN in outputs).
+              const auto cell = [](double v, int digits) {
+                char c[32];
+                if (std::isfinite(v))
+                  std::snprintf(c, sizeof c, "%.*f", digits, v);
+                else
+                  std::snprintf(c, sizeof c, "-");
+                return std::string(c);
+              };
               std::snprintf(line, sizeof line,
-                            "%-10s %6.1f %4d %10.3f %10.3f %10.3f %10.3f %10.1f %10.1f %10.1f %6d\n",
-                            ToString(plan.difficulty).c_str(), mp, n, Median(rms), worst(rms),
-                            worst(mx), Median(tip), Median(cpu_ms), Median(ms), Median(decode_ms),
-                            fails);
+                            "%-10s %6.1f %4d %10s %10s %10s %10s %10s %10s %10s %6d\n",
+                            ToString(plan.difficulty).c_str(), mp, n, cell(Median(rms), 3).c_str(),
+                            cell(worst(rms), 3).c_str(), cell(worst(mx), 3).c_str(),
+                            cell(Median(tip), 3).c_str(), cell(Median(cpu_ms), 1).c_str(),
+                            cell(Median(ms), 1).c_str(), cell(Median(decode_ms), 1).c_str(), fails);
               sum << line;
             }
             res.summary = sum.str();

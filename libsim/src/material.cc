@@ -170,10 +170,7 @@ Material ParseMaterialJson(const std::string& text, const std::string& source) {
 }
 
 Material ReadMaterial(const std::string& path) {
-  std::ifstream f = OpenInputFile(path, "material file");
-  std::stringstream buffer;
-  buffer << f.rdbuf();
-  if (f.bad()) throw InputError(path + ": cannot read material file");
+  std::stringstream buffer(ReadInputFile(path, "material file", 16u << 20));  // kilobytes in use
   if (buffer.str().find_first_not_of(" \t\r\n") == std::string::npos) {
     throw InputError(path + ": empty material file");
   }

@@ -237,11 +237,8 @@ TriangleMesh ParseObj(const std::string& text, const std::string& source) {
 }
 
 TriangleMesh ReadObj(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open for reading");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return ParseObj(text.str(), path);
+  // 1 GB: some twenty million triangles, far beyond what the solvers take.
+  return ParseObj(ReadInputFile(path, "mesh (OBJ)", 1u << 30), path);
 }
 
 MeshQuality ComputeMeshQuality(const TriangleMesh& mesh) {

@@ -388,10 +388,7 @@ SeamProfile ParseSeamJson(const std::string& text, const std::string& source) {
 }
 
 SeamProfile ReadSeamProfile(const std::string& path) {
-  std::ifstream f = OpenInputFile(path, "seam file");
-  std::stringstream buffer;
-  buffer << f.rdbuf();
-  if (f.bad()) throw InputError(path + ": cannot read seam file");
+  std::stringstream buffer(ReadInputFile(path, "seam file", 16u << 20));  // kilobytes in use
   if (buffer.str().find_first_not_of(" \t\r\n") == std::string::npos) {
     throw InputError(path + ": empty seam file");
   }

@@ -133,7 +133,7 @@ TEST(MeshIo, BadVertexDataAndPathsAreRefusedByName) {
   EXPECT_EQ(InputErrorOf([&] { WriteObj("/nonexistent-dir/m.obj", m); }),
             "/nonexistent-dir/m.obj: cannot open for writing");
   EXPECT_EQ(InputErrorOf([&] { ReadObj("/nonexistent-dir/m.obj"); }),
-            "/nonexistent-dir/m.obj: cannot open for reading");
+            "/nonexistent-dir/m.obj: cannot open mesh (OBJ)");
 }
 
 TEST(MeshIo, ObjReaderHandlesCommonFormsAndNamesBadLines) {

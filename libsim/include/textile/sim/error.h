@@ -26,6 +26,12 @@ class ComputeError : public std::runtime_error {
 // empty stream on Linux and would otherwise be reported as an empty file.
 std::ifstream OpenInputFile(const std::string& path, const std::string& what);
 
+// The whole of an input file (OpenInputFile's errors), refused with InputError "<path>: more
+// than N MB, too large for a <what>" once it passes max_bytes: a material, seam or rig file is
+// kilobytes, and a stray gigabyte file (or /dev/zero) would otherwise be read into memory until
+// the machine runs out of it.
+std::string ReadInputFile(const std::string& path, const std::string& what, std::size_t max_bytes);
+
 }  // namespace textile
 
 #endif  // TEXTILE_SIM_ERROR_H_

@@ -8,6 +8,9 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "common/atomic_file.h"
 #include "common/chart.h"
@@ -175,11 +178,17 @@ void Run(const ValidateArgs& a) {
     throw InputError("--width-mm must lie in [5, 200] mm, got " + Num(a.width_mm));
   const bool run_elastica = a.model != "shell", run_shell = a.model != "elastica";
   const double rho = units::GsmToSi(a.gsm);
-  const std::vector<LoadedProfile> loaded = LoadProfileInputs(a.inputs, a.photo.Options());
-  const OutputFolder folder(a.out_dir);  // made when the files are committed
+  const PhotoInputOptions photo = a.photo.Options();
   const std::string report_path = (std::filesystem::path(a.out_dir) / "validate.json").string();
   const std::string png_path = (std::filesystem::path(a.out_dir) / "validate.png").string();
   const std::string material_path = (std::filesystem::path(a.out_dir) / "fitted.json").string();
+  // Before any work: an input in the folder under an output's name would be replaced by it
+  // (the photo by the chart, the rig by the fitted material).
+  std::vector<std::pair<std::string, std::string>> inputs{{"--rig", a.photo.rig_file}};
+  for (const std::string& in : a.inputs) inputs.emplace_back(in, in);
+  CheckDistinctOutputs({{"-o", report_path}, {"-o", png_path}, {"-o", material_path}}, inputs);
+  const std::vector<LoadedProfile> loaded = LoadProfileInputs(a.inputs, photo);
+  const OutputFolder folder(a.out_dir);  // made when the files are committed
   // Fail fast on an unusable folder; the three files appear together or not at all.
   AtomicFileSet outputs;
   AtomicFile& report_file = outputs.Add(report_path, folder.stage_dir());

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
 #include "run_cli.h"
 
@@ -100,6 +102,38 @@ TEST(CliValidate, RefusesBadInput) {
   ExpectRefused(Textile("validate " + (dir / "fake.png").string() + " --gsm 200" + out), "fake.png",
                 "photo without rig");
   EXPECT_FALSE(fs::exists(dir / "out" / "validate.json"));
+}
+
+// An input in the -o folder under one of validate's output names was replaced by the output
+// (exit 0): the photo by the chart, the rig by the fitted material, a profile by the report.
+TEST(CliValidate, RefusesToOverwriteItsInputs) {
+  const auto dir = Scratch("CliValidate.InputsAsOutputs");
+  const fs::path profile = "samples/profiles/pabst-fig8_L040mm.profile.csv";
+  const fs::path photo = "samples/photos/pabst-fig8_L040mm.jpg";
+  const fs::path rig = "samples/photos/pabst-fig8.rig-truth.json";
+  struct Case {
+    fs::path source;
+    std::string name, args;  // the copy's name in the folder; the run's arguments
+  };
+  const std::vector<Case> cases = {
+      {profile, "validate.json", "validate " + (dir / "validate.json").string()},
+      {photo, "validate.png",
+       "validate " + (dir / "validate.png").string() + " --rig " + rig.string()},
+      {rig, "fitted.json",
+       "validate " + photo.string() + " --rig " + (dir / "fitted.json").string()},
+      // Another spelling of the same file.
+      {profile, "validate.json", "validate " + (dir / "." / "validate.json").string()}};
+  for (const Case& c : cases) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    fs::copy_file(fs::path(TEXTILE_SOURCE_DIR) / c.source, dir / c.name);
+    const std::string before = ReadAll(dir / c.name);
+    const auto r = Textile(c.args + " --gsm 200 --model elastica -o " + dir.string());
+    ExpectRefused(r, (dir / c.name).string(), c.name);
+    EXPECT_NE(r.err.find("would overwrite"), std::string::npos) << r.err;
+    EXPECT_EQ(ReadAll(dir / c.name), before) << c.name;
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1) << c.name;
+  }
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include "common/profile_inputs.h"
 #include "textile/fit/direct_fit.h"
 #include "textile/fit/profile_compare.h"
+#include "textile/fit/rig.h"
 #include "textile/sim/acpm_shell.h"
 #include "textile/sim/cantilever_outputs.h"
 #include "textile/sim/error.h"
@@ -36,7 +37,9 @@ struct ValidateArgs {
   double width_mm = 25.0;
   std::string model = "both";
   bool strict = false, json = false;
+  bool width_given = false;
   PhotoFlags photo;
+  std::vector<std::string> photo_flags_given;  // e.g. "--rig": unused when no input is a photo
 };
 
 // Per profile: the verdict's three criteria. The RMS normal distance carries the tolerance; a
@@ -176,6 +179,9 @@ void Run(const ValidateArgs& a) {
   // (exit 3 after the fit instead of a refused flag).
   if (!std::isfinite(a.width_mm) || a.width_mm < 5.0 || a.width_mm > 200.0)
     throw InputError("--width-mm must lie in [5, 200] mm, got " + Num(a.width_mm));
+  // As textile fit refuses the direct fit's options with --method clapp.
+  if (a.width_given && a.model == "elastica")
+    throw InputError("--width-mm: the shell's strip width; --model elastica simulates no shell");
   const bool run_elastica = a.model != "shell", run_shell = a.model != "elastica";
   const double rho = units::GsmToSi(a.gsm);
   const PhotoInputOptions photo = a.photo.Options();
@@ -187,7 +193,22 @@ void Run(const ValidateArgs& a) {
   std::vector<std::pair<std::string, std::string>> inputs{{"--rig", a.photo.rig_file}};
   for (const std::string& in : a.inputs) inputs.emplace_back(in, in);
   CheckDistinctOutputs({{"-o", report_path}, {"-o", png_path}, {"-o", material_path}}, inputs);
+  // The scale and the rig file are checked whatever the inputs (LoadProfileInputs reads them at
+  // the first photo only): a bad value is refused even when only profiles are given.
+  if (photo.mm_per_px) (void)Rig::FromScale(*photo.mm_per_px);
+  if (photo.rig_path) (void)ReadRigJson(*photo.rig_path);
   const std::vector<LoadedProfile> loaded = LoadProfileInputs(a.inputs, photo);
+  const bool any_photo =
+      std::any_of(loaded.begin(), loaded.end(), [](const auto& in) { return in.from_photo; });
+  // Valid photo flags with profiles only are not an error (textile fit takes them too, and a
+  // glob may or may not match photos), but the run does not use them: say so.
+  std::string note;
+  if (!any_photo && !a.photo_flags_given.empty()) {
+    note = "no input is a photo: ";
+    for (size_t f = 0; f < a.photo_flags_given.size(); ++f)
+      note += (f ? ", " : "") + a.photo_flags_given[f];
+    note += " not used";
+  }
   const OutputFolder folder(a.out_dir);  // made when the files are committed
   // Fail fast on an unusable folder; the three files appear together or not at all.
   AtomicFileSet outputs;
@@ -298,6 +319,7 @@ void Run(const ValidateArgs& a) {
         {"tip_mm", kMaxOverRms * a.tolerance_mm}}},
       {"profiles", per},
       {"verdict", all_pass ? "pass" : "fail"},
+      {"note", note.empty() ? nlohmann::json() : nlohmann::json(note)},
       {"png", png_path},
       {"material", material_path}};
   if (all_pass || !a.strict) {
@@ -343,6 +365,7 @@ void Run(const ValidateArgs& a) {
     if (k.elastica.run) line("elastica", k.elastica);
     if (k.shell.run) line("shell   ", k.shell);
   }
+  if (!note.empty()) std::cout << "note: " << note << "\n";
   std::cout << "verdict: " << (all_pass ? "PASS" : "FAIL") << " (tolerance: rms ≤ "
             << Num(a.tolerance_mm) << " mm, max and tip ≤ " << Num(kMaxOverRms * a.tolerance_mm)
             << " mm)\nwrote " << report_path << ", " << png_path << ", " << material_path << "\n";
@@ -377,7 +400,18 @@ void RegisterValidate(CLI::App& app) {
   sub->add_flag("--strict", a->strict, "A failed validation is an error (exit 3, nothing written)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   AddPhotoFlags(sub, &a->photo);
-  sub->callback([a] { Run(*a); });
+  CLI::Option* width = sub->get_option("--width-mm");
+  std::vector<CLI::Option*> photo_flags;
+  for (const char* name : {"--rig", "--mm-per-px", "--edge-px", "--level-deg", "--trace",
+                           "--rig-type", "--step-mm", "--progress"})
+    photo_flags.push_back(sub->get_option(name));
+  sub->callback([a, width, photo_flags] {
+    a->width_given = width->count() > 0;
+    a->photo_flags_given.clear();
+    for (const CLI::Option* o : photo_flags)
+      if (o->count() > 0) a->photo_flags_given.push_back(o->get_name());
+    Run(*a);
+  });
 }
 
 namespace {

@@ -136,5 +136,27 @@ TEST(CliValidate, RefusesToOverwriteItsInputs) {
   }
 }
 
+// Photo flags with profiles only are checked (bad ones refused, bad-input cases) and, when
+// valid, named in a note: the run does not use them (textile fit takes them silently).
+TEST(CliValidate, PhotoFlagsWithoutPhotosGetANote) {
+  const auto dir = Scratch("CliValidate.PhotoFlagsNote");
+  const auto r = Textile(
+      "validate samples/profiles/pabst-fig8_L060mm.profile.csv --gsm 200 --model elastica "
+      "--rig samples/photos/pabst-fig8.rig-truth.json --trace upper -o " +
+      dir.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("note: no input is a photo: --rig, --trace not used"), std::string::npos)
+      << r.out;
+  const auto j = nlohmann::json::parse(ReadAll(dir / "validate.json"));
+  EXPECT_NE(j["note"].get<std::string>().find("--rig, --trace"), std::string::npos) << j["note"];
+  // A photo among the inputs uses them: no note.
+  const auto p = Textile(
+      "validate samples/photos/pabst-fig8_L060mm.jpg --gsm 200 --model elastica --json "
+      "--rig samples/photos/pabst-fig8.rig-truth.json -o " +
+      dir.string());
+  ASSERT_EQ(p.exit_code, 0) << p.err;
+  EXPECT_TRUE(nlohmann::json::parse(p.out)["note"].is_null()) << p.out;
+}
+
 }  // namespace
 }  // namespace textile

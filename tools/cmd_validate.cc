@@ -9,6 +9,7 @@
 #include <iostream>
 #include <limits>
 #include <string>
+#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -96,6 +97,21 @@ nlohmann::json ModelJson(const ModelCheck& k) {
       {"solves", k.solves},
       {"pass", k.pass},
       {"why", k.why}};
+}
+
+// One file given twice (or under two spellings) would count twice in the fit: its points would
+// weigh double. Missing files are left to the loader, which names them.
+void CheckDistinctInputs(const std::vector<std::string>& inputs) {
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      std::error_code ec;
+      if (!std::filesystem::equivalent(inputs[j], inputs[i], ec) || ec) continue;
+      throw InputError(
+          (inputs[i] == inputs[j] ? inputs[i] + " is given twice"
+                                  : inputs[j] + " and " + inputs[i] + " are the same file") +
+          ": give each profile once (twice, its points would weigh double in the fit)");
+    }
+  }
 }
 
 void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles,
@@ -189,10 +205,12 @@ void Run(const ValidateArgs& a) {
   const std::string png_path = (std::filesystem::path(a.out_dir) / "validate.png").string();
   const std::string material_path = (std::filesystem::path(a.out_dir) / "fitted.json").string();
   // Before any work: an input in the folder under an output's name would be replaced by it
-  // (the photo by the chart, the rig by the fitted material).
+  // (the photo by the chart, the rig by the fitted material), and one profile given twice would
+  // weigh double.
   std::vector<std::pair<std::string, std::string>> inputs{{"--rig", a.photo.rig_file}};
   for (const std::string& in : a.inputs) inputs.emplace_back(in, in);
   CheckDistinctOutputs({{"-o", report_path}, {"-o", png_path}, {"-o", material_path}}, inputs);
+  CheckDistinctInputs(a.inputs);
   // The scale and the rig file are checked whatever the inputs (LoadProfileInputs reads them at
   // the first photo only): a bad value is refused even when only profiles are given.
   if (photo.mm_per_px) (void)Rig::FromScale(*photo.mm_per_px);

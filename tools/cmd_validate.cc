@@ -18,6 +18,7 @@
 #include "common/cli.h"
 #include "common/profile_inputs.h"
 #include "textile/fit/direct_fit.h"
+#include "textile/fit/extract.h"
 #include "textile/fit/profile_compare.h"
 #include "textile/fit/rig.h"
 #include "textile/sim/acpm_shell.h"
@@ -99,6 +100,9 @@ nlohmann::json ModelJson(const ModelCheck& k) {
       {"why", k.why}};
 }
 
+// JSON null for a value that is not available (an undetermined constant's σ).
+nlohmann::json OrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+
 // One file given twice (or under two spellings) would count twice in the fit: its points would
 // weigh double. Missing files are left to the loader, which names them.
 void CheckDistinctInputs(const std::vector<std::string>& inputs) {
@@ -112,6 +116,79 @@ void CheckDistinctInputs(const std::vector<std::string>& inputs) {
           ": give each profile once (twice, its points would weigh double in the fit)");
     }
   }
+}
+
+// The fit report `textile fit` writes into a material's `fit` (cli.md; cmd_fit.cc's RunDirect
+// and AddClassicOutputs), for the direct fit with default options that validate runs: no
+// rotation, offset fitted, Cauchy scale options.robust_scale. The classic outputs: what the
+// 41.5° test would report for this law, and how that G relates to b1 and b2.
+nlohmann::json FitReport(const DirectFitSummary& fit, const DirectFitOptions& options,
+                         const std::vector<LoadedProfile>& loaded, double gsm) {
+  const double rho = units::GsmToSi(gsm);
+  nlohmann::json per = nlohmann::json::array();
+  for (const auto& r : fit.profiles) {
+    per.push_back({{"source", r.source},
+                   {"overhang_mm", units::MToMm(r.overhang)},
+                   {"data_length_mm", units::MToMm(r.data_length)},
+                   {"rms_mm", units::MToMm(r.rms)},
+                   {"max_mm", units::MToMm(r.max)},
+                   {"clamp_curvature_per_cm", units::SiCurvatureToKes(r.clamp_curvature)}});
+  }
+  nlohmann::json report = {{"method", "direct"},
+                           {"b1_sd", OrNull(units::SiStiffnessToKes(fit.b1_sd))},
+                           {"b2_sd", OrNull(units::SiStiffnessToKes(fit.b2_sd))},
+                           {"c1_sd", OrNull(units::SiQuadraticToKes(fit.c1_sd))},
+                           {"sd_units", "kes"},
+                           {"rms_mm", units::MToMm(fit.rms)},
+                           {"b1_observed", fit.b1_observed},
+                           {"b2_observed", fit.b2_observed},
+                           {"c1_observed", fit.c1_observed},
+                           {"observability", fit.observability},
+                           {"kappa_max_per_cm", units::SiCurvatureToKes(fit.kappa_max)},
+                           {"offset_mm", units::MToMm(fit.offset)},
+                           {"offset_fitted", options.fit_offset},
+                           {"rotation_deg", fit.rotation * 180.0 / M_PI},
+                           {"rotation_fitted", options.fit_rotation},
+                           {"robust_scale_mm", units::MToMm(options.robust_scale)},
+                           {"iterations", fit.iterations},
+                           {"seconds", fit.seconds},
+                           {"profiles", per}};
+  const BendingLaw& law = *fit.law;
+  const BarrierCrossing x = FindBarrierCrossing(law, rho);
+  if (x.converged) {
+    const ClassicOutputs c = ComputeClassicOutputs(rho, x.overhang);
+    report["crossing_overhang_mm"] = units::MToMm(x.overhang);
+    report["bending_length_mm"] = units::MToMm(c.bending_length);
+    report["flexural_rigidity_uNm"] = c.rigidity_micro_nm();
+    report["flexural_rigidity_mgcm"] = c.rigidity_mg_cm();
+    report["flexural_rigidity_gfcm"] = c.rigidity_gf_cm();
+    report["G_over_b1"] = c.flexural_rigidity / law.b1();
+    report["G_over_b2"] = c.flexural_rigidity / law.b2();
+    report["classic_note"] = c.RelationToLaw(law);
+  } else {
+    report["classic_note"] = "no 41.5° crossing: " + x.message;
+  }
+  nlohmann::json photos = nlohmann::json::array();
+  for (const auto& in : loaded) {
+    if (!in.extraction) continue;
+    const ExtractionSummary& r = *in.extraction;
+    photos.push_back({{"photo", in.source},
+                      {"rig_type", r.rig_type},
+                      {"polarity", r.polarity},
+                      {"direction", r.direction},
+                      {"trace", r.trace},
+                      {"points", r.profile.size()},
+                      {"length_mm", r.length_mm},
+                      {"tip_mm", {r.tip_mm.x(), r.tip_mm.y()}},
+                      {"mm_per_px", r.mm_per_px},
+                      {"warnings", r.warnings}});
+  }
+  std::vector<std::string> inputs;
+  for (const auto& in : loaded) inputs.push_back(in.source);
+  report["inputs"] = inputs;
+  if (!photos.empty()) report["photos"] = photos;
+  report["areal_density_gsm"] = gsm;
+  return report;
 }
 
 void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles,
@@ -236,7 +313,8 @@ void Run(const ValidateArgs& a) {
 
   std::vector<Profile> profiles;
   for (const auto& in : loaded) profiles.push_back(in.profile);
-  const DirectFitSummary fit = FitDirect(profiles, rho, DirectFitOptions{});
+  const DirectFitOptions fit_options;
+  const DirectFitSummary fit = FitDirect(profiles, rho, fit_options);
   if (!fit.converged || !fit.law) throw ComputeError("fit: " + fit.message);
   const BendingLaw& law = *fit.law;
   // Only a law a material file accepts is worth simulating (as textile fit checks): a fit to a
@@ -341,8 +419,9 @@ void Run(const ValidateArgs& a) {
       {"png", png_path},
       {"material", material_path}};
   if (all_pass || !a.strict) {
-    fitted.fit = {
-        {"method", "direct"}, {"rms_mm", units::MToMm(fit.rms)}, {"validate", report_path}};
+    fitted.fit = FitReport(fit, fit_options, loaded, a.gsm);
+    fitted.fit["validate"] = report_path;
+    fitted.fit["verdict"] = all_pass ? "pass" : "fail";
     material_file.Write(MaterialToJson(fitted).dump(2) + "\n");
     Plot(checks, profiles, law, a.tolerance_mm, all_pass, png_file);
     report_file.Write(report.dump(2) + "\n");

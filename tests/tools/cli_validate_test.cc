@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -156,6 +157,37 @@ TEST(CliValidate, PhotoFlagsWithoutPhotosGetANote) {
       dir.string());
   ASSERT_EQ(p.exit_code, 0) << p.err;
   EXPECT_TRUE(nlohmann::json::parse(p.out)["note"].is_null()) << p.out;
+}
+
+// fitted.json carries the fit report `textile fit` writes (cli.md: b1_sd, b2_sd, c1_sd,
+// bending_length_mm, flexural_rigidity_uNm, ...), with the same numbers for the same profiles:
+// both run the direct fit with its default options.
+TEST(CliValidate, FittedMaterialCarriesTheFitReport) {
+  const auto dir = Scratch("CliValidate.FitReport");
+  const auto v =
+      Textile("validate " + kFig8Profiles + " --gsm 200 --model elastica -o " + dir.string());
+  ASSERT_EQ(v.exit_code, 0) << v.err;
+  const auto f = Textile("fit " + kFig8Profiles + " --gsm 200 -o " + (dir / "fit.json").string());
+  ASSERT_EQ(f.exit_code, 0) << f.err;
+  const auto mv = nlohmann::json::parse(ReadAll(dir / "fitted.json"))["fit"];
+  const auto mf = nlohmann::json::parse(ReadAll(dir / "fit.json"))["fit"];
+  for (const char* key : {"b1_sd", "b2_sd", "c1_sd", "rms_mm", "bending_length_mm",
+                          "flexural_rigidity_uNm", "flexural_rigidity_mgcm", "crossing_overhang_mm",
+                          "G_over_b1", "G_over_b2", "kappa_max_per_cm", "offset_mm"}) {
+    ASSERT_TRUE(mv.contains(key) && mv[key].is_number()) << key << ": " << mv.dump();
+    // Same fit, same options: equal to the digits the two runs print (rel. 1e-9 covers the
+    // solver's floating-point order).
+    EXPECT_NEAR(mv[key].get<double>(), mf[key].get<double>(),
+                1e-9 * std::abs(mf[key].get<double>()) + 1e-12)
+        << key;
+  }
+  for (const char* key : {"method", "sd_units", "b1_observed", "b2_observed", "c1_observed",
+                          "observability", "classic_note", "offset_fitted", "rotation_fitted"})
+    EXPECT_EQ(mv[key], mf[key]) << key;
+  EXPECT_EQ(mv["profiles"].size(), 3u);
+  EXPECT_EQ(mv["areal_density_gsm"], 200);
+  EXPECT_EQ(mv["validate"], (dir / "validate.json").string());
+  EXPECT_EQ(mv["verdict"], "pass");
 }
 
 }  // namespace

@@ -246,6 +246,24 @@ TEST(CliBench, ExtractAccuracySummaryPrintsNoNan) {
   EXPECT_EQ(lower.find("nan"), std::string::npos) << r.out;
 }
 
+// Sensitive Couture Fig. 6 (docs/benchmarks.md, "stability"): every start converges to one
+// energy, and the run-time-against-error rows carry their errors against the reference (a
+// reference solve that stalled above its tolerance used to leave them empty after 60 s).
+TEST(CliBench, StabilityQuickConvergesAndMeasuresItsErrors) {
+  Csv csv;
+  ASSERT_NO_FATAL_FAILURE(RunQuickBench("stability", &csv));
+  int tolerance_rows = 0;
+  for (const auto& row : csv.rows) {
+    EXPECT_EQ(row.at("converged"), "true") << row.at("case") << " " << row.at("solver");
+    if (row.at("case").find("tolerance") == std::string::npos) continue;
+    ++tolerance_rows;
+    EXPECT_TRUE(std::isfinite(Number(row, "position_error_mm"))) << row.at("tolerance");
+    // The loosest tolerance (1e-2 of the weight) is within 0.1 mm of the reference.
+    EXPECT_LT(Number(row, "position_error_mm"), 0.1) << row.at("tolerance");
+  }
+  EXPECT_EQ(tolerance_rows, 3);
+}
+
 // Pabst Fig. 10 (docs/bending.md, "hinge-curve"): one curve per fabric and model, and the shapes
 // the paper describes. Physics only: no timing.
 TEST(CliBench, HingeCurveQuickWritesPabstFig10Curves) {

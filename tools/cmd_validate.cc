@@ -103,21 +103,6 @@ nlohmann::json ModelJson(const ModelCheck& k) {
 // JSON null for a value that is not available (an undetermined constant's σ).
 nlohmann::json OrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
 
-// One file given twice (or under two spellings) would count twice in the fit: its points would
-// weigh double. Missing files are left to the loader, which names them.
-void CheckDistinctInputs(const std::vector<std::string>& inputs) {
-  for (size_t i = 0; i < inputs.size(); ++i) {
-    for (size_t j = 0; j < i; ++j) {
-      std::error_code ec;
-      if (!std::filesystem::equivalent(inputs[j], inputs[i], ec) || ec) continue;
-      throw InputError(
-          (inputs[i] == inputs[j] ? inputs[i] + " is given twice"
-                                  : inputs[j] + " and " + inputs[i] + " are the same file") +
-          ": give each profile once (twice, its points would weigh double in the fit)");
-    }
-  }
-}
-
 // The fit report `textile fit` writes into a material's `fit` (cli.md; cmd_fit.cc's RunDirect
 // and AddClassicOutputs), for the direct fit with default options that validate runs: no
 // rotation, offset fitted, Cauchy scale options.robust_scale. The classic outputs: what the
@@ -282,16 +267,11 @@ void Run(const ValidateArgs& a) {
   const std::string png_path = (std::filesystem::path(a.out_dir) / "validate.png").string();
   const std::string material_path = (std::filesystem::path(a.out_dir) / "fitted.json").string();
   // Before any work: an input in the folder under an output's name would be replaced by it
-  // (the photo by the chart, the rig by the fitted material), and one profile given twice would
-  // weigh double.
+  // (the photo by the chart, the rig by the fitted material). (A profile given twice is refused
+  // by LoadProfileInputs, as in textile fit.)
   std::vector<std::pair<std::string, std::string>> inputs{{"--rig", a.photo.rig_file}};
   for (const std::string& in : a.inputs) inputs.emplace_back(in, in);
   CheckDistinctOutputs({{"-o", report_path}, {"-o", png_path}, {"-o", material_path}}, inputs);
-  CheckDistinctInputs(a.inputs);
-  // The scale and the rig file are checked whatever the inputs (LoadProfileInputs reads them at
-  // the first photo only): a bad value is refused even when only profiles are given.
-  if (photo.mm_per_px) (void)Rig::FromScale(*photo.mm_per_px);
-  if (photo.rig_path) (void)ReadRigJson(*photo.rig_path);
   const std::vector<LoadedProfile> loaded = LoadProfileInputs(a.inputs, photo);
   const bool any_photo =
       std::any_of(loaded.begin(), loaded.end(), [](const auto& in) { return in.from_photo; });

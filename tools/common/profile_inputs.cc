@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <system_error>
 
 #include "common/cli.h"
 #include "textile/sim/error.h"
@@ -54,6 +55,18 @@ std::vector<LoadedProfile> LoadProfileInputs(const std::vector<std::string>& pat
   }
   std::string why;
   if (!options.extract.Check(&why)) throw InputError("photo options: " + why);
+  // One file given twice (or under two spellings) would count twice: its points would weigh
+  // double in a fit. Missing files are left to the loader below, which names them.
+  for (size_t i = 0; i < paths.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      std::error_code ec;
+      if (!std::filesystem::equivalent(paths[j], paths[i], ec) || ec) continue;
+      throw InputError(
+          (paths[i] == paths[j] ? paths[i] + " is given twice"
+                                : paths[j] + " and " + paths[i] + " are the same file") +
+          ": give each profile once (twice, its points would weigh double in the fit)");
+    }
+  }
   std::optional<Rig> rig;  // read once, at the first photo
   std::vector<LoadedProfile> loaded;
   for (const auto& path : paths) {
@@ -125,6 +138,10 @@ PhotoInputOptions PhotoFlags::Options() const {
                                                           : "--edge-px";
     throw InputError(flag + ": " + why.substr(why.find(' ') + 1));
   }
+  // The scale and the rig file are checked whatever the inputs (LoadProfileInputs reads them at
+  // the first photo only): with profiles alone, --mm-per-px -1 or nan and a missing --rig ran.
+  if (o.mm_per_px) (void)Rig::FromScale(*o.mm_per_px);
+  if (o.rig_path) (void)ReadRigJson(*o.rig_path);
   return o;
 }
 

@@ -2,12 +2,15 @@
 // B_f(d) = a2 d² + a1 d + a0 (Pabst et al. section 4.2, Table 2) with covariance and range,
 // written as a seam file (libsim seam.h) of type "fitted" with a `fit` report.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <optional>
 #include <sstream>
+#include <vector>
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
@@ -21,7 +24,7 @@ namespace {
 struct FitSeamArgs {
   std::string input, out, name;
   std::optional<int> layers;  // not given: from the ACPM result's seam, else required
-  double influence_mm = 100.0;
+  std::optional<double> influence_mm;  // not given: the data's range
   bool strict = false, json = false;
 };
 
@@ -51,7 +54,7 @@ void Run(const FitSeamArgs& a) {
   const std::vector<SeamSample> samples = ReadSeamSamples(a.input);
   SeamFitOptions o;
   o.name = a.name;
-  o.influence_mm = a.influence_mm;
+  if (a.influence_mm) o.influence_mm = *a.influence_mm;
   o.layers = a.layers ? *a.layers : LayersFromAcpmResult(a.input);
   if (!a.layers && o.layers == 0)
     throw InputError("--layers: required for " + a.input +
@@ -68,19 +71,32 @@ void Run(const FitSeamArgs& a) {
   seam["source"] = a.input;
   WriteFileAtomically(a.out, seam.dump(2) + "\n");
   if (fit.poor) Info("warning: " + a.input + ": poor fit: " + fit.poor_reason);
-  if (fit.range_mm[1] < o.influence_mm)
-    Info("note: the fit saw d in [" + Num(fit.range_mm[0], 4) + ", " + Num(fit.range_mm[1], 4) +
-         "] mm; S(d) extrapolates it up to the influence range " + Num(o.influence_mm) + " mm");
+  for (const std::string& note : fit.notes) Info("note: " + a.input + ": " + note);
 
   if (a.json) {
     PrintJson({{"input", a.input}, {"output", a.out}, {"seam", seam}});
     return;
   }
+  const SeamProfile& p = fit.profile;
   std::cout << "fit-seam: " << fit.num_points << " points from " << a.input << "\n"
             << fit.BriefReport() << "\n"
-            << "  d [mm]   B_f(d)\n";
-  for (double d : {0.0, 10.0, 25.0, 50.0, 75.0, 100.0}) {
-    std::printf("  %6.1f   %.4f\n", d, fit.profile.StiffnessFactor(d));
+            << "influence range " << Num(p.influence_mm) << " mm ("
+            << (fit.influence_from_data ? "the data's" : "--influence-mm") << "), fade "
+            << Num(p.fade_mm) << " mm: S = max(1, B_f) up to there, then to 1 by "
+            << Num(p.influence_mm + p.fade_mm) << " mm\n"
+            << "  d [mm]   B_f(d)        S(d)\n";
+  std::vector<double> ds{0.0, 10.0, 25.0, 50.0, 75.0, 100.0};
+  ds.push_back(p.influence_mm);
+  ds.push_back(p.influence_mm + p.fade_mm);
+  std::sort(ds.begin(), ds.end());
+  ds.erase(std::unique(ds.begin(), ds.end()), ds.end());
+  for (double d : ds) {
+    if (d > p.influence_mm + p.fade_mm) break;
+    // Beyond d_max the polynomial is not used (the fade is): no B_f shown there.
+    if (d <= p.influence_mm)
+      std::printf("  %6.1f   %-10.4f    %.4f\n", d, p.StiffnessFactor(d), p.Multiplier(d));
+    else
+      std::printf("  %6.1f   %-10s    %.4f\n", d, "-", p.Multiplier(d));
   }
   std::cout << "wrote " << a.out << "\n";
 }
@@ -102,7 +118,8 @@ void RegisterFitSeam(CLI::App& app) {
                   "Fabric layers in the seam (A 2, B 3, C 4); default: the ACPM result's seam");
   sub->add_option("--name", a->name, "Name to store in the seam file");
   sub->add_option("--influence-mm", a->influence_mm,
-                  "Influence range d_max of the written profile [mm] (default 100)");
+                  "Influence range d_max of the written profile [mm] (default: the largest d "
+                  "fitted; beyond it S fades to 1 without extrapolating the fit)");
   sub->add_flag("--strict", a->strict, "A poor fit is an error (exit 3, nothing written)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   sub->callback([a] { Run(*a); });

@@ -75,6 +75,26 @@ void CheckSample(const SeamSample& p, const std::string& where) {
                      Num(p.factor));
 }
 
+double Quadratic(const std::array<double, 3>& a, double d) { return (a[0] * d + a[1]) * d + a[2]; }
+
+// Where max(1, B_f) rises on [lo, hi]: B_f' = 2 a2 d + a1 is linear, so B_f increases on one
+// interval [from, to] (possibly empty), and the rise is max(1, B_f(to)) - max(1, B_f(from)).
+struct Rise {
+  double amount = 0.0, from = 0.0, to = 0.0;
+};
+Rise RiseOn(const std::array<double, 3>& a, double lo, double hi) {
+  double from = lo, to = hi;
+  if (a[0] > 0.0) {
+    from = std::max(lo, -a[1] / (2.0 * a[0]));
+  } else if (a[0] < 0.0) {
+    to = std::min(hi, -a[1] / (2.0 * a[0]));
+  } else if (!(a[1] > 0.0)) {
+    return {};
+  }
+  if (!(to > from)) return {};
+  return {std::max(1.0, Quadratic(a, to)) - std::max(1.0, Quadratic(a, from)), from, to};
+}
+
 struct GslMatrixDeleter {
   void operator()(gsl_matrix* m) const { gsl_matrix_free(m); }
 };
@@ -180,12 +200,14 @@ bool SeamFitOptions::Check(std::string* why) const {
   std::ostringstream s;
   if (layers < 1 || layers > 20) {
     s << "layers must be in [1, 20], got " << layers;
-  } else if (!(influence_mm >= 1.0 && influence_mm <= 1000.0)) {
+  } else if (!std::isnan(influence_mm) && !(influence_mm >= 1.0 && influence_mm <= 1000.0)) {
     s << "influence_mm must be in [1, 1000] mm, got " << influence_mm;
   } else if (!(poor_probability > 0.0 && poor_probability < 1.0)) {
     s << "poor_probability must be in (0, 1), got " << poor_probability;
   } else if (!(poor_r2 >= 0.0 && poor_r2 <= 1.0)) {
     s << "poor_r2 must be in [0, 1], got " << poor_r2;
+  } else if (!(rise_tolerance >= 0.0 && rise_tolerance < 1e6)) {
+    s << "rise_tolerance must be >= 0, got " << rise_tolerance;
   }
   if (why != nullptr) *why = s.str();
   return s.str().empty();
@@ -300,12 +322,69 @@ SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,
   p.range_mm = fit.range_mm;
   if (!(p.range_mm[1] > p.range_mm[0])) p.range_mm[1] = p.range_mm[0] + 1.0;  // not reached
   if (fit.covariance_known) p.covariance = fit.covariance;
-  p.influence_mm = options.influence_mm;
-  p.fit = fit.Report();
+  // The influence range: where the data are, unless given. Beyond d_max only the value and
+  // slope of B_f at d_max enter (the fade, seam.h), so the default extrapolates nothing.
+  const double hi = fit.range_mm[1];
+  fit.influence_from_data = std::isnan(options.influence_mm);
+  fit.influence_mm = fit.influence_from_data ? std::max(1.0, hi) : options.influence_mm;
+  p.influence_mm = fit.influence_mm;
+  const auto& a = fit.coefficients_mm;
+  if (fit.influence_mm > hi) {
+    const Rise rise = RiseOn(a, hi, fit.influence_mm);
+    if (rise.amount > options.rise_tolerance) {
+      std::string advice = "leave the influence range to the data (" + Num(hi, 4) + " mm)";
+      if (rise.from > hi) advice += " or end it by " + Num(rise.from, 4) + " mm";
+      throw InputError("influence range " + Num(fit.influence_mm) +
+                       " mm reaches beyond the data (d up to " + Num(hi, 4) +
+                       " mm), and there the fitted B_f rises from " +
+                       Num(Quadratic(a, rise.from), 4) + " at " + Num(rise.from, 4) + " mm to " +
+                       Num(Quadratic(a, rise.to), 4) + " at " + Num(rise.to, 4) +
+                       " mm: a seam stiffer away from its line is the polynomial extrapolated, "
+                       "not measured; " +
+                       advice);
+    }
+    if (!fit.influence_from_data)
+      fit.notes.push_back("the influence range " + Num(fit.influence_mm) +
+                          " mm reaches beyond the data (d up to " + Num(hi, 4) +
+                          " mm): S extrapolates the fit there, B_f " + Num(Quadratic(a, hi), 4) +
+                          " -> " + Num(Quadratic(a, fit.influence_mm), 4));
+  }
   if (std::string why; !p.Check(&why))
     throw ComputeError("fitted B_f(d) = " + Num(p.coefficients_mm[0]) + " d² + " +
                        Num(p.coefficients_mm[1]) + " d + " + Num(p.coefficients_mm[2]) +
                        " cannot serve as a seam profile: " + why);
+  if (fit.influence_mm < hi) {
+    // S fades to 1 from d_max on: say how far it then lies from the points it leaves out.
+    int beyond = 0;
+    const SeamSample* worst = nullptr;
+    for (const auto& s : samples) {
+      if (s.d_mm <= fit.influence_mm) continue;
+      ++beyond;
+      if (worst == nullptr || std::abs(s.factor - p.Multiplier(s.d_mm)) >
+                                  std::abs(worst->factor - p.Multiplier(worst->d_mm)))
+        worst = &s;
+    }
+    fit.notes.push_back("the influence range " + Num(fit.influence_mm) +
+                        " mm ends inside the data (d up to " + Num(hi, 4) +
+                        " mm): S fades to 1 by " + Num(fit.influence_mm + p.fade_mm) + " mm; at " +
+                        std::to_string(beyond) +
+                        " point(s) beyond it S departs from the measured factor by up to " +
+                        Num(std::abs(worst->factor - p.Multiplier(worst->d_mm)), 3) +
+                        " (S = " + Num(p.Multiplier(worst->d_mm), 4) + " where the data say " +
+                        Num(worst->factor, 4) + " at " + Num(worst->d_mm, 4) + " mm)");
+  }
+  // The fade starts with B_f's slope at d_max: a fit that still rises there overshoots.
+  double peak = p.Multiplier(fit.influence_mm), peak_at = fit.influence_mm;
+  for (int k = 1; k <= 200; ++k) {
+    const double d = fit.influence_mm + p.fade_mm * k / 200.0;
+    if (p.Multiplier(d) > peak) peak = p.Multiplier(d), peak_at = d;
+  }
+  if (peak > p.Multiplier(fit.influence_mm) + options.rise_tolerance)
+    fit.notes.push_back("B_f still rises at d_max = " + Num(fit.influence_mm, 4) + " mm (slope " +
+                        Num(2.0 * a[0] * fit.influence_mm + a[1], 3) +
+                        " /mm); the fade to 1, which starts with that slope, peaks at S = " +
+                        Num(peak, 4) + " at " + Num(peak_at, 4) + " mm");
+  p.fit = fit.Report();
   return fit;
 }
 
@@ -329,7 +408,10 @@ nlohmann::json SeamFitSummary::Report() const {
           {"coefficients_sd", sd},
           {"covariance_known", covariance_known},
           {"poor", poor},
-          {"poor_reason", poor_reason}};
+          {"poor_reason", poor_reason},
+          {"influence_mm", influence_mm},
+          {"influence_from", influence_from_data ? "data" : "option"},
+          {"notes", notes}};
 }
 
 std::string SeamFitSummary::BriefReport() const {

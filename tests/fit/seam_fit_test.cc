@@ -187,14 +187,18 @@ TEST(SeamFit, RefusesBadInput) {
 }
 
 TEST(SeamFit, AFitThatCannotBeASeamProfileIsAComputeError) {
-  // Factors falling on a line that reaches 0 at 60 mm, before d_max = 100 mm.
+  // Factors falling on a line that reaches 0 at 60 mm, before d_max = 100 mm (given: by
+  // default d_max is the data's 30 mm, and the line is a fine profile there).
+  SeamFitOptions o;
+  o.influence_mm = 100.0;
   try {
-    FitSeamFactor({{0, 3.0}, {10, 2.5}, {20, 2.0}, {30, 1.5}});
+    FitSeamFactor({{0, 3.0}, {10, 2.5}, {20, 2.0}, {30, 1.5}}, o);
     ADD_FAILURE() << "accepted";
   } catch (const ComputeError& e) {
     EXPECT_NE(std::string(e.what()).find("cannot serve as a seam profile"), std::string::npos)
         << e.what();
   }
+  EXPECT_NO_THROW(FitSeamFactor({{0, 3.0}, {10, 2.5}, {20, 2.0}, {30, 1.5}}));
 }
 
 TEST(SeamFitCsv, ParsesWithAndWithoutSd) {
@@ -272,6 +276,76 @@ TEST(SeamFit, WrittenProfileReadsBack) {
   EXPECT_NEAR((*back.covariance - fit.covariance).norm(), 0.0, 1e-12 * fit.covariance.norm());
   EXPECT_EQ(back.fit["dof"].get<int>(), 14);
   EXPECT_DOUBLE_EQ(back.coefficients_mm[1], fit.coefficients_mm[1]);
+}
+
+// tests/bad_inputs/files/seam-ok.csv: d = 0-30 mm, falling from 3 to 1.8. The quadratic
+// through it has its minimum at 42 mm and climbs to 4.17 at 100 mm.
+std::vector<SeamSample> FallingTo30() { return {{0, 3.0}, {10, 2.5}, {20, 2.0}, {30, 1.8}}; }
+
+TEST(SeamFitInfluence, DefaultsToTheDataAndNeverRisesBeyondThem) {
+  const SeamFitSummary fit = FitSeamFactor(FallingTo30());
+  EXPECT_TRUE(fit.influence_from_data);
+  EXPECT_DOUBLE_EQ(fit.profile.influence_mm, 30.0);
+  EXPECT_TRUE(fit.notes.empty()) << fit.notes.front();
+  // Beyond the data S only falls, from B_f(30) to 1 at the end of the fade (0.01 mm sweep).
+  const SeamProfile& p = fit.profile;
+  double previous = p.Multiplier(30.0);
+  EXPECT_DOUBLE_EQ(previous, p.StiffnessFactor(30.0));
+  for (double d = 30.01; d <= 200.0; d += 0.01) {
+    EXPECT_LE(p.Multiplier(d), previous + 1e-12) << d;
+    previous = p.Multiplier(d);
+  }
+  EXPECT_EQ(p.Multiplier(30.0 + p.fade_mm), 1.0);
+  EXPECT_EQ(fit.Report()["influence_from"], "data");
+}
+
+TEST(SeamFitInfluence, AGivenRangeBeyondTheDataWhereTheFitRisesIsRefused) {
+  SeamFitOptions o;
+  o.influence_mm = 100.0;  // the old default: S(75) = 2.47 and S(100) = 4.17 were written
+  try {
+    FitSeamFactor(FallingTo30(), o);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("rises from 1.671 at 42.33 mm to 4.165 at 100 mm"), std::string::npos)
+        << what;
+    EXPECT_NE(what.find("end it by 42.33 mm"), std::string::npos) << what;
+  }
+  // Up to the polynomial's minimum it only falls: an extrapolation, said in a note.
+  o.influence_mm = 40.0;
+  const SeamFitSummary fit = FitSeamFactor(FallingTo30(), o);
+  EXPECT_FALSE(fit.influence_from_data);
+  ASSERT_EQ(fit.notes.size(), 1u);
+  EXPECT_NE(fit.notes[0].find("reaches beyond the data (d up to 30 mm)"), std::string::npos)
+      << fit.notes[0];
+  // A rise within rise_tolerance (round-off of a flat fit) is no reason to refuse.
+  o.influence_mm = 43.0;
+  EXPECT_NO_THROW(FitSeamFactor(FallingTo30(), o));
+}
+
+TEST(SeamFitInfluence, AGivenRangeInsideTheDataSaysWhatItCuts) {
+  SeamFitOptions o;
+  o.influence_mm = 10.0;
+  std::vector<SeamSample> data = FallingTo30();
+  data.push_back({40, 1.6});
+  const SeamFitSummary fit = FitSeamFactor(data, o);
+  EXPECT_EQ(fit.profile.Multiplier(30.0), 1.0);  // the data say 1.8
+  ASSERT_EQ(fit.notes.size(), 1u);
+  EXPECT_NE(fit.notes[0].find("ends inside the data (d up to 40 mm)"), std::string::npos)
+      << fit.notes[0];
+  EXPECT_NE(fit.notes[0].find("3 point(s) beyond it"), std::string::npos) << fit.notes[0];
+  EXPECT_NE(fit.notes[0].find("by up to 0.8 (S = 1 where the data say 1.8 at 30 mm)"),
+            std::string::npos)
+      << fit.notes[0];
+  EXPECT_EQ(fit.Report()["notes"].size(), 1u);
+}
+
+TEST(SeamFitInfluence, AFadeThatOvershootsAFitRisingAtTheEndOfTheDataIsNoted) {
+  // Factors with a minimum inside the data: B_f rises at 60 mm, the fade starts with that
+  // slope and first climbs.
+  const SeamFitSummary fit = FitSeamFactor({{0, 3.0}, {20, 2.0}, {40, 1.8}, {60, 2.2}});
+  ASSERT_EQ(fit.notes.size(), 1u);
+  EXPECT_NE(fit.notes[0].find("still rises at d_max = 60 mm"), std::string::npos) << fit.notes[0];
 }
 
 }  // namespace

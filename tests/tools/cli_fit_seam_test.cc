@@ -104,5 +104,30 @@ TEST(CliFitSeam, JsonOutput) {
   EXPECT_FALSE(j["seam"]["fit"]["poor"].get<bool>());
 }
 
+// seam-ok.csv covers d = 0-30 mm (3 -> 1.8); its quadratic turns up beyond 42 mm.
+TEST(CliFitSeam, InfluenceRangeFollowsTheDataUnlessGiven) {
+  const auto dir = Scratch("CliFitSeam.Influence");
+  const std::string ok = "tests/bad_inputs/files/seam-ok.csv --layers 2";
+  const auto r = Textile("fit-seam " + ok + " -o " + (dir / "s.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");  // nothing extrapolated, nothing to note
+  const auto j = nlohmann::json::parse(ReadAll(dir / "s.json"));
+  EXPECT_EQ(j["influence_mm"].get<double>(), 30.0);
+  EXPECT_EQ(j["fit"]["influence_from"], "data");
+  EXPECT_NE(r.out.find("influence range 30 mm (the data's)"), std::string::npos) << r.out;
+  // The old default of 100 mm wrote S(100) = 4.17: refused, naming where the rise starts.
+  ExpectRefused(Textile("fit-seam " + ok + " --influence-mm 100 -o " + (dir / "x.json").string()),
+                "rises from 1.671 at 42.33 mm to 4.165 at 100 mm", "rising extrapolation");
+  EXPECT_FALSE(fs::exists(dir / "x.json"));
+  // A range inside the data is the user's call, with a note on what it cuts off.
+  Write(dir / "to40.csv", "d_mm,factor\n0,3\n10,2.5\n20,2\n30,1.8\n40,1.6\n");
+  const auto cut = Textile("fit-seam " + (dir / "to40.csv").string() +
+                           " --layers 2 --influence-mm 10 -o " + (dir / "c.json").string());
+  ASSERT_EQ(cut.exit_code, 0) << cut.err;
+  EXPECT_NE(cut.err.find("note: "), std::string::npos) << cut.err;
+  EXPECT_NE(cut.err.find("ends inside the data (d up to 40 mm)"), std::string::npos) << cut.err;
+  EXPECT_EQ(nlohmann::json::parse(ReadAll(dir / "c.json"))["fit"]["notes"].size(), 1u);
+}
+
 }  // namespace
 }  // namespace textile

@@ -20,6 +20,12 @@
 //  - without sd: r² < 0.9 (the quadratic explains less than 90 % of the factor's variance).
 // Without sd the covariance is (XᵀX)⁻¹ scaled by the residual variance χ²/dof (as if every
 // point had the same unknown sd); with exactly three points and no sd it is unknown and left out.
+//
+// The influence range d_max of the written profile is the largest d fitted unless given: S
+// follows B_f where the data are and fades to 1 beyond (seam.h), so the polynomial is never
+// extrapolated. A d_max beyond the data extrapolates B_f and is refused where B_f would rise
+// there (a seam stiffer away from its line); one inside the data cuts them off (a note says
+// by how much).
 
 #include <Eigen/Core>
 #include <array>
@@ -57,10 +63,13 @@ std::vector<SeamSample> ReadSeamSamples(const std::string& path);
 struct SeamFitOptions {
   int layers = 2;             // the seam's fabric layers (Table 1), 1..20
   std::string name;           // free text for the seam file
-  double influence_mm = 100;  // d_max of the written profile (seam.h); B_f must stay in (0, 100]
-                              // on [0, d_max], else the fit cannot serve as a seam profile
+  // d_max of the written profile (seam.h) [mm]; B_f must stay in (0, 100] on [0, d_max], else
+  // the fit cannot serve as a seam profile. NaN: the largest d fitted (at least 1 mm).
+  double influence_mm = std::numeric_limits<double>::quiet_NaN();
   double poor_probability = 1e-3;  // weighted: poor when Q(χ², dof) is below this
   double poor_r2 = 0.9;            // unweighted: poor when r² is below this
+  // An explicit d_max beyond the data is refused when B_f rises there by more than this [-].
+  double rise_tolerance = 0.01;
 
   bool Check(std::string* why) const;
 };
@@ -81,6 +90,11 @@ struct SeamFitSummary {
   double r2 = 0.0;         // 1 - SS_res / SS_tot (unweighted); NaN if the factors are all equal
   bool poor = false;
   std::string poor_reason;  // why, when poor
+  double influence_mm = 0.0;         // d_max written [mm]
+  bool influence_from_data = false;  // d_max is the largest d fitted (not given)
+  // What the user should know about the written S(d) (d_max inside or beyond the data, the
+  // fade overshooting a fit that rises at the end of the data), one sentence each.
+  std::vector<std::string> notes;
 
   SeamProfile profile;  // type "fitted", ready for SeamProfileToJson (fit report included)
 
@@ -90,7 +104,8 @@ struct SeamFitSummary {
 
 // Fits B_f(d) = a2 d² + a1 d + a0. Throws InputError for invalid options, fewer than 3 points,
 // fewer than 3 distinct distances (the quadratic is not determined), non-finite values, d < 0,
-// factor ≤ 0, sd ≤ 0, or sd given on some points only. Throws ComputeError when the fitted
+// factor ≤ 0, sd ≤ 0, sd given on some points only, or an influence range beyond the data
+// where B_f rises by more than rise_tolerance. Throws ComputeError when the fitted
 // polynomial cannot serve as a seam profile (B_f ≤ 0 or > 100 somewhere on [0, d_max]).
 SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,
                              const SeamFitOptions& options = {});

@@ -206,6 +206,8 @@ bool SeamFitOptions::Check(std::string* why) const {
     s << "poor_probability must be in (0, 1), got " << poor_probability;
   } else if (!(poor_r2 >= 0.0 && poor_r2 <= 1.0)) {
     s << "poor_r2 must be in [0, 1], got " << poor_r2;
+  } else if (!(poor_relative_rms >= 0.0 && poor_relative_rms < 1e6)) {
+    s << "poor_relative_rms must be >= 0, got " << poor_relative_rms;
   } else if (!(rise_tolerance >= 0.0 && rise_tolerance < 1e6)) {
     s << "rise_tolerance must be >= 0, got " << rise_tolerance;
   }
@@ -294,6 +296,7 @@ SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,
     fit.max_residual = std::max(fit.max_residual, std::abs(r));
   }
   fit.rms = std::sqrt(ss_res / n);
+  fit.rms_relative = fit.rms / mean;  // mean > 0: every factor is
   // Factors that do not vary leave no variance to explain: the fit is perfect when it
   // reproduces them (r² = 1; it was NaN, printed "nan" and flagged as poor), undefined if not.
   const double round_off = 1e-20 * n * mean * mean;
@@ -307,11 +310,18 @@ SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,
         "residuals too large for the stated sd: chi2/dof = " + Num(chi2 / fit.dof, 4) +
         ", Q(chi2, " + std::to_string(fit.dof) + ") = " + Num(fit.chi2_probability, 3) + " < " +
         Num(options.poor_probability);
-  } else if (!fit.weighted && fit.dof > 0 && !(fit.r2 >= options.poor_r2)) {
+  } else if (!fit.weighted && fit.dof > 0 && !(fit.r2 >= options.poor_r2) &&
+             fit.rms_relative > options.poor_relative_rms) {
+    // r² alone judges a flat profile by its round-off: with no variance to explain, residuals
+    // of 0.001 on factors of 2 gave r² = 0.11. A fit is poor when it misses the trend (low r²)
+    // by residuals that matter against the factors themselves.
     fit.poor = true;
     fit.poor_reason = "the quadratic explains only " +
                       (std::isnan(fit.r2) ? std::string("none") : Num(100.0 * fit.r2, 3) + " %") +
-                      " of the factor's variance (r2 < " + Num(options.poor_r2) + ")";
+                      " of the factor's variance (r2 < " + Num(options.poor_r2) +
+                      ") and its rms residual " + Num(fit.rms, 3) + " is " +
+                      Num(100.0 * fit.rms_relative, 3) + " % of the mean factor " + Num(mean, 4) +
+                      " (> " + Num(100.0 * options.poor_relative_rms) + " %)";
   }
 
   SeamProfile& p = fit.profile;
@@ -402,6 +412,7 @@ nlohmann::json SeamFitSummary::Report() const {
           {"chi2_per_dof", dof > 0 ? nlohmann::json(chi2 / dof) : nlohmann::json()},
           {"chi2_probability", or_null(chi2_probability)},
           {"rms", rms},
+          {"rms_relative", rms_relative},
           {"max_residual", max_residual},
           {"r2", or_null(r2)},
           {"range_mm", range_mm},

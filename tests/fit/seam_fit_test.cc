@@ -348,5 +348,22 @@ TEST(SeamFitInfluence, AFadeThatOvershootsAFitRisingAtTheEndOfTheDataIsNoted) {
   EXPECT_NE(fit.notes[0].find("still rises at d_max = 60 mm"), std::string::npos) << fit.notes[0];
 }
 
+// Factors of 2 ± 0.001 (a flat profile, as the shell ACPM gives an along seam) leave almost no
+// variance to explain: r² is 0.03, yet the fit is as good as the data. It is poor only when the
+// residuals are also large against the factors.
+TEST(SeamFit, AFlatProfileFittedToItsScatterIsNotPoor) {
+  std::vector<SeamSample> flat;
+  for (int i = 0; i <= 12; ++i) flat.push_back({5.0 * i, i % 2 == 0 ? 2.001 : 1.999});
+  const SeamFitSummary fit = FitSeamFactor(flat);
+  EXPECT_LT(fit.r2, 0.9);
+  EXPECT_LT(fit.rms_relative, 1e-3);
+  EXPECT_FALSE(fit.poor) << fit.poor_reason;
+  // The same pattern at ±0.2 (10 % of the factor) is poor.
+  for (auto& p : flat) p.factor = 2.0 + 200.0 * (p.factor - 2.0);
+  const SeamFitSummary noisy = FitSeamFactor(flat);
+  EXPECT_TRUE(noisy.poor);
+  EXPECT_NE(noisy.poor_reason.find("% of the mean factor"), std::string::npos) << noisy.poor_reason;
+}
+
 }  // namespace
 }  // namespace textile

@@ -129,5 +129,16 @@ TEST(CliFitSeam, InfluenceRangeFollowsTheDataUnlessGiven) {
   EXPECT_EQ(nlohmann::json::parse(ReadAll(dir / "c.json"))["fit"]["notes"].size(), 1u);
 }
 
+TEST(CliFitSeam, AFlatExcellentFitPassesStrict) {
+  const auto dir = Scratch("CliFitSeam.Flat");
+  std::string csv = "d_mm,factor\n";
+  for (int i = 0; i <= 12; ++i) csv += std::to_string(5 * i) + (i % 2 ? ",1.999\n" : ",2.001\n");
+  Write(dir / "flat.csv", csv);
+  const auto r = Textile("fit-seam " + (dir / "flat.csv").string() + " --layers 2 --strict -o " +
+                         (dir / "s.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(nlohmann::json::parse(ReadAll(dir / "s.json"))["fit"]["poor"].get<bool>());
+}
+
 }  // namespace
 }  // namespace textile

@@ -17,7 +17,10 @@
 // "Poor" (the fit is still returned; the CLI warns, or refuses with --strict):
 //  - with sd on every point: χ² too large for the stated sd, i.e. the χ² upper-tail
 //    probability Q(χ², dof) < 1e-3 (the quadratic, or the sd, is wrong);
-//  - without sd: r² < 0.9 (the quadratic explains less than 90 % of the factor's variance).
+//  - without sd: r² < 0.9 (the quadratic explains less than 90 % of the factor's variance)
+//    and the rms residual is above 5 % of the mean factor. r² alone misfires on a flat
+//    profile (an along seam on the shell ACPM): there is no variance to explain, and round-off
+//    scatter of 0.001 gave r² = 0.03.
 // Without sd the covariance is (XᵀX)⁻¹ scaled by the residual variance χ²/dof (as if every
 // point had the same unknown sd); with exactly three points and no sd it is unknown and left out.
 //
@@ -67,7 +70,8 @@ struct SeamFitOptions {
   // the fit cannot serve as a seam profile. NaN: the largest d fitted (at least 1 mm).
   double influence_mm = std::numeric_limits<double>::quiet_NaN();
   double poor_probability = 1e-3;  // weighted: poor when Q(χ², dof) is below this
-  double poor_r2 = 0.9;            // unweighted: poor when r² is below this
+  double poor_r2 = 0.9;            // unweighted: poor when r² is below this ...
+  double poor_relative_rms = 0.05;  // ... and the rms residual above this times the mean factor
   // An explicit d_max beyond the data is refused when B_f rises there by more than this [-].
   double rise_tolerance = 0.01;
 
@@ -86,6 +90,7 @@ struct SeamFitSummary {
   double chi2 = 0.0;       // Σ w r² (w = 1/sd², or 1 unweighted)
   double chi2_probability = std::numeric_limits<double>::quiet_NaN();  // Q(χ², dof), weighted
   double rms = 0.0;        // unweighted RMS residual of the factor [-]
+  double rms_relative = 0.0;  // rms / mean factor [-]
   double max_residual = 0.0;  // largest |residual| [-]
   double r2 = 0.0;         // 1 - SS_res / SS_tot (unweighted); NaN if the factors are all equal
   bool poor = false;

@@ -236,6 +236,18 @@ SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,
     throw InputError(std::to_string(distinct.size()) +
                      " distinct distance(s) d: a quadratic needs at least 3 (a seam across the "
                      "push direction gives every ray the same d)");
+  // A seam stiffens the fabric. With every factor below 1 the written S = max(1, B_f) would
+  // be 1 everywhere: the measurement discarded without a word. Most likely the ratio is
+  // inverted (plain / seamed).
+  const auto [lowest, highest] = std::minmax_element(
+      samples.begin(), samples.end(),
+      [](const SeamSample& l, const SeamSample& r) { return l.factor < r.factor; });
+  if (highest->factor < 1.0)
+    throw InputError("every factor is below 1 (" + Num(lowest->factor, 4) + " to " +
+                     Num(highest->factor, 4) +
+                     "): a seam would make the fabric softer, and S = max(1, B_f) would be 1 "
+                     "everywhere; is the ratio inverted (plain / seamed)? Its inverse is " +
+                     Num(1.0 / highest->factor, 4) + " to " + Num(1.0 / lowest->factor, 4));
 
   SeamFitSummary fit;
   fit.num_points = n;

@@ -365,5 +365,19 @@ TEST(SeamFit, AFlatProfileFittedToItsScatterIsNotPoor) {
   EXPECT_NE(noisy.poor_reason.find("% of the mean factor"), std::string::npos) << noisy.poor_reason;
 }
 
+TEST(SeamFit, RefusesFactorsThatAreAllBelowOne) {
+  // 0.5-0.8: S = max(1, B_f) would be 1 everywhere; the inverse ratio is what was meant.
+  try {
+    FitSeamFactor({{0, 0.5}, {10, 0.6}, {20, 0.7}, {40, 0.8}});
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("every factor is below 1 (0.5 to 0.8)"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("inverse is 1.25 to 2"), std::string::npos) << e.what();
+  }
+  // Factors that reach 1 (a seam with no effect far out, with scatter) are fine.
+  EXPECT_NO_THROW(FitSeamFactor({{0, 1.5}, {10, 1.2}, {20, 0.98}, {40, 1.01}}));
+}
+
 }  // namespace
 }  // namespace textile

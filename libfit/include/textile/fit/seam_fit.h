@@ -109,7 +109,8 @@ struct SeamFitSummary {
 
 // Fits B_f(d) = a2 d² + a1 d + a0. Throws InputError for invalid options, fewer than 3 points,
 // fewer than 3 distinct distances (the quadratic is not determined), non-finite values, d < 0,
-// factor ≤ 0, sd ≤ 0, sd given on some points only, or an influence range beyond the data
+// factor ≤ 0, sd ≤ 0, sd given on some points only, every factor below 1 (S = max(1, B_f)
+// would be 1 everywhere: likely an inverted ratio), or an influence range beyond the data
 // where B_f rises by more than rise_tolerance. Throws ComputeError when the fitted
 // polynomial cannot serve as a seam profile (B_f ≤ 0 or > 100 somewhere on [0, d_max]).
 SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,

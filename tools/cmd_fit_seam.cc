@@ -4,19 +4,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <optional>
-#include <sstream>
 #include <vector>
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
 #include "textile/fit/seam_fit.h"
 #include "textile/sim/error.h"
-#include "textile/sim/json_text.h"
 
 namespace textile::cli {
 namespace {
@@ -28,41 +24,26 @@ struct FitSeamArgs {
   bool strict = false, json = false;
 };
 
-// The seam layers an ACPM result records ({"seam": {"layers": N}}), or 0.
-int LayersFromAcpmResult(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::stringstream buffer;
-  buffer << f.rdbuf();
-  const std::string text = buffer.str();
-  const auto first = text.find_first_not_of(" \t\r\n");
-  if (first == std::string::npos || text[first] != '{') return 0;
-  const nlohmann::json j = ParseJsonText(text, path);
-  if (j.contains("seam") && j["seam"].is_object() && j["seam"].contains("profile") &&
-      j["seam"]["profile"].is_object() && j["seam"]["profile"].contains("layers") &&
-      j["seam"]["profile"]["layers"].is_number_integer()) {
-    // Read wide and checked here: get<int>() would wrap a huge count into the valid range.
-    const std::int64_t layers = j["seam"]["profile"]["layers"].get<std::int64_t>();
-    if (layers < 1 || layers > 20)
-      throw InputError(path + ": seam.profile.layers must be in [1, 20], got " + std::to_string(layers));
-    return static_cast<int>(layers);
-  }
-  return 0;
-}
-
 void Run(const FitSeamArgs& a) {
   CheckDistinctOutputs({{"-o", a.out}}, {{"(the input)", a.input}});
-  const std::vector<SeamSample> samples = ReadSeamSamples(a.input);
+  const SeamMeasurement m = ReadSeamMeasurement(a.input);
   SeamFitOptions o;
   o.name = a.name;
   if (a.influence_mm) o.influence_mm = *a.influence_mm;
-  o.layers = a.layers ? *a.layers : LayersFromAcpmResult(a.input);
+  // The ACPM result's factors were simulated with its seam's layers (the band's extra plies
+  // load the strip): a seam file with other layers would not describe what was measured.
+  if (a.layers && m.layers != 0 && *a.layers != m.layers)
+    throw InputError("--layers " + std::to_string(*a.layers) + ": " + a.input +
+                     " records seam.profile.layers " + std::to_string(m.layers) +
+                     " (its factors were simulated with that seam); leave --layers out");
+  o.layers = a.layers ? *a.layers : m.layers;
   if (!a.layers && o.layers == 0)
     throw InputError("--layers: required for " + a.input +
                      " (the seam's fabric layers, Table 1: A 2, B 3, C 4)");
   if (std::string why; !o.Check(&why)) throw InputError("--layers/--influence-mm: " + why);
   SeamFitSummary fit;
   try {
-    fit = FitSeamFactor(samples, o);
+    fit = FitSeamFactor(m.samples, o);
   } catch (const InputError& e) {
     throw InputError(a.input + ": " + e.what());
   }

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <memory>
 #include <set>
@@ -184,7 +185,31 @@ std::vector<SeamSample> SeamSamplesFromAcpmJson(const nlohmann::json& result,
   return samples;
 }
 
-std::vector<SeamSample> ReadSeamSamples(const std::string& path) {
+int SeamLayersFromAcpmJson(const nlohmann::json& result, const std::string& source) {
+  if (!result.is_object() || !result.contains("seam") || !result["seam"].is_object()) return 0;
+  const nlohmann::json& seam = result["seam"];
+  if (!seam.contains("profile") || !seam["profile"].is_object()) return 0;
+  const nlohmann::json& profile = seam["profile"];
+  if (!profile.contains("layers")) return 0;
+  const nlohmann::json& layers = profile["layers"];
+  const std::string where = source + ": seam.profile.layers";
+  // Read wide and checked here: get<int>() would wrap a huge count into the valid range.
+  if (layers.is_number_unsigned() || layers.is_number_integer()) {
+    const bool in_range =
+        layers.is_number_unsigned()
+            ? layers.get<std::uint64_t>() >= 1 && layers.get<std::uint64_t>() <= 20
+            : layers.get<std::int64_t>() >= 1 && layers.get<std::int64_t>() <= 20;
+    if (!in_range) throw InputError(where + " must be in [1, 20], got " + layers.dump());
+    return static_cast<int>(layers.get<std::int64_t>());
+  }
+  // 2.0 is a whole number; 3.5, "4" and null are not a count of plies.
+  if (layers.is_number_float() && layers.get<double>() == std::floor(layers.get<double>()) &&
+      layers.get<double>() >= 1.0 && layers.get<double>() <= 20.0)
+    return static_cast<int>(layers.get<double>());
+  throw InputError(where + " must be a whole number in [1, 20], got " + layers.dump());
+}
+
+SeamMeasurement ReadSeamMeasurement(const std::string& path) {
   std::ifstream f = OpenInputFile(path, "seam measurement file");
   std::stringstream buffer;
   buffer << f.rdbuf();
@@ -192,8 +217,19 @@ std::vector<SeamSample> ReadSeamSamples(const std::string& path) {
   const std::string text = buffer.str();
   const auto first = text.find_first_not_of(" \t\r\n");
   if (first == std::string::npos) throw InputError(path + ": empty file");
-  if (text[first] == '{') return SeamSamplesFromAcpmJson(ParseJsonText(text, path), path);
-  return ParseSeamSamplesCsv(text, path);
+  SeamMeasurement m;
+  if (text[first] == '{') {
+    const nlohmann::json result = ParseJsonText(text, path);
+    m.samples = SeamSamplesFromAcpmJson(result, path);
+    m.layers = SeamLayersFromAcpmJson(result, path);
+  } else {
+    m.samples = ParseSeamSamplesCsv(text, path);
+  }
+  return m;
+}
+
+std::vector<SeamSample> ReadSeamSamples(const std::string& path) {
+  return ReadSeamMeasurement(path).samples;
 }
 
 bool SeamFitOptions::Check(std::string* why) const {

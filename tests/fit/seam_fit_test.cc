@@ -379,5 +379,31 @@ TEST(SeamFit, RefusesFactorsThatAreAllBelowOne) {
   EXPECT_NO_THROW(FitSeamFactor({{0, 1.5}, {10, 1.2}, {20, 0.98}, {40, 1.01}}));
 }
 
+TEST(SeamFitAcpm, LayersOfTheResultsSeam) {
+  nlohmann::json r = {{"model", "shell"}, {"rays", nlohmann::json::array()}};
+  EXPECT_EQ(SeamLayersFromAcpmJson(r, "r.json"), 0);  // no seam recorded
+  r["seam"] = {{"direction", "none"}};
+  EXPECT_EQ(SeamLayersFromAcpmJson(r, "r.json"), 0);
+  r["seam"] = {{"direction", "along"}, {"profile", {{"layers", 4}}}};
+  EXPECT_EQ(SeamLayersFromAcpmJson(r, "r.json"), 4);
+  r["seam"]["profile"]["layers"] = 3.0;
+  EXPECT_EQ(SeamLayersFromAcpmJson(r, "r.json"), 3);
+  for (const nlohmann::json& bad : {nlohmann::json(3.5), nlohmann::json("4"), nlohmann::json()}) {
+    r["seam"]["profile"]["layers"] = bad;
+    try {
+      SeamLayersFromAcpmJson(r, "r.json");
+      ADD_FAILURE() << "accepted " << bad.dump();
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("r.json: seam.profile.layers must be a whole number"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  r["seam"]["profile"]["layers"] = 4294967298ull;  // would wrap to 2 as an int
+  EXPECT_THROW(SeamLayersFromAcpmJson(r, "r.json"), InputError);
+  r["seam"]["profile"]["layers"] = -2;
+  EXPECT_THROW(SeamLayersFromAcpmJson(r, "r.json"), InputError);
+}
+
 }  // namespace
 }  // namespace textile

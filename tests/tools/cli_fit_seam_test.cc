@@ -140,5 +140,24 @@ TEST(CliFitSeam, AFlatExcellentFitPassesStrict) {
   EXPECT_FALSE(nlohmann::json::parse(ReadAll(dir / "s.json"))["fit"]["poor"].get<bool>());
 }
 
+TEST(CliFitSeam, LayersMustAgreeWithTheAcpmResult) {
+  const auto dir = Scratch("CliFitSeam.Layers");
+  const std::string rays =
+      R"("rays": [{"d_mm": 0, "factor": 4}, {"d_mm": 20, "factor": 3}, {"d_mm": 40, "factor": 2.5}])";
+  Write(dir / "two.json",
+        R"({"seam": {"direction": "along", "profile": {"layers": 2}}, )" + rays + "}");
+  Write(dir / "frac.json",
+        R"({"seam": {"direction": "along", "profile": {"layers": 3.5}}, )" + rays + "}");
+  const std::string out = " -o " + (dir / "s.json").string();
+  ExpectRefused(Textile("fit-seam " + (dir / "two.json").string() + " --layers 4" + out),
+                "--layers 4: " + (dir / "two.json").string() + " records seam.profile.layers 2",
+                "contradicting --layers");
+  ExpectRefused(Textile("fit-seam " + (dir / "frac.json").string() + out),
+                "seam.profile.layers must be a whole number in [1, 20], got 3.5", "layers 3.5");
+  EXPECT_FALSE(fs::exists(dir / "s.json"));
+  // Saying the same as the result is fine.
+  EXPECT_EQ(Textile("fit-seam " + (dir / "two.json").string() + " --layers 2" + out).exit_code, 0);
+}
+
 }  // namespace
 }  // namespace textile

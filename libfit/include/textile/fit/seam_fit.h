@@ -59,9 +59,21 @@ std::vector<SeamSample> ParseSeamSamplesCsv(const std::string& text, const std::
 std::vector<SeamSample> SeamSamplesFromAcpmJson(const nlohmann::json& result,
                                                 const std::string& source);
 
+// The seam layers an ACPM result records (`seam.profile.layers`), or 0 when it records none
+// (no seam object or profile). Throws InputError "<source>: seam.profile.layers ..." for a
+// value that is not a whole number in [1, 20].
+int SeamLayersFromAcpmJson(const nlohmann::json& result, const std::string& source);
+
+// What a measurement file holds: the samples and, for an ACPM result, its seam's layers.
+struct SeamMeasurement {
+  std::vector<SeamSample> samples;
+  int layers = 0;  // seam.profile.layers of an ACPM result; 0: not recorded (or a CSV)
+};
+
 // Reads a file: JSON (an ACPM result) if its first non-blank character is '{', else CSV.
 // Throws InputError naming the file for unreadable files and every problem above.
-std::vector<SeamSample> ReadSeamSamples(const std::string& path);
+SeamMeasurement ReadSeamMeasurement(const std::string& path);
+std::vector<SeamSample> ReadSeamSamples(const std::string& path);  // its samples
 
 struct SeamFitOptions {
   int layers = 2;             // the seam's fabric layers (Table 1), 1..20

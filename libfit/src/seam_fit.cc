@@ -76,6 +76,12 @@ void CheckSample(const SeamSample& p, const std::string& where) {
                      Num(p.factor));
 }
 
+// Excel's "CSV UTF-8" (and some editors) start the file with a UTF-8 byte-order mark.
+constexpr char kUtf8Bom[] = "\xEF\xBB\xBF";
+std::string WithoutBom(const std::string& text) {
+  return text.rfind(kUtf8Bom, 0) == 0 ? text.substr(3) : text;
+}
+
 double Quadratic(const std::array<double, 3>& a, double d) { return (a[0] * d + a[1]) * d + a[2]; }
 
 // Where max(1, B_f) rises on [lo, hi]: B_f' = 2 a2 d + a1 is linear, so B_f increases on one
@@ -110,7 +116,7 @@ struct GslWorkspaceDeleter {
 
 std::vector<SeamSample> ParseSeamSamplesCsv(const std::string& text, const std::string& source) {
   std::vector<SeamSample> samples;
-  std::istringstream in(text);
+  std::istringstream in(WithoutBom(text));
   std::string line;
   int line_no = 0, columns = 0;
   while (std::getline(in, line)) {
@@ -214,7 +220,7 @@ SeamMeasurement ReadSeamMeasurement(const std::string& path) {
   std::stringstream buffer;
   buffer << f.rdbuf();
   if (f.bad()) throw InputError(path + ": cannot read");
-  const std::string text = buffer.str();
+  const std::string text = WithoutBom(buffer.str());
   const auto first = text.find_first_not_of(" \t\r\n");
   if (first == std::string::npos) throw InputError(path + ": empty file");
   SeamMeasurement m;

@@ -365,6 +365,15 @@ TEST(SeamFit, AFlatProfileFittedToItsScatterIsNotPoor) {
   EXPECT_NE(noisy.poor_reason.find("% of the mean factor"), std::string::npos) << noisy.poor_reason;
 }
 
+TEST(SeamFitCsv, SkipsAUtf8ByteOrderMark) {
+  const std::string bom = "\xEF\xBB\xBF";
+  const auto s = ParseSeamSamplesCsv(bom + "d_mm,factor\n0,3\n10,2.5\n", "excel.csv");
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_DOUBLE_EQ(s[1].factor, 2.5);
+  // Only at the start: a mark elsewhere is not a number.
+  EXPECT_THROW(ParseSeamSamplesCsv("d_mm,factor\n" + bom + "0,3\n", "x.csv"), InputError);
+}
+
 TEST(SeamFit, RefusesFactorsThatAreAllBelowOne) {
   // 0.5-0.8: S = max(1, B_f) would be 1 everywhere; the inverse ratio is what was meant.
   try {

@@ -140,6 +140,23 @@ TEST(CliFitSeam, AFlatExcellentFitPassesStrict) {
   EXPECT_FALSE(nlohmann::json::parse(ReadAll(dir / "s.json"))["fit"]["poor"].get<bool>());
 }
 
+TEST(CliFitSeam, AcceptsAUtf8ByteOrderMark) {
+  const auto dir = Scratch("CliFitSeam.Bom");
+  const std::string bom = "\xEF\xBB\xBF";  // Excel's "CSV UTF-8" starts with it
+  Write(dir / "excel.csv", bom + "d_mm,factor\r\n0,3\r\n10,2.5\r\n20,2\r\n30,1.8\r\n");
+  const auto csv = Textile("fit-seam " + (dir / "excel.csv").string() + " --layers 2 -o " +
+                           (dir / "a.json").string());
+  EXPECT_EQ(csv.exit_code, 0) << csv.err;
+  const std::string acpm_json =
+      R"({"model": "shell", "seam": {"direction": "along", "profile": {"layers": 3}}, "rays": )"
+      R"([{"d_mm": 0, "factor": 4}, {"d_mm": 20, "factor": 3}, {"d_mm": 40, "factor": 2.5}]})";
+  Write(dir / "acpm.json", bom + acpm_json);
+  const auto acpm =
+      Textile("fit-seam " + (dir / "acpm.json").string() + " -o " + (dir / "b.json").string());
+  ASSERT_EQ(acpm.exit_code, 0) << acpm.err;
+  EXPECT_EQ(nlohmann::json::parse(ReadAll(dir / "b.json"))["layers"], 3);
+}
+
 TEST(CliFitSeam, LayersMustAgreeWithTheAcpmResult) {
   const auto dir = Scratch("CliFitSeam.Layers");
   const std::string rays =

@@ -70,8 +70,9 @@ struct SeamMeasurement {
   int layers = 0;  // seam.profile.layers of an ACPM result; 0: not recorded (or a CSV)
 };
 
-// Reads a file: JSON (an ACPM result) if its first non-blank character is '{', else CSV.
-// Throws InputError naming the file for unreadable files and every problem above.
+// Reads a file: JSON (an ACPM result) if its first non-blank character is '{', else CSV. A
+// leading UTF-8 byte-order mark (Excel's "CSV UTF-8") is skipped. Throws InputError naming the
+// file for unreadable files and every problem above.
 SeamMeasurement ReadSeamMeasurement(const std::string& path);
 std::vector<SeamSample> ReadSeamSamples(const std::string& path);  // its samples
 

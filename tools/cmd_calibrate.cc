@@ -107,7 +107,11 @@ void Run(const CalibrateArgs& a) {
     }
     nlohmann::json lens_models = nlohmann::json::array();
     for (const auto& m : c.lens_candidates) {
-      lens_models.push_back({{"terms", m.terms}, {"rms_px", m.rms_px}, {"p_value", m.p_value}});
+      lens_models.push_back({{"terms", m.terms},
+                             {"rms_px", m.rms_px},
+                             {"p_next", m.p_next},
+                             {"p_value", m.p_value},
+                             {"significance", m.significance}});
     }
     PrintJson(
         {{"rig_file", a.out},

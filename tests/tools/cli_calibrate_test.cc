@@ -77,6 +77,12 @@ TEST(CliCalibrate, SeveralBoardsReportTheLensTermsKept) {
   ASSERT_FALSE(j.at("lens_models").empty());
   EXPECT_TRUE(j.at("lens_rms_px").is_number());
   EXPECT_EQ(j.at("lens_models").back().at("terms"), j.at("lens_terms"));
+  // Each model tried with the p-values of the next model's and the full model's gain on it.
+  for (const auto& m : j.at("lens_models")) {
+    EXPECT_TRUE(m.at("p_next").is_number()) << m;
+    EXPECT_TRUE(m.at("p_value").is_number()) << m;
+    EXPECT_TRUE(m.at("significance").is_number()) << m;
+  }
   EXPECT_EQ(j.at("lens_model").get<bool>(), j.at("lens_terms") != "none");
 }
 

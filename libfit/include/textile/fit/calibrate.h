@@ -62,16 +62,21 @@ struct CalibrationSummary {
   double max_error_mm = 0.0;
   double lens_rms_px = 0.0;       // cv::calibrateCamera's RMS over all boards, if fitted [px]
   // The lens fit (several boards): nested models none, k1, (k1, k2), (k1, k2, p1, p2) and
-  // (k1, k2, p1, p2, k3) are fitted; the simplest whose RMS the full model does not lower
-  // significantly (F-test at 1 %) and by 5 % is kept. lens_rms_px is the kept model's.
+  // (k1, k2, p1, p2, k3) are fitted and, from none, the next is taken while it or the full
+  // model lowers the squared error significantly (F-test: at 1 % for k1, 0.1 % for the
+  // terms after it). lens_rms_px is the kept model's.
   std::string lens_terms;         // the kept model's terms ("none": no lens in the rig); empty
                                   // when no lens was fitted
+  double lens_next_rms_px = 0.0;  // RMS over all boards of the next model, with one more term
+                                  // (group) than the kept one [px]; the kept one's if full
   double lens_full_rms_px = 0.0;  // RMS over all boards of the full model [px]
   std::vector<double> distortion_sigma;  // 1-σ of k1, k2, p1, p2, k3 (0 for terms not kept)
   struct LensCandidate {
     std::string terms;
-    double rms_px = 0.0;   // over all boards [px]
-    double p_value = 1.0;  // of the full model's improvement on it (F-test)
+    double rms_px = 0.0;        // over all boards [px]
+    double p_next = 1.0;        // of the next model's improvement on it (F-test); 1 for the full
+    double p_value = 1.0;       // of the full model's improvement on it (F-test); 1 for the full
+    double significance = 0.0;  // the level either must be below to go on (0.01 or 0.001)
   };
   std::vector<LensCandidate> lens_candidates;  // tried, simplest first, up to the kept one
   double mm_per_px = 0.0;         // local scale at the board's centre [mm/px]

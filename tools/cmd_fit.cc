@@ -1,13 +1,11 @@
 // textile fit: cantilever profiles -> the bending law {b1, b2, c1}, by the direct elastica fit
 // (default) or by Clapp et al.'s method; writes a material file with a `fit` report.
 
-#include <array>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <optional>
 #include <sstream>
-#include <tuple>
 
 #include "common/atomic_file.h"
 #include "common/chart.h"
@@ -61,98 +59,15 @@ struct Outcome {
   std::string notes;  // what the user should know about a fit that succeeded ("; "-joined)
 };
 
-// The fitted offset below which a note says the profiles' origin is off [m]: noise and the
-// trace line (upper or lower edge) move it by tenths of a millimetre.
-constexpr double kOffsetNoteM = 0.0005;
-
-// Smallest tilt the fit adopts [rad]. Below it the rotation fitted to photos is the extraction's
-// correlated residuals, not a tilt (the shipped photos: −0.04°, which would move c1 by 30 %).
-constexpr double kMinTiltRad = 0.1 * M_PI / 180.0;
-
-// Whether a fit with a rig rotation explains the data so much better than the fit without one
-// that the tilt is real: a likelihood-ratio test on the objective both minimise (the robust
-// loss, so that stray points neither hide a tilt nor fake one), 2 (F₀ − F₁) / σ̂₁² above 9
-// (three standard deviations of noise's χ²₁), σ̂₁² = 2 F₁ / (residuals − free parameters), and a
-// tilt of at least kMinTiltRad. A fit without rotation that failed (a tilt of a degree can drive
-// b1 into its bound) counts as infinitely worse.
-bool TiltIsSignificant(const DirectFitSummary& level, const DirectFitSummary& tilted) {
-  if (!tilted.converged || std::abs(tilted.rotation) < kMinTiltRad) return false;
-  if (!level.converged) return true;
-  const double dof = std::max(1, tilted.num_residuals - tilted.num_free_parameters);
-  const double sigma2 = 2.0 * tilted.cost / dof;
-  return 2.0 * (level.cost - tilted.cost) > 9.0 * sigma2;
-}
-
-// The largest change of b1 or b2 between the level fit and the fit with a rotation, in the
-// latter's standard deviations (0 where an sd is not available), and which constant it is.
-std::pair<double, std::string> LawShiftInSds(const DirectFitSummary& level,
-                                             const DirectFitSummary& tilted) {
-  std::pair<double, std::string> worst{0.0, ""};
-  const std::array<std::tuple<double, double, double, const char*>, 2> pairs = {
-      std::tuple{level.law->b1(), tilted.law->b1(), tilted.b1_sd, "b1"},
-      std::tuple{level.law->b2(), tilted.law->b2(), tilted.b2_sd, "b2"}};
-  for (const auto& [a, b, sd, name] : pairs) {
-    if (!(sd > 0.0) || !std::isfinite(sd)) continue;
-    const double z = std::abs(a - b) / sd;
-    if (z > worst.first) worst = {z, name};
-  }
-  return worst;
-}
-
 Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double rho) {
   DirectFitOptions o;
   o.fit_offset = !a.thickness_given && !a.no_offset;
   o.offset = a.thickness_given ? units::MmToM(a.thickness_mm) / 2.0 : 0.0;
   o.fit_rotation = a.fit_rotation;
   o.robust_scale = units::MmToM(a.robust_mm);
-  DirectFitSummary fit = FitDirect(profiles, rho, o);
   std::vector<std::string> notes;
-  if (!o.fit_rotation) {
-    // A rig that is not level (or a camera rolled against it) tilts every profile alike; half a
-    // degree already sent b1 2.5× off and one degree c1 to -800 gf·cm², with rms hardly worse.
-    // The fit with a rotation is tried too and kept when the data ask for it.
-    DirectFitOptions turned = o;
-    turned.fit_rotation = true;
-    DirectFitSummary tilted;
-    try {
-      tilted = FitDirect(profiles, rho, turned);
-    } catch (const InputError&) {
-      // Only the fit without rotation speaks for the input (profiles of different strips).
-    }
-    if (TiltIsSignificant(fit, tilted)) {
-      notes.push_back("the profiles are tilted by " + Num(tilted.rotation * 180.0 / M_PI, 2) +
-                      "° (a rig not level or a camera rolled against it): fitted with that "
-                      "rotation, rms " +
-                      Num(tilted.rms * 1e3, 3) + " mm instead of " +
-                      (fit.converged ? Num(fit.rms * 1e3, 3) + " mm" : "no fit") + " without it");
-      fit = tilted;
-      o = turned;
-    } else if (fit.converged && tilted.converged && std::abs(tilted.rotation) >= kMinTiltRad) {
-      // A tilt the data do not show clearly can still move the law by more than its sds (a
-      // 0.2-0.3° tilt: b1 8-80 % high): say what it would change.
-      const auto [z, name] = LawShiftInSds(fit, tilted);
-      if (z > 2.0) {
-        const double level_b = name == "b1" ? fit.law->b1() : fit.law->b2();
-        const double tilted_b = name == "b1" ? tilted.law->b1() : tilted.law->b2();
-        notes.push_back("a tilt of " + Num(tilted.rotation * 180.0 / M_PI, 2) +
-                        "°, which the data do not show clearly, would change " + name + " by " +
-                        Num(100.0 * (tilted_b - level_b) / level_b, 2) + " % (" + Num(z, 2) +
-                        " sd): if the rig is not known to be level within 0.1°, "
-                        "fit with --fit-rotation");
-      }
-    }
-  }
+  const DirectFitSummary fit = FitDirectCheckingTilt(profiles, rho, o, &notes, &o);
   if (!fit.converged) throw ComputeError("fit: " + fit.message);
-  // The mid-line's height at the edge is half the strip's thickness (at most 3 mm: profiles
-  // rising higher are refused); a fitted offset outside that means the profiles' origin is not
-  // the platform's edge. A shift in y alone is what the offset absorbs (the law unchanged); one
-  // in x changes the law (2 mm: b2 2.3× low), which no offset can tell apart.
-  if (o.fit_offset && (fit.offset < -kOffsetNoteM || fit.offset > 0.003)) {
-    notes.push_back("the fitted offset at the edge, " + Num(fit.offset * 1e3, 3) +
-                    " mm, is not half a strip's thickness (0 to 3 mm): the profiles' y = 0 is "
-                    "not the platform's top, or x = 0 is not its edge (a shift in y alone leaves "
-                    "the law as it is, one in x does not): check the platform edge");
-  }
   Outcome out;
   for (const std::string& n : notes) out.notes += (out.notes.empty() ? "" : "; ") + n;
   out.law = *fit.law;

@@ -293,9 +293,14 @@ void Run(const ValidateArgs& a) {
 
   std::vector<Profile> profiles;
   for (const auto& in : loaded) profiles.push_back(in.profile);
-  const DirectFitOptions fit_options;
-  const DirectFitSummary fit = FitDirect(profiles, rho, fit_options);
+  // The fit textile fit runs: a tilted rig is found and fitted with its rotation (and the
+  // simulated curves below are turned with it).
+  DirectFitOptions fit_options;
+  std::vector<std::string> fit_notes;
+  const DirectFitSummary fit =
+      FitDirectCheckingTilt(profiles, rho, DirectFitOptions{}, &fit_notes, &fit_options);
   if (!fit.converged || !fit.law) throw ComputeError("fit: " + fit.message);
+  for (const std::string& n : fit_notes) note += (note.empty() ? "" : "; ") + n;
   const BendingLaw& law = *fit.law;
   // Only a law a material file accepts is worth simulating (as textile fit checks): a fit to a
   // straight or vertical strip can run to constants no fabric has.
@@ -326,14 +331,22 @@ void Run(const ValidateArgs& a) {
     k.overhang = fit.profiles[i].overhang;
     if (run_elastica) {
       k.elastica.run = true;
-      k.elastica.c = CompareWithElastica(law, rho, profiles[i], k.overhang, fit.offset);
+      k.elastica.c =
+          CompareWithElastica(law, rho, profiles[i], k.overhang, fit.offset, fit.rotation);
       Grade(tol, a.tolerance_mm, &k.elastica);
     }
     if (run_shell) {
       const ShellCantilever sc = SolveShellCantilever(fitted, k.overhang, units::MmToM(a.width_mm));
       if (!sc.converged) throw ComputeError(k.source + ": " + sc.message);
       k.shell.run = true;
-      k.shell.c = CompareWithCurve(profiles[i], sc.x, sc.y, fit.offset);
+      // The shell's curve turned by the fitted rig rotation about the edge (0 for a level rig).
+      std::vector<double> sx(sc.x.size()), sy(sc.y.size());
+      const double cr = std::cos(fit.rotation), sr = std::sin(fit.rotation);
+      for (size_t j = 0; j < sc.x.size(); ++j) {
+        sx[j] = cr * sc.x[j] - sr * sc.y[j];
+        sy[j] = sr * sc.x[j] + cr * sc.y[j];
+      }
+      k.shell.c = CompareWithCurve(profiles[i], sx, sy, fit.offset);
       k.shell.solves = sc.solves;
       k.shell.notes = sc.notes;
       shell_notes = sc.notes;
@@ -341,10 +354,9 @@ void Run(const ValidateArgs& a) {
       Grade(tol, a.tolerance_mm, &k.shell);
       if (run_elastica) {
         // How far the shell's curve lies from the elastica's (both lifted by the offset).
-        std::vector<double> lifted = sc.y;
+        std::vector<double> lifted = sy;
         for (double& y : lifted) y += fit.offset;
-        k.model_gap =
-            MaxDistanceToPolyline(k.elastica.c.model_x, k.elastica.c.model_y, sc.x, lifted);
+        k.model_gap = MaxDistanceToPolyline(k.elastica.c.model_x, k.elastica.c.model_y, sx, lifted);
       }
     }
     std::vector<std::string> why;
@@ -400,6 +412,9 @@ void Run(const ValidateArgs& a) {
       {"material", material_path}};
   if (all_pass || !a.strict) {
     fitted.fit = FitReport(fit, fit_options, loaded, a.gsm);
+    std::string fit_note;  // as textile fit's report has it: the fit's own notes only
+    for (const std::string& n : fit_notes) fit_note += (fit_note.empty() ? "" : "; ") + n;
+    fitted.fit["note"] = fit_note.empty() ? nlohmann::json() : nlohmann::json(fit_note);
     fitted.fit["validate"] = report_path;
     fitted.fit["verdict"] = all_pass ? "pass" : "fail";
     material_file.Write(MaterialToJson(fitted).dump(2) + "\n");

@@ -4,11 +4,15 @@
 
 #include <Eigen/SVD>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <memory>
+#include <numbers>
 #include <sstream>
+#include <tuple>
 
 #include "cost_functions/profile_model.h"
 #include "law_parameters.h"
@@ -467,6 +471,117 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
   out.converged = true;
   out.message = "converged (" + solver_summary.message + ")";
   return finish();
+}
+
+}  // namespace textile
+
+namespace textile {
+namespace {
+
+// The fitted offset below which a note says the profiles' origin is off [m]: noise and the
+// trace line (upper or lower edge) move it by tenths of a millimetre.
+constexpr double kOffsetNoteM = 0.0005;
+// Above it the offset is more than half the thickest strip a profile may show [m].
+constexpr double kOffsetMaxM = 0.003;
+
+// Smallest tilt the fit adopts [rad]. Below it the rotation fitted to photos is the extraction's
+// correlated residuals, not a tilt (the shipped photos: −0.04°, which would move c1 by 30 %).
+constexpr double kMinTiltRad = 0.1 * std::numbers::pi / 180.0;
+// The longest profile at least this many times the shortest for the tilt to be looked for.
+constexpr double kMinLengthRatioForTilt = 1.2;
+
+// Whether a fit with a rig rotation explains the data so much better than the fit without one
+// that the tilt is real: a likelihood-ratio test on the objective both minimise (the robust
+// loss, so that stray points neither hide a tilt nor fake one), 2 (F₀ − F₁) / σ̂₁² above 9
+// (three standard deviations of noise's χ²₁), σ̂₁² = 2 F₁ / (residuals − free parameters), and a
+// tilt of at least kMinTiltRad. A fit without rotation that failed (a tilt of a degree can drive
+// b1 into its bound) counts as infinitely worse.
+bool TiltIsSignificant(const DirectFitSummary& level, const DirectFitSummary& tilted) {
+  if (!tilted.converged || std::abs(tilted.rotation) < kMinTiltRad) return false;
+  if (!level.converged) return true;
+  const double dof = std::max(1, tilted.num_residuals - tilted.num_free_parameters);
+  const double sigma2 = 2.0 * tilted.cost / dof;
+  return 2.0 * (level.cost - tilted.cost) > 9.0 * sigma2;
+}
+
+std::string Fixed(double v, int digits) {
+  std::ostringstream s;
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+DirectFitSummary FitDirectCheckingTilt(const std::vector<Profile>& profiles, double areal_density,
+                                       const DirectFitOptions& options,
+                                       std::vector<std::string>* notes, DirectFitOptions* used) {
+  std::vector<std::string> said;
+  DirectFitOptions o = options;
+  DirectFitSummary fit = FitDirect(profiles, areal_density, o);
+  const auto deg = [](double rad) { return Fixed(rad * 180.0 / std::numbers::pi, 2); };
+  // Only overhangs of different lengths tell a tilt from the law: on one profile (or several of
+  // one length) the rotation trades against b1 and c1, and the shipped 40 mm photo alone "found"
+  // −0.73° with b1 = 3.2 gf·cm, c1 = −2000 gf·cm² (the truth 0.1 and −0.0092).
+  double shortest = std::numeric_limits<double>::infinity(), longest = 0.0;
+  for (const Profile& p : profiles) {
+    shortest = std::min(shortest, NoiseFreeLength(p));
+    longest = std::max(longest, NoiseFreeLength(p));
+  }
+  if (!o.fit_rotation && longest >= kMinLengthRatioForTilt * shortest) {
+    // A rig that is not level (or a camera rolled against it) tilts every profile alike; half a
+    // degree already sent b1 2.5× off and one degree c1 to -800 gf·cm², with rms hardly worse.
+    DirectFitOptions turned = o;
+    turned.fit_rotation = true;
+    DirectFitSummary tilted;
+    try {
+      tilted = FitDirect(profiles, areal_density, turned);
+    } catch (const InputError&) {
+      // Only the fit without rotation speaks for the input (profiles of different strips).
+    }
+    if (TiltIsSignificant(fit, tilted)) {
+      said.push_back("the profiles are tilted by " + deg(tilted.rotation) +
+                     "° (a rig not level or a camera rolled against it): fitted with that "
+                     "rotation, rms " +
+                     Fixed(tilted.rms * 1e3, 3) + " mm instead of " +
+                     (fit.converged ? Fixed(fit.rms * 1e3, 3) + " mm" : "no fit") + " without it");
+      fit = tilted;
+      o = turned;
+    } else if (fit.converged && tilted.converged && std::abs(tilted.rotation) >= kMinTiltRad) {
+      // A tilt the data do not show clearly can still move the law by more than its sds (a
+      // 0.2-0.3° tilt: b1 8-80 % high): say what it would change, b1 or b2, whichever moves
+      // more in the tilted fit's sds.
+      double z = 0.0, level_b = 0.0, tilted_b = 0.0;
+      const char* name = "";
+      const std::array<std::tuple<double, double, double, const char*>, 2> pairs = {
+          std::tuple{fit.law->b1(), tilted.law->b1(), tilted.b1_sd, "b1"},
+          std::tuple{fit.law->b2(), tilted.law->b2(), tilted.b2_sd, "b2"}};
+      for (const auto& [a, b, sd, n] : pairs) {
+        if (!(sd > 0.0) || !std::isfinite(sd) || std::abs(a - b) / sd <= z) continue;
+        z = std::abs(a - b) / sd, level_b = a, tilted_b = b, name = n;
+      }
+      if (z > 2.0) {
+        said.push_back("a tilt of " + deg(tilted.rotation) +
+                       "°, which the data do not show clearly, would change " + name + " by " +
+                       Fixed(100.0 * (tilted_b - level_b) / level_b, 2) + " % (" + Fixed(z, 2) +
+                       " sd): if the rig is not known to be level within 0.1°, fit with "
+                       "--fit-rotation");
+      }
+    }
+  }
+  // The mid-line's height at the edge is half the strip's thickness (at most 3 mm: profiles
+  // rising higher are refused); a fitted offset outside that means the profiles' origin is not
+  // the platform's edge. A shift in y alone is what the offset absorbs (the law unchanged); one
+  // in x changes the law (2 mm: b2 2.3× low), which no offset can tell apart.
+  if (fit.converged && o.fit_offset && (fit.offset < -kOffsetNoteM || fit.offset > kOffsetMaxM)) {
+    said.push_back("the fitted offset at the edge, " + Fixed(fit.offset * 1e3, 3) +
+                   " mm, is not half a strip's thickness (0 to 3 mm): the profiles' y = 0 is "
+                   "not the platform's top, or x = 0 is not its edge (a shift in y alone leaves "
+                   "the law as it is, one in x does not): check the platform edge");
+  }
+  if (notes) notes->insert(notes->end(), said.begin(), said.end());
+  if (used) *used = o;
+  return fit;
 }
 
 }  // namespace textile

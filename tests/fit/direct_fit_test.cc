@@ -266,6 +266,42 @@ TEST(DirectFit, SaysWhenB2IsPoorlyDetermined) {
       << fit.observability;
 }
 
+// The commands' fit (fit, validate): a tilt is looked for only where overhangs of different
+// lengths can tell it from the law. Three overhangs tilted by 1°: found and fitted; the 40 mm
+// one alone: left level (a shipped photo alone "found" -0.73° with b1 30× off).
+TEST(DirectFit, CheckingTiltNeedsOverhangsOfDifferentLengths) {
+  const BendingLaw truth = LawOf(kFig8);
+  const double rho = units::GsmToSi(kFig8.gsm);
+  const double tilt = 1.0 * std::numbers::pi / 180.0;
+  std::vector<Profile> data;
+  unsigned seed = 3;
+  for (double L : {0.04, 0.06, 0.08}) {
+    Profile p = MakeProfile(truth, rho, L, 1e-4, 0.0, seed++);
+    for (size_t i = 0; i < p.x.size(); ++i) {
+      const double x = p.x[i], y = p.y[i];
+      p.x[i] = std::cos(tilt) * x - std::sin(tilt) * y;
+      p.y[i] = std::sin(tilt) * x + std::cos(tilt) * y;
+    }
+    data.push_back(p);
+  }
+  std::vector<std::string> notes;
+  DirectFitOptions used;
+  const DirectFitSummary fit = FitDirectCheckingTilt(data, rho, {}, &notes, &used);
+  ASSERT_TRUE(fit.converged) << fit.message;
+  EXPECT_TRUE(used.fit_rotation);
+  EXPECT_NEAR(fit.rotation, tilt, 0.1 * tilt);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("tilted by"), std::string::npos) << notes[0];
+  EXPECT_LT(MomentCurveError(*fit.law, truth, fit.kappa_max), 0.02) << fit.BriefReport();
+
+  notes.clear();
+  const DirectFitSummary one = FitDirectCheckingTilt({data[0]}, rho, {}, &notes, &used);
+  ASSERT_TRUE(one.converged) << one.message;
+  EXPECT_FALSE(used.fit_rotation);
+  EXPECT_EQ(one.rotation, 0.0);
+  for (const std::string& n : notes) EXPECT_EQ(n.find("tilt"), std::string::npos) << n;
+}
+
 TEST(DirectFit, RefusesProfilesOfDifferentStrips) {
   std::vector<Profile> data;
   for (double L : {0.05, 0.07}) data.push_back(MakeProfile(LawOf(kFig8), 0.2, L, 0.05e-3, 0.0, 4));

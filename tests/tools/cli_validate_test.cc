@@ -57,6 +57,35 @@ TEST(CliValidate, ShippedProfilesPassWithTheirNoiseLevel) {
   EXPECT_TRUE(fs::exists(dir / "fitted.json"));
 }
 
+// A tilted rig (1°): validate fits the rotation as textile fit does, says so, and turns both
+// models' curves with it (before, it fitted level: b1 9× off, and compared unturned curves).
+TEST(CliValidate, ATiltedRigIsFittedAndBothModelsAreTurned) {
+  const auto dir = Scratch("CliValidate.Tilted");
+  const auto synth = Textile(
+      "synth-profile --material samples/materials/pabst-fig8.json "
+      "--overhang-mm 40 60 80 --noise-mm 0.1 --rotation-deg 1 -o " +
+      (dir / "profiles").string());
+  ASSERT_EQ(synth.exit_code, 0) << synth.err;
+  std::string profiles;
+  for (const char* L : {"040", "060", "080"})
+    profiles +=
+        (dir / "profiles" / ("pabst-fig8_L" + std::string(L) + "mm.profile.csv")).string() + " ";
+  const auto r = Textile("validate " + profiles + "--gsm 200 -o " + (dir / "out").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("note: the profiles are tilted by"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(ReadAll(dir / "out" / "validate.json"));
+  EXPECT_EQ(j["verdict"], "pass");
+  for (const auto& p : j["profiles"]) {
+    EXPECT_LT(p["elastica"]["rms_mm"].get<double>(), 0.15);
+    EXPECT_NEAR(p["shell"]["rms_mm"].get<double>(), p["elastica"]["rms_mm"].get<double>(), 0.02);
+    EXPECT_LT(p["shell_vs_elastica_max_mm"].get<double>(), 0.1);
+  }
+  const auto m = nlohmann::json::parse(ReadAll(dir / "out" / "fitted.json"));
+  EXPECT_TRUE(m["fit"]["rotation_fitted"].get<bool>());
+  EXPECT_NEAR(m["fit"]["rotation_deg"].get<double>(), 1.0, 0.1);
+  EXPECT_NEAR(m["bending"]["b1"].get<double>(), 0.1, 0.005);
+}
+
 TEST(CliValidate, ModelChoosesWhatIsSimulated) {
   const auto dir = Scratch("CliValidate.Model");
   const auto r = Textile("validate " + kFig8Profiles + " --gsm 200 --model elastica --json -o " +

@@ -105,6 +105,18 @@ struct DirectFitSummary {
 DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_density,
                            const DirectFitOptions& options = {});
 
+// FitDirect as the commands run it (fit, validate). With options.fit_rotation false it also fits
+// a rig rotation and returns that fit when the data show a tilt: a likelihood-ratio test on the
+// objective both minimise at three sd and a tilt of at least 0.1° (docs/fitting.md, "A rig that
+// is not level"). `notes` (may be null) receives what a user should know of a fit that
+// succeeded: a tilt found, one the data do not show clearly but that would move b1 or b2 by more
+// than two sd, a fitted offset that is no half thickness. `used` (may be null) receives the
+// options of the fit returned. Throws as FitDirect.
+DirectFitSummary FitDirectCheckingTilt(const std::vector<Profile>& profiles, double areal_density,
+                                       const DirectFitOptions& options,
+                                       std::vector<std::string>* notes,
+                                       DirectFitOptions* used = nullptr);
+
 // Initial bending stiffness from a profile's tip (Peirce's formula on the chord angle): the
 // linear-law B [N·m] that a lab would quote. Used to start fits; exposed for tests.
 double PeirceStiffnessEstimate(const Profile& profile, double areal_density);

@@ -31,7 +31,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       const auto& a = fit.coefficients_mm;
       for (double c : a)
         if (!std::isfinite(c)) __builtin_trap();
-      for (int d = 0; d <= 100; ++d) {
+      // B_f is promised valid over the written influence range (the data's by default; beyond
+      // it S fades to 1 and the polynomial is not used).
+      for (int k = 0; k <= 100; ++k) {
+        const double d = fit.influence_mm * k / 100.0;
         const double b = (a[0] * d + a[1]) * d + a[2];
         if (!(b > 0.0 && b <= 100.0 * (1.0 + 1e-9))) __builtin_trap();
       }

@@ -216,11 +216,8 @@ int SeamLayersFromAcpmJson(const nlohmann::json& result, const std::string& sour
 }
 
 SeamMeasurement ReadSeamMeasurement(const std::string& path) {
-  std::ifstream f = OpenInputFile(path, "seam measurement file");
-  std::stringstream buffer;
-  buffer << f.rdbuf();
-  if (f.bad()) throw InputError(path + ": cannot read");
-  const std::string text = WithoutBom(buffer.str());
+  // 64 MB: a measurement file is a few rows or one acpm result (kilobytes).
+  const std::string text = WithoutBom(ReadInputFile(path, "seam measurement file", 64u << 20));
   const auto first = text.find_first_not_of(" \t\r\n");
   if (first == std::string::npos) throw InputError(path + ": empty file");
   SeamMeasurement m;

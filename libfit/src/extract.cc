@@ -867,6 +867,28 @@ bool NextGuide(const SectionSet& set, std::vector<Vec2>* guide, double* w_max) {
 Vec2 ReducedFromFull(const Vec2& p, int f) { return (p.array() + 0.5) / f - 0.5; }
 Vec2 FullFromReduced(const Vec2& p, int f) { return (p.array() + 0.5) * f - 0.5; }
 
+// `line` (a guide extended straight back by its first points before `start`) with that back
+// extension replaced by the coarse line from `start` back to `reach` px beyond the point
+// nearest `target`, if that lies behind `start` along the coarse line; else `line`.
+std::vector<Vec2> ReachBackAlong(const std::vector<Vec2>& coarse, const std::vector<Vec2>& line,
+                                 const Vec2& start, const Vec2& target, double reach) {
+  const auto nearest = [&](const Vec2& q) {
+    size_t best = 0;
+    for (size_t k = 1; k < coarse.size(); ++k)
+      if ((coarse[k] - q).squaredNorm() < (coarse[best] - q).squaredNorm()) best = k;
+    return best;
+  };
+  const size_t from = nearest(start), to = nearest(target);
+  if (to + 2 > from) return line;
+  size_t k0 = 0;  // the guide's start in `line`
+  while (k0 + 1 < line.size() && (line[k0] - start).squaredNorm() > 1e-12) ++k0;
+  // The coarse line is resampled every pixel of arc: reach px are as many points.
+  const size_t first = to - std::min(to, static_cast<size_t>(reach));
+  std::vector<Vec2> out(coarse.begin() + first, coarse.begin() + from);
+  out.insert(out.end(), line.begin() + k0, line.end());
+  return ResampleByArc(SmoothPolyline(out, 2.0), 1.0);
+}
+
 // Cross-sections along the strip at full resolution: a first pass on the coarse line (width
 // about t_full px), then passes on the measured line (whose normals cross the strip squarely),
 // extended along the strip for as long as it continues, so that tracking goes on past where the
@@ -874,9 +896,14 @@ Vec2 FullFromReduced(const Vec2& p, int f) { return (p.array() + 0.5) * f - 0.5;
 // The first pass, whose window is wide, may run on `mid`, the photo reduced by the integer
 // factor `f` (f = 1: none): it only places the guide, which the later passes measure again at
 // full resolution, and it costs f² less there. *ok is false if the first pass found too little
-// to follow.
-SectionSet TrackStrip(const cv::Mat& gray, const cv::Mat& mid, int f, const std::vector<Vec2>& coarse,
-                      int direction, int polarity, double t_full, double root_ext, bool* ok) {
+// to follow. With a root_target (--edge-px: where the strip leaves its support) behind the
+// measured stretch's start, each later pass reaches back along the coarse line to root_ext
+// beyond it instead of straight on: the first, wide pass may start its measured stretch far
+// down a sharp bend (where the platform's corner merges with the strip in its wide window),
+// and a straight extension leaves a bend within a few widths.
+SectionSet TrackStrip(const cv::Mat& gray, const cv::Mat& mid, int f,
+                      const std::vector<Vec2>& coarse, int direction, int polarity, double t_full,
+                      double root_ext, const std::optional<Vec2>& root_target, bool* ok) {
   *ok = true;
   // The reduced image may show only the strip's brightest part (a lit edge): the first window is
   // wide enough for an oblique face several times wider, and the core is looked for widely.
@@ -911,6 +938,7 @@ SectionSet TrackStrip(const cv::Mat& gray, const cv::Mat& mid, int f, const std:
     const double half_2 = 0.5 * w_max + std::max(12.0, 0.75 * width);
     const double ahead = std::max(60.0, 4.0 * width);
     line = Extend(guide, root_ext, ahead, std::max(10.0, 2.0 * width));
+    if (root_target) line = ReachBackAlong(coarse, line, guide.front(), *root_target, root_ext);
     set = AnalyseSections(gray, line, direction, polarity, half_2, 0.5 * w_max + 3.0);
     set_f = 1;
     RejectOutliers(&set);
@@ -1181,9 +1209,17 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   bool root_is_a;
   std::string root_how;
   if (options.edge_px) {
+    // The held end is the one at a side border if only one is (a free tip there would be cut
+    // off), else the one nearer the edge given. Not simply the nearer one: a short strip
+    // lying far along a platform from the border has its tip nearer the platform's corner
+    // (pabst-fig8_L040mm.jpg was refused as a tip cut off by the border).
     const Vec2 e = *options.edge_px;
-    root_is_a = (full(Vec2(sweep.a.x, sweep.a.y)) - e).norm() <=
-                (full(Vec2(sweep.b.x, sweep.b.y)) - e).norm();
+    if (static_cast<bool>(at_a & sides) != static_cast<bool>(at_b & sides)) {
+      root_is_a = (at_a & sides) != 0;
+    } else {
+      root_is_a = (full(Vec2(sweep.a.x, sweep.a.y)) - e).norm() <=
+                  (full(Vec2(sweep.b.x, sweep.b.y)) - e).norm();
+    }
     root_how = "edge";
   } else if ((at_a & sides) && !(at_b & sides)) {
     root_is_a = true;
@@ -1322,9 +1358,10 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   const int first_f = mid_factor > 1 && t_full >= 4.0 * mid_factor ? mid_factor : 1;
   bool tracked;
   SectionSet set = TrackStrip(gray, mid, first_f, coarse, direction, strip.polarity, t_full,
-                              root_ext, &tracked);
+                              root_ext, options.edge_px, &tracked);
   if (!tracked) {
-    set = TrackStrip(gray, mid, 1, coarse, direction, strip.polarity, t_full, root_ext, &tracked);
+    set = TrackStrip(gray, mid, 1, coarse, direction, strip.polarity, t_full, root_ext,
+                     options.edge_px, &tracked);
   }
   double w_end = 0.0;
   int measured_from = 0;
@@ -1438,21 +1475,32 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   // ---- 7. Origin and horizontal.
   if (options.edge_px) {
     // The edge is where the strip leaves its support: on the traced line (a clamp) or a
-    // thickness under it (a platform's corner), or on its straight continuation back from
-    // where the sections start. Farther than a few strip widths from all of these it is a
-    // mistake (reduced-image pixels, x and y swapped, another photo's edge) that would move
-    // the whole profile: refused.
+    // thickness under it (a platform's corner), on the coarse centre line (which also runs
+    // over the part lying on a platform, back to where the strip was first seen), or on the
+    // traced line's straight continuation back from where the sections start. Farther than a
+    // few strip widths from all of these it is a mistake (reduced-image pixels, x and y
+    // swapped, another photo's edge) that would move the whole profile: refused.
     const Vec2 e = *options.edge_px;
+    // Distance from e to a polyline [px]; *arc: the arc length from its start to the nearest
+    // point [px].
+    const auto distance_to = [&](const std::vector<Vec2>& line, double* arc) {
+      double best = (e - line.front()).norm(), run = 0.0;
+      *arc = 0.0;
+      for (size_t k = 1; k < line.size(); ++k) {
+        const Vec2 d = line[k] - line[k - 1];
+        const double f =
+            std::clamp((e - line[k - 1]).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
+        const double miss = (e - line[k - 1] - f * d).norm();
+        if (miss < best) best = miss, *arc = run + f * d.norm();
+        run += d.norm();
+      }
+      return best;
+    };
+    double along = 0.0, unused = 0.0;
+    double miss = std::min(distance_to(trace, &along), distance_to(coarse, &unused));
     const Vec2 back = (trace.front() - trace[std::min<size_t>(10, trace.size() - 1)]).normalized();
-    double miss = (e - trace.front()).norm();
-    const double along = (e - trace.front()).dot(back);
-    if (along > 0.0) miss = std::min(miss, (e - trace.front() - along * back).norm());
-    for (size_t k = 1; k < trace.size(); ++k) {
-      const Vec2 d = trace[k] - trace[k - 1];
-      const double f =
-          std::clamp((e - trace[k - 1]).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
-      miss = std::min(miss, (e - trace[k - 1] - f * d).norm());
-    }
+    const double behind = (e - trace.front()).dot(back);
+    if (behind > 0.0) miss = std::min(miss, (e - trace.front() - behind * back).norm());
     const double limit = kEdgeFarWidths * set.width + kEdgeFarPx;
     if (!(miss <= limit)) {
       throw InputError("--edge-px " + Fmt(e.x(), 1) + "," + Fmt(e.y(), 1) + " lies " +
@@ -1462,6 +1510,16 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
                        Fmt(trace.front().x(), 0) + "," + Fmt(trace.front().y(), 0) +
                        "): the edge is where the strip leaves the platform or clamp, in "
                        "full-resolution pixels (x right, y down)");
+    }
+    // An edge well along the measured strip cuts off what lies before it: right only if the
+    // strip lies on a support up to there that the photo does not show apart from the
+    // background; an edge 100 mm along a 251 mm strip gave L = 151 mm with no word.
+    if (along > limit) {
+      r.warnings.push_back("--edge-px lies " + Fmt(along * rig.MmPerPxAt(e), 1) + " mm (" +
+                           Fmt(along, 0) + " px) along the strip from its held end at " +
+                           Fmt(trace.front().x(), 0) + "," + Fmt(trace.front().y(), 0) +
+                           ": the profile leaves that part out; the edge is where the strip "
+                           "leaves the platform or clamp");
     }
   }
   double level = options.level_deg ? *options.level_deg * kDeg : 0.0;

@@ -522,6 +522,39 @@ TEST(ExtractFailures, EdgeFarFromTheStripIsRefused) {
   }
 }
 
+// An edge well along the strip from its held end (here 300 px along a strip that leaves the
+// left border) is where the strip leaves no support: the profile would start there and leave
+// the rest out (a real photo gave L = 151 mm of 251 with no word). It is warned about; the
+// held end itself is not.
+TEST(ExtractFailures, EdgeWellAlongTheStripIsWarnedAbout) {
+  const SyntheticPhoto photo = testing::Render(BorderScene());
+  const auto warned = [](const ExtractionSummary& r) {
+    for (const std::string& w : r.warnings)
+      if (w.find("along the strip from its held end") != std::string::npos) return true;
+    return false;
+  };
+  ExtractOptions at_border;
+  at_border.edge_px = photo.origin;
+  const ExtractionSummary held = Extract(photo.gray, at_border);
+  ASSERT_TRUE(held.success) << held.message;
+  EXPECT_FALSE(warned(held));
+  // A point of the mid-line 300 px along it (on the straight run and the arc).
+  const auto along = Extract(photo.gray);
+  ASSERT_TRUE(along.success) << along.message;
+  double run = 0.0;
+  Eigen::Vector2d point = along.trace_px.front();
+  for (size_t k = 1; k < along.trace_px.size() && run < 300.0; ++k) {
+    run += (along.trace_px[k] - along.trace_px[k - 1]).norm();
+    point = along.trace_px[k];
+  }
+  ExtractOptions far_along;
+  far_along.edge_px = point;
+  const ExtractionSummary cut = Extract(photo.gray, far_along);
+  ASSERT_TRUE(cut.success) << cut.message;
+  EXPECT_TRUE(warned(cut)) << cut.BriefReport();
+  EXPECT_LT(cut.length_mm, held.length_mm - 20.0);
+}
+
 TEST(ExtractFailures, BadInputThrows) {
   const cv::Mat gray = testing::Render(BorderScene()).gray;
   cv::Mat colour;

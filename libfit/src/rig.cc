@@ -100,6 +100,10 @@ constexpr int kMaxHalvings = 40;
 // Points along the ray from the optical axis to an undistorted point at which the model must
 // keep its orientation (Jacobian determinant > 0).
 constexpr int kFoldSamples = 32;
+// Continuation out from the optical axis (UndoLens): first step, and the smallest step before
+// it gives up [fraction of the way].
+constexpr double kContinuationFirstStep = 0.125;
+constexpr double kMinContinuationStep = 1e-4;
 
 enum class UndoStatus { kConverged, kNoConvergence, kFolded };
 
@@ -125,27 +129,14 @@ Eigen::Vector2d PixelFromNormalised(const Eigen::Matrix3d& K, const Eigen::Vecto
   return {K(0, 0) * x.x() + K(0, 1) * x.y() + K(0, 2), K(1, 1) * x.y() + K(1, 2)};
 }
 
-// Solves DistortNormalized(x) = target for x by damped Newton, from x = target.
-UndoStatus UndoLens(const std::vector<double>& d, const Eigen::Vector2d& target,
-                    Eigen::Vector2d* x_out) {
-  Eigen::Vector2d x = target;
+// Solves DistortNormalized(x) = target for x by damped Newton from x = *x (the step halved
+// while the residual grows); true if it converged.
+bool SolveNewton(const std::vector<double>& d, const Eigen::Vector2d& target, Eigen::Vector2d* x) {
   Eigen::Matrix2d J;
-  Eigen::Vector2d f = DistortNormalized(d, x, &J) - target;
+  Eigen::Vector2d f = DistortNormalized(d, *x, &J) - target;
   double residual = f.norm();
   for (int step = 0; step <= kMaxNewtonSteps && std::isfinite(residual); ++step) {
-    if (residual < kUndistortTolerance) {
-      *x_out = x;
-      // The physical pre-image is reached from the optical axis (where the model is about the
-      // identity) without the model folding over on the way: its Jacobian determinant stays
-      // positive along the ray. A root beyond a fold is another point that the lens would put
-      // on the same pixel (k1 = -5 puts r = 0.6 on the opposite side, with det > 0 there).
-      for (int k = 1; k <= kFoldSamples; ++k) {
-        Eigen::Matrix2d J_ray;
-        DistortNormalized(d, x * (static_cast<double>(k) / kFoldSamples), &J_ray);
-        if (!(J_ray.determinant() > 0.0)) return UndoStatus::kFolded;
-      }
-      return UndoStatus::kConverged;
-    }
+    if (residual < kUndistortTolerance) return true;
     const double det = J.determinant();
     if (!(std::abs(det) > 1e-300) || step == kMaxNewtonSteps) break;
     const Eigen::Vector2d dx = -J.inverse() * f;
@@ -154,18 +145,67 @@ UndoStatus UndoLens(const std::vector<double>& d, const Eigen::Vector2d& target,
     bool fell = false;
     for (int h = 0; h <= kMaxHalvings; ++h, lambda *= 0.5) {
       Eigen::Matrix2d J_try;
-      const Eigen::Vector2d x_try = x + lambda * dx;
+      const Eigen::Vector2d x_try = *x + lambda * dx;
       const Eigen::Vector2d f_try = DistortNormalized(d, x_try, &J_try) - target;
       if (f_try.norm() < residual) {
-        x = x_try, f = f_try, J = J_try, residual = f_try.norm();
+        *x = x_try, f = f_try, J = J_try, residual = f_try.norm();
         fell = true;
         break;
       }
     }
     if (!fell) break;
   }
-  *x_out = x;
-  return UndoStatus::kNoConvergence;
+  return false;
+}
+
+// The physical pre-image is reached from the optical axis (where the model is about the
+// identity) without the model folding over on the way: its Jacobian determinant stays
+// positive along the segment from a to b. A root beyond a fold is another point that the lens
+// would put on the same pixel (k1 = -5 puts r = 0.6 on the opposite side, with det > 0 there).
+bool KeepsOrientation(const std::vector<double>& d, const Eigen::Vector2d& a,
+                      const Eigen::Vector2d& b, int samples) {
+  for (int k = 1; k <= samples; ++k) {
+    Eigen::Matrix2d J;
+    DistortNormalized(d, a + (b - a) * (static_cast<double>(k) / samples), &J);
+    if (!(J.determinant() > 0.0)) return false;
+  }
+  return true;
+}
+
+// Solves DistortNormalized(x) = target for x: Newton from x = target, and if that does not
+// converge or lands beyond a fold, by continuation out from the optical axis: the solution
+// for t · target, t from 0 (x = 0) to 1, each step solved from the previous one and kept only
+// if the model keeps its orientation between them (else the step is halved). Newton from
+// the pixel's own coordinates lands beyond the fold when the observed radius lies past the
+// model's turn-over although the physical pre-image lies before it: a pincushion lens with
+// k1 = 0.204, k2 = -0.011, k3 = -0.017 at fx = 757 px puts the corner of a 2000 x 1500 photo
+// at r_d = 1.651, from r = 1.340, and turns over at r = 1.631.
+UndoStatus UndoLens(const std::vector<double>& d, const Eigen::Vector2d& target,
+                    Eigen::Vector2d* x_out) {
+  Eigen::Vector2d x = target;
+  const bool converged = SolveNewton(d, target, &x);
+  if (converged && KeepsOrientation(d, Eigen::Vector2d::Zero(), x, kFoldSamples)) {
+    *x_out = x;
+    return UndoStatus::kConverged;
+  }
+  Eigen::Vector2d y = Eigen::Vector2d::Zero();
+  double t = 0.0, h = kContinuationFirstStep;
+  while (t < 1.0) {
+    const double t_next = std::min(1.0, t + h);
+    Eigen::Vector2d y_next = y;
+    if (SolveNewton(d, t_next * target, &y_next) &&
+        KeepsOrientation(d, y, y_next, kFoldSamples / 4)) {
+      y = y_next, t = t_next, h *= 2.0;
+    } else if ((h *= 0.5) < kMinContinuationStep) {
+      break;
+    }
+  }
+  if (t >= 1.0 && KeepsOrientation(d, Eigen::Vector2d::Zero(), y, kFoldSamples)) {
+    *x_out = y;
+    return UndoStatus::kConverged;
+  }
+  *x_out = converged ? x : y;
+  return converged || t >= 1.0 ? UndoStatus::kFolded : UndoStatus::kNoConvergence;
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -242,6 +243,56 @@ TEST(Lens, StrongWideAngleIsUndoneToTheCorners) {
   rig.lens = lens;
   EXPECT_NO_THROW(rig.CheckForImage(1400, 1000, "wide.jpg"));
   EXPECT_TRUE(rig.PlaneFromImage({-0.5, -0.5}).allFinite());
+}
+
+// Pincushion lenses whose photo corners lie past the model's turn-over as seen, though their
+// ideal points lie before it: Newton's method from the corner's own coordinates converged on
+// the folded branch beyond the turn-over, and the rig was refused ("it folds the photo over
+// near (-0.5, -0.5)"); the continuation out from the optical axis finds the physical point.
+// 25 of 2970 random invertible radial models over a 2000 x 1500 photo were refused so.
+TEST(Lens, PincushionCornersPastTheTurnOverAsSeenAreUndone) {
+  struct Case {
+    double fx;
+    int width, height;
+    std::vector<double> distortion;
+    double corner_r;  // the corner's ideal radius, normalised (0: not checked)
+  };
+  const Case cases[] = {
+      // r_d(r) = r (1 + 0.204 r^2 - 0.011 r^4 - 0.017 r^6) turns over at r = 1.631; the corner
+      // is seen at r_d = 1.651 and comes from r = 1.340.
+      {757, 2000, 1500, {0.204, -0.011, 0, 0, -0.017}, 1.340},
+      // A phone-like camera.
+      {2867, 4000, 3000, {0.227, 0.304, 0, 0, -0.788}, 0.0},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.fx);
+    Lens lens;
+    lens.camera_matrix << c.fx, 0, (c.width - 1) / 2.0, 0, c.fx, (c.height - 1) / 2.0, 0, 0, 1;
+    lens.distortion = c.distortion;
+    EXPECT_EQ(LensProblemOverImage(lens, c.width, c.height), "");
+    for (const Eigen::Vector2d& corner :
+         {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(c.width - 0.5, -0.5),
+          Eigen::Vector2d(-0.5, c.height - 0.5), Eigen::Vector2d(c.width - 0.5, c.height - 0.5)}) {
+      const std::optional<Eigen::Vector2d> ideal = lens.Undistort(corner);
+      ASSERT_TRUE(ideal) << corner.transpose();
+      // Back through OpenCV's own forward model.
+      EXPECT_LT((OpenCvDistort(lens, Normalised(lens, *ideal)) - corner).norm(), 0.01)
+          << corner.transpose();
+      // Pincushion: the ideal point lies nearer the axis than the one seen.
+      EXPECT_LT(Normalised(lens, *ideal).norm(), Normalised(lens, corner).norm());
+      if (c.corner_r > 0) EXPECT_NEAR(Normalised(lens, *ideal).norm(), c.corner_r, 1e-3);
+    }
+    // And a rig file with it is read (it was refused when read with its image_size).
+    std::ostringstream text;
+    text.precision(17);
+    text << R"({"type": "homography", "plane_from_image": [[0.1, 0, 0], [0, 0.1, 0], [0, 0, 1]],)"
+         << R"("image_size": [)" << c.width << ", " << c.height << R"(], "camera_matrix": [[)"
+         << c.fx << ", 0, " << (c.width - 1) / 2.0 << "], [0, " << c.fx << ", "
+         << (c.height - 1) / 2.0 << R"(], [0, 0, 1]], "distortion": [)";
+    for (size_t k = 0; k < c.distortion.size(); ++k) text << (k ? ", " : "") << c.distortion[k];
+    text << "]}";
+    EXPECT_NO_THROW(ParseRigJson(text.str(), "rig.json")) << text.str();
+  }
 }
 
 // A point the lens puts nowhere in reach (k1 = -5: r_d = r - 5 r³ is at most 0.17) has no

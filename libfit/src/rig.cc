@@ -488,10 +488,7 @@ Rig ParseRigJson(const std::string& text, const std::string& source) {
 }
 
 Rig ReadRigJson(const std::string& path) {
-  std::ifstream in = OpenInputFile(path, "rig file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) throw InputError(path + ": cannot read rig file");
+  std::stringstream buffer(ReadInputFile(path, "rig file", 16u << 20));  // kilobytes in use
   if (buffer.str().find_first_not_of(" \t\r\n") == std::string::npos) {
     throw InputError(path + ": empty rig file");
   }

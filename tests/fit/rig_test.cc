@@ -280,7 +280,9 @@ TEST(Lens, PincushionCornersPastTheTurnOverAsSeenAreUndone) {
           << corner.transpose();
       // Pincushion: the ideal point lies nearer the axis than the one seen.
       EXPECT_LT(Normalised(lens, *ideal).norm(), Normalised(lens, corner).norm());
-      if (c.corner_r > 0) EXPECT_NEAR(Normalised(lens, *ideal).norm(), c.corner_r, 1e-3);
+      if (c.corner_r > 0) {
+        EXPECT_NEAR(Normalised(lens, *ideal).norm(), c.corner_r, 1e-3);
+      }
     }
     // And a rig file with it is read (it was refused when read with its image_size).
     std::ostringstream text;

@@ -314,7 +314,9 @@ TEST(CliExtract, EdgeAtTheCornerOfASharplyBentStripIsAccepted) {
     char edge[64];
     std::snprintf(edge, sizeof edge, "%.1f,%.1f", a.at("origin_px")[0].get<double>(),
                   a.at("origin_px")[1].get<double>());
-    if (stem == "pabst-fig8_L080mm") EXPECT_STREQ(edge, "1030.3,218.1");
+    if (stem == "pabst-fig8_L080mm") {
+      EXPECT_STREQ(edge, "1030.3,218.1");
+    }
     const auto given = Textile("extract " + photo + " --mm-per-px 0.12 --edge-px " + edge + " -o " +
                                Quote(dir / "edge") + " --json");
     ASSERT_EQ(given.exit_code, 0) << given.err;

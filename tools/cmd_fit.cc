@@ -279,16 +279,7 @@ void Run(const FitArgs& a) {
     profiles.push_back(in.profile);
     if (!in.extraction) continue;
     const ExtractionSummary& r = *in.extraction;
-    photos.push_back({{"photo", in.source},
-                      {"rig_type", r.rig_type},
-                      {"polarity", r.polarity},
-                      {"direction", r.direction},
-                      {"trace", r.trace},
-                      {"points", r.profile.size()},
-                      {"length_mm", r.length_mm},
-                      {"tip_mm", {r.tip_mm.x(), r.tip_mm.y()}},
-                      {"mm_per_px", r.mm_per_px},
-                      {"warnings", r.warnings}});
+    photos.push_back(ExtractionJson(in));
     if (!a.json) {
       extracted << "extracted " << in.source << ": " << r.rig_type << " rig, " << r.polarity
                 << " strip, L = " << Num(r.length_mm, 4) << " mm, tip (" << Num(r.tip_mm.x(), 4)

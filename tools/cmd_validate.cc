@@ -156,17 +156,7 @@ nlohmann::json FitReport(const DirectFitSummary& fit, const DirectFitOptions& op
   nlohmann::json photos = nlohmann::json::array();
   for (const auto& in : loaded) {
     if (!in.extraction) continue;
-    const ExtractionSummary& r = *in.extraction;
-    photos.push_back({{"photo", in.source},
-                      {"rig_type", r.rig_type},
-                      {"polarity", r.polarity},
-                      {"direction", r.direction},
-                      {"trace", r.trace},
-                      {"points", r.profile.size()},
-                      {"length_mm", r.length_mm},
-                      {"tip_mm", {r.tip_mm.x(), r.tip_mm.y()}},
-                      {"mm_per_px", r.mm_per_px},
-                      {"warnings", r.warnings}});
+    photos.push_back(ExtractionJson(in));
   }
   std::vector<std::string> inputs;
   for (const auto& in : loaded) inputs.push_back(in.source);

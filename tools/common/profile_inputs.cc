@@ -111,6 +111,15 @@ Eigen::Vector2d ParseEdgePx(const std::string& text) {
   return p;
 }
 
+nlohmann::json ExtractionJson(const LoadedProfile& in) {
+  const ExtractionSummary& r = *in.extraction;
+  return {{"photo", in.source},       {"rig_type", r.rig_type},
+          {"polarity", r.polarity},   {"direction", r.direction},
+          {"trace", r.trace},         {"points", r.profile.size()},
+          {"length_mm", r.length_mm}, {"tip_mm", {r.tip_mm.x(), r.tip_mm.y()}},
+          {"mm_per_px", r.mm_per_px}, {"warnings", r.warnings}};
+}
+
 PhotoInputOptions PhotoFlags::Options() const {
   PhotoInputOptions o;
   const bool rig_given = rig_option && rig_option->count() > 0;

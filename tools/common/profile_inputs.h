@@ -19,6 +19,7 @@
 // Messages are one line naming the file or flag.
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
@@ -60,6 +61,10 @@ Rig RigFromOptions(const PhotoInputOptions& options, const std::string& what);
 // stderr is a terminal or options.progress is set (Progress in cli.h).
 std::vector<LoadedProfile> LoadProfileInputs(const std::vector<std::string>& paths,
                                              const PhotoInputOptions& options);
+
+// What a fit report says of a photo input (fit, validate): photo, rig_type, polarity,
+// direction, trace, points, length_mm, tip_mm, mm_per_px, warnings. in.extraction must be set.
+nlohmann::json ExtractionJson(const LoadedProfile& in);
 
 // The shared photo flags, as CLI11 binds them (raw strings; Options() validates them).
 struct PhotoFlags {

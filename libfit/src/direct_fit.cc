@@ -11,12 +11,15 @@
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <tuple>
 
 #include "cost_functions/profile_model.h"
+#include "textile/fit/clapp.h"
 #include "law_parameters.h"
 #include "textile/sim/error.h"
+#include "textile/sim/textile_range.h"
 #include "textile/sim/units.h"
 
 namespace textile {
@@ -60,7 +63,7 @@ class LawPrior : public ceres::SizedCostFunction<2, 3> {
   double w_, log_kappa_ref_;
 };
 
-[[maybe_unused]] double Median(std::vector<double> v) {
+double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
@@ -149,6 +152,75 @@ std::string DirectFitSummary::BriefReport() const {
   return s.str();
 }
 
+namespace {
+
+// Where a solve starts: the law p = (ln b1, ln b2, ln κ0) and the centre of its bounds.
+struct LawStart {
+  std::array<double, 3> p{};
+  double b_centre = 0.0;  // b1, b2 bounded within a factor 100 of this [N·m]
+  std::string name;       // "Peirce" or "Clapp", for reports
+};
+
+// A linear law from Peirce's formula (geometric mean over profiles), κ0 at the curvature
+// scale 1/c of that law.
+LawStart PeirceStart(const std::vector<Profile>& profiles, double areal_density) {
+  double log_b = 0.0;
+  for (const Profile& p : profiles) log_b += std::log(PeirceStiffnessEstimate(p, areal_density));
+  const double b0 = std::exp(log_b / profiles.size());
+  const double c0 = std::cbrt(b0 / (areal_density * units::kGravity));
+  return {{std::log(b0), std::log(b0), std::log(1.0 / c0)}, b0, "Peirce"};
+}
+
+// The data's own M-κ: Clapp's regression (clapp.h) on the same profiles, robust, with the
+// digitised points' distances as weights. Its law follows a softening the linear start cannot
+// reach within its bounds (a technical fabric whose moment is nearly constant past a small
+// curvature). None when the regression fails.
+std::optional<LawStart> ClappStart(const std::vector<Profile>& profiles, double areal_density) {
+  ClappOptions o;
+  o.weighting = ClappWeighting::kRadius;
+  o.loss = ClappLoss::kCauchy;
+  o.max_seconds = 2.0;
+  try {
+    const ClappResult r = FitClapp(profiles, areal_density, o);
+    if (!r.success || !r.law) return std::nullopt;
+    const std::array<double, 3> p = internal::ParametersFromLaw(*r.law);
+    return LawStart{p, std::exp(0.5 * (p[0] + p[1])), "Clapp"};
+  } catch (const InputError&) {
+    return std::nullopt;  // too few points for its polynomial: the direct fit's start stands
+  }
+}
+
+DirectFitSummary FitDirectFrom(const std::vector<Profile>& profiles, double areal_density,
+                               const DirectFitOptions& options, const LawStart& start);
+
+// The RMS normal distance of each point from the line through its neighbours, divided by
+// √1.5 (white noise σ gives σ √1.5 there), median-based so that fibres do not count: the
+// points' own scatter, against which a fit's rms says whether the law follows the data [m].
+double PointScatter(const Profile& p) {
+  std::vector<double> d;
+  for (size_t i = 1; i + 1 < p.size(); ++i) {
+    const double tx = p.x[i + 1] - p.x[i - 1], ty = p.y[i + 1] - p.y[i - 1];
+    const double t = std::hypot(tx, ty);
+    if (!(t > 0.0)) continue;
+    const double mx = 0.5 * (p.x[i + 1] + p.x[i - 1]), my = 0.5 * (p.y[i + 1] + p.y[i - 1]);
+    d.push_back(std::abs((p.x[i] - mx) * ty - (p.y[i] - my) * tx) / t);
+  }
+  if (d.empty()) return 0.0;
+  return 1.4826 * Median(d) / std::sqrt(1.5);
+}
+
+// A fit whose rms exceeds this many times the points' scatter (and kLackOfFitFloor) is one the
+// law does not follow: the fit tries its other start, and the report says where it misses.
+constexpr double kLackOfFitRatio = 3.0;
+constexpr double kLackOfFitFloor = 0.05e-3;  // [m]: below it a misfit is within any claim
+
+bool LacksFit(const DirectFitSummary& fit) {
+  return fit.converged && fit.rms > kLackOfFitFloor &&
+         fit.rms > kLackOfFitRatio * fit.point_scatter;
+}
+
+}  // namespace
+
 DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_density,
                            const DirectFitOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -159,14 +231,74 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
     throw InputError("direct fit: areal density must be a finite number > 0");
   }
   for (const Profile& p : profiles) CheckProfile(p);
+  // Peirce's linear start first; where it fails or the law misses the data by more than
+  // their scatter, the data's own M-κ (Clapp) as a second start, keeping the better fit.
+  DirectFitSummary fit = FitDirectFrom(profiles, areal_density, options,
+                                       PeirceStart(profiles, areal_density));
+  if (!fit.converged || LacksFit(fit)) {
+    if (const std::optional<LawStart> clapp = ClappStart(profiles, areal_density)) {
+      DirectFitSummary other = FitDirectFrom(profiles, areal_density, options, *clapp);
+      if (other.converged && (!fit.converged || other.cost < fit.cost)) {
+        other.iterations += fit.iterations;
+        fit = std::move(other);
+      } else {
+        fit.iterations += other.iterations;
+      }
+    }
+  }
+  fit.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return fit;
+}
 
-  // Start: a linear law from Peirce's formula (geometric mean over profiles), κ0 at the
-  // curvature scale 1/c of that law, overhangs from the data.
-  double log_b = 0.0;
-  for (const Profile& p : profiles) log_b += std::log(PeirceStiffnessEstimate(p, areal_density));
-  const double b0 = std::exp(log_b / profiles.size());
-  const double c0 = std::cbrt(b0 / (areal_density * units::kGravity));
-  std::array<double, 3> law_p = {std::log(b0), std::log(b0), std::log(1.0 / c0)};
+namespace {
+
+// Where and how a converged fit misses the data (DirectFitSummary::fit_pattern): per profile
+// the signed residuals' runs (noise changes sign about every other point; a law that cannot
+// follow leaves long runs) and the rms on the law's two branches, the stretch nearer the clamp
+// where κ > κ0 (b2, the linear branch) and beyond it (b1, c1: the quadratic).
+std::string DescribeMisfit(const std::vector<Profile>& profiles,
+                           const std::vector<std::unique_ptr<ProfileModel>>& models,
+                           const DirectFitSummary& fit) {
+  std::ostringstream s;
+  s.precision(3);
+  s << "the law does not follow the data: rms " << fit.rms * 1e3 << " mm against the points' own "
+    << "scatter of " << fit.point_scatter * 1e3 << " mm";
+  for (size_t i = 0; i < models.size(); ++i) {
+    const ProfileModel& m = *models[i];
+    const Profile& p = profiles[i];
+    const double kink = m.solution().kink_arc_length;  // NaN: κ0 not reached
+    const double scale = fit.profiles[i].overhang / std::max(p.s.back(), 1e-9);
+    int runs = 1;
+    double sum2[2] = {0.0, 0.0};
+    int n[2] = {0, 0};
+    for (int j = 0; j < m.num_points(); ++j) {
+      const double r = m.residual(j);  // [mm]
+      if (j > 0 && (r > 0.0) != (m.residual(j - 1) > 0.0)) ++runs;
+      const int branch = std::isfinite(kink) && p.s[j] * scale < kink ? 0 : 1;
+      sum2[branch] += r * r;
+      ++n[branch];
+    }
+    s << "; " << p.source << ": " << runs << " sign runs in " << m.num_points()
+      << " points (noise: about " << (m.num_points() + 1) / 2 << ")";
+    if (n[0] > 0) {
+      s << ", rms " << std::sqrt(sum2[0] / n[0]) << " mm on the linear branch (κ > κ0, the "
+        << kink * 1e3 << " mm next to the edge)";
+    }
+    if (n[1] > 0) {
+      s << (n[0] > 0 ? " and " : ", rms ") << std::sqrt(sum2[1] / n[1])
+        << " mm on the quadratic branch (κ ≤ κ0)";
+    }
+  }
+  s << ": Pabst's three constants cannot follow this fabric everywhere, or the profile is not a "
+       "clean cantilever (a bend near the clamp, fibres, the strip's face)";
+  return s.str();
+}
+
+DirectFitSummary FitDirectFrom(const std::vector<Profile>& profiles, double areal_density,
+                               const DirectFitOptions& options, const LawStart& start) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::array<double, 3> law_p = start.p;
+  const double b0 = start.b_centre;
   std::vector<double> lengths;
   for (const Profile& p : profiles) lengths.push_back(NoiseFreeLength(p));
   std::array<double, 2> rig = {options.fit_offset ? 0.0 : options.offset, 0.0};
@@ -197,14 +329,14 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
   // Bounds: b1, b2 within a factor 100 of the start and inside the textile range that material
   // files accept (1e-5 .. 1e3 gf·cm), κ0 within a factor 1000 of the curvature scale. Without
   // them, data that no law explains (mixed strips) drive b2 towards 0, a plastic hinge.
-  const double lo_b = std::log(std::max(b0 / 100.0, units::KesStiffnessToSi(1e-5)));
-  const double hi_b = std::log(std::min(b0 * 100.0, units::KesStiffnessToSi(1e3)));
+  const double lo_b = std::log(std::max(b0 / 100.0, units::KesStiffnessToSi(range::kMinStiffnessKes)));
+  const double hi_b = std::log(std::min(b0 * 100.0, units::KesStiffnessToSi(range::kMaxStiffnessKes)));
   if (!(lo_b < hi_b)) {
     DirectFitSummary out;
     std::ostringstream m;
     m.precision(3);
     m << "the profiles' shape asks for a bending stiffness of about " << units::SiStiffnessToKes(b0)
-      << " gf·cm, outside any textile (1e-5 .. 1e3 gf·cm): is --gsm right, is y up?";
+      << " gf·cm, outside any textile (1e-5 .. 1e5 gf·cm): is --gsm right, is y up?";
     out.message = m.str();
     return out;
   }
@@ -324,6 +456,9 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
     out.profiles.push_back(r);
   }
   out.rms = std::sqrt(sum2 / count);
+  double scatter2 = 0.0;
+  for (const Profile& p : profiles) scatter2 += std::pow(PointScatter(p), 2);
+  const double scatter = std::sqrt(scatter2 / profiles.size());
   out.cost = solver_summary.final_cost;
   out.offset = rig[0];
   out.rotation = rig[1];
@@ -470,9 +605,13 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
   out.law = law;
   out.converged = true;
   out.message = "converged (" + solver_summary.message + ")";
+  out.start = start.name;
+  out.point_scatter = scatter;
+  if (LacksFit(out)) out.fit_pattern = DescribeMisfit(profiles, models, out);
   return finish();
 }
 
+}  // namespace
 }  // namespace textile
 
 namespace textile {
@@ -579,6 +718,7 @@ DirectFitSummary FitDirectCheckingTilt(const std::vector<Profile>& profiles, dou
                    "not the platform's top, or x = 0 is not its edge (a shift in y alone leaves "
                    "the law as it is, one in x does not): check the platform edge");
   }
+  if (fit.converged && !fit.fit_pattern.empty()) said.push_back(fit.fit_pattern);
   if (notes) notes->insert(notes->end(), said.begin(), said.end());
   if (used) *used = o;
   return fit;

@@ -7,6 +7,7 @@
 
 #include "textile/sim/error.h"
 #include "textile/sim/json_text.h"
+#include "textile/sim/textile_range.h"
 #include "textile/sim/units.h"
 
 namespace textile {
@@ -16,11 +17,11 @@ using nlohmann::json;
 
 // Plausibility bounds. Outside them a value is far more likely a unit mix-up (an "si" file
 // written in KES numbers, mm for m) than a fabric, so the file is refused with a hint.
-// Bending stiffness of textiles spans about 1e-4 gf·cm (fine silk) to ~100 gf·cm (stiff
-// technical fabrics); see docs/materials.md.
-constexpr double kMinBKes = 1e-5, kMaxBKes = 1e3;   // [gf·cm]
-constexpr double kMaxAbsC1Kes = 1e4;               // [gf·cm²]
-constexpr double kMinGsm = 1.0, kMaxGsm = 1e4;     // [g/m²]
+// The ranges are textile_range.h's (docs/materials.md).
+using range::kMaxGsm;
+using range::kMinGsm;
+constexpr double kMinBKes = range::kMinStiffnessKes, kMaxBKes = range::kMaxStiffnessKes;
+constexpr double kMaxAbsC1Kes = range::kMaxAbsQuadraticKes;
 constexpr double kMinBeta = 1e-3, kMaxBeta = 1e3;  // [-]
 
 class Reader {
@@ -89,6 +90,16 @@ class Reader {
       std::ostringstream s;
       s << "suspicious magnitude " << c1 << " gf·cm², |c1| above " << kMaxAbsC1Kes << " gf·cm²"
         << unit_hint;
+      Fail(key + ".c1", s.str());
+    }
+    // |c1| alone says little (a technical fabric's sharp knee needs ~1e6 gf·cm²); a kink at a
+    // radius of curvature beyond a kilometre is a c1 out of scale with b1 and b2.
+    if (c1 != 0.0 && b1 != b2 && (b2 - b1) / (2.0 * c1) > 0.0 &&
+        (b2 - b1) / (2.0 * c1) < range::kMinKinkCurvatureKes) {
+      std::ostringstream s;
+      s << "suspicious magnitude " << c1 << " gf·cm²: it puts the kink κ0 = (b2 - b1)/(2 c1) at "
+        << (b2 - b1) / (2.0 * c1) << " /cm, below " << range::kMinKinkCurvatureKes
+        << " /cm (a radius of 1 km)" << unit_hint;
       Fail(key + ".c1", s.str());
     }
     const double sb1 = units::KesStiffnessToSi(b1), sb2 = units::KesStiffnessToSi(b2);

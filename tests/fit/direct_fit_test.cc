@@ -311,6 +311,72 @@ TEST(DirectFit, RefusesProfilesOfDifferentStrips) {
   }
 }
 
+// Technical textiles and composite reinforcements: stiffnesses of thousands of gf·cm, areal
+// densities up to 3000 g/m², and laws softening far more than apparel's (the moment almost
+// constant past a small curvature). Three overhangs, 0.1 mm noise.
+TEST(DirectFit, RecoversTechnicalFabricsAndCompositesAcrossTheRange) {
+  struct Case {
+    Fabric f;
+    double lengths[3];
+  };
+  const Case cases[] = {
+      // A technical fabric with a sharp knee: b1/b2 = 100, κ0 = 0.003 /cm.
+      {{"knee", 8000.0, 80.0, -1.32e6, 1387}, {0.15, 0.20, 0.25}},
+      // A heavy, linear composite prepreg.
+      {{"prepreg", 5000.0, 5000.0, 0.0, 3000}, {0.15, 0.20, 0.25}},
+      // A limp lining: bending length 10 mm at 103 g/m².
+      {{"lining", 0.012, 0.012, 0.0, 103}, {0.013, 0.017, 0.021}},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.f.name);
+    const double rho = c.f.gsm * 1e-3;
+    std::vector<Profile> data;
+    for (int i = 0; i < 3; ++i)
+      data.push_back(MakeProfile(LawOf(c.f), rho, c.lengths[i], 0.1e-3, 0.0, 10 + i, 100));
+    const DirectFitSummary fit = FitDirect(data, rho);
+    ASSERT_TRUE(fit.converged) << fit.message;
+    // b1 within three of its sds (and 15 %), rms at the noise: the law follows the data.
+    EXPECT_LT(std::abs(fit.law->b1_kes() - c.f.b1), 3.0 * units::SiStiffnessToKes(fit.b1_sd));
+    EXPECT_LT(std::abs(fit.law->b1_kes() / c.f.b1 - 1.0), 0.15);
+    EXPECT_LT(fit.rms, 0.13e-3);
+    EXPECT_TRUE(fit.fit_pattern.empty()) << fit.fit_pattern;
+    if (c.f.b1 != c.f.b2) EXPECT_LT(std::abs(fit.law->b2_kes() / c.f.b2 - 1.0), 0.02);
+  }
+}
+
+// A profile that no law of eq. 1 follows (a 0.5 mm wave along the strip, as a kinked clamp
+// or a strip's face followed in places would leave) gets its misfit described: long runs of
+// one sign and the rms on each branch; the same profile without the wave gets no such report.
+TEST(DirectFit, DescribesWhereTheLawCannotFollowTheData) {
+  const BendingLaw law = LawOf(kFig8);
+  Profile clean = MakeProfile(law, 0.2, 0.08, 0.02e-3, 0.0, 5, 160);
+  Profile wavy = clean;
+  for (size_t i = 0; i < wavy.size(); ++i) {
+    // Along the curve's normal (the chord of the point's neighbours turned a quarter).
+    const size_t a = i == 0 ? 0 : i - 1, b = std::min(i + 1, clean.size() - 1);
+    const double tx = clean.x[b] - clean.x[a], ty = clean.y[b] - clean.y[a];
+    const double w = 0.5e-3 * std::sin(2.0 * std::numbers::pi * clean.s[i] / 0.03);
+    wavy.x[i] -= w * ty / std::hypot(tx, ty);
+    wavy.y[i] += w * tx / std::hypot(tx, ty);
+  }
+  const DirectFitSummary good = FitDirect({clean}, 0.2);
+  ASSERT_TRUE(good.converged) << good.message;
+  EXPECT_TRUE(good.fit_pattern.empty()) << good.fit_pattern;
+  EXPECT_NEAR(good.point_scatter, 0.02e-3, 0.01e-3);
+  const DirectFitSummary bad = FitDirect({wavy}, 0.2);
+  ASSERT_TRUE(bad.converged) << bad.message;
+  EXPECT_GT(bad.rms, 3.0 * bad.point_scatter);
+  EXPECT_NE(bad.fit_pattern.find("the law does not follow the data"), std::string::npos);
+  EXPECT_NE(bad.fit_pattern.find("sign runs in 160 points"), std::string::npos) << bad.fit_pattern;
+  EXPECT_NE(bad.fit_pattern.find("quadratic branch"), std::string::npos) << bad.fit_pattern;
+  // The checking fit (what fit and validate run) passes it on as a note.
+  std::vector<std::string> notes;
+  FitDirectCheckingTilt({wavy}, 0.2, DirectFitOptions{}, &notes);
+  EXPECT_TRUE(std::any_of(notes.begin(), notes.end(), [](const std::string& n) {
+    return n.find("the law does not follow the data") != std::string::npos;
+  }));
+}
+
 TEST(DirectFit, RejectsBadArguments) {
   std::vector<Profile> data = {MakeProfile(LawOf(kFig8), 0.2, 0.05, 0.0, 0.0, 1)};
   EXPECT_THROW(FitDirect({}, 0.2), InputError);

@@ -106,11 +106,11 @@ TEST(ElasticaGuards, UnusableOptionsAreRefused) {
 }
 
 TEST(ElasticaGuards, ExtremeStripsEitherConvergeFinitelyOrSayWhy) {
-  // The corners of what material files accept (b 1e-5 .. 1e3 gf·cm) and of plausible
+  // The corners of what material files accept (b 1e-5 .. 1e5 gf·cm) and of plausible
   // overhangs: each solve is either finite throughout or a failure with a reason and no
   // numbers, never garbage.
   int converged = 0;
-  for (const double b : {1e-4, 0.1, 1e3}) {
+  for (const double b : {1e-4, 0.1, 1e3, 1e5}) {
     for (const double L : {0.001, 0.1, 1.0}) {
       SCOPED_TRACE("b = " + std::to_string(b) + " gf·cm, L = " + std::to_string(L) + " m");
       ElasticaOptions o;
@@ -125,7 +125,7 @@ TEST(ElasticaGuards, ExtremeStripsEitherConvergeFinitelyOrSayWhy) {
     }
   }
   // Most of them are ordinary strips: the guard must not be refusing everything.
-  EXPECT_GE(converged, 6);
+  EXPECT_GE(converged, 8);
 }
 
 }  // namespace

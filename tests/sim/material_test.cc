@@ -13,6 +13,22 @@ namespace {
 const std::string kSamples = std::string(TEXTILE_SOURCE_DIR) + "/samples/materials/";
 const std::string kBad = std::string(TEXTILE_SOURCE_DIR) + "/tests/data/materials/";
 
+TEST(Material, AcceptsTechnicalFabricsAndRefusesBeyondTheTextileRange) {
+  // A law fitted to a real technical fabric's photo: b1 ~ 8600 gf·cm softening to 119 gf·cm at
+  // κ0 = 0.005 /cm (|c1| ~ 8e5 gf·cm²); the range now reaches composite prepregs (1e5 gf·cm).
+  const Material technical = ParseMaterialJson(
+      R"({"areal_density_gsm": 1387, "bending": {"units": "kes", "b1": 8557.3, "b2": 119.37,
+          "c1": -816710}})",
+      "technical.json");
+  EXPECT_NEAR(technical.bending.b1_kes(), 8557.3, 1e-9);
+  EXPECT_NEAR(units::SiCurvatureToKes(technical.bending.kappa0()), 0.0051658, 1e-6);
+  for (const char* text :
+       {R"({"areal_density_gsm": 1387, "bending": {"units": "kes", "b1": 2e5, "b2": 100, "c1": -1e7}})",
+        R"({"areal_density_gsm": 200, "bending": {"units": "kes", "b1": 0.1, "b2": 0.2, "c1": 1e6}})"}) {
+    EXPECT_THROW(ParseMaterialJson(text, "beyond.json"), InputError) << text;
+  }
+}
+
 TEST(Material, ReadsThePapersFabrics) {
   const Material fig8 = ReadMaterial(kSamples + "pabst-fig8.json");
   EXPECT_DOUBLE_EQ(fig8.areal_density, 0.2);

@@ -93,6 +93,16 @@ struct DirectFitSummary {
   int num_residuals = 0;
   int num_free_parameters = 0;
 
+  // The points' own scatter (pooled over profiles: each point's distance from the line through
+  // its neighbours, median-based) [m]. A fit whose rms exceeds 3× this and 0.05 mm is one the law
+  // does not follow: then fit_pattern says where and how it misses (residual runs, rms on each
+  // branch of eq. 1), and FitDirect has tried its second start.
+  double point_scatter = 0.0;
+  std::string fit_pattern;  // empty when the law follows the data
+  // The start the fit was solved from: "Peirce" (a linear law from the tip angle) or "Clapp"
+  // (the data's own M-κ regression, clapp.h), tried when the first fails or lacks fit.
+  std::string start;
+
   int iterations = 0;
   double seconds = 0.0;
 

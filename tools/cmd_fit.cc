@@ -59,6 +59,19 @@ struct Outcome {
   std::string notes;  // what the user should know about a fit that succeeded ("; "-joined)
 };
 
+// The 3×3 covariance of (b1, b2, c1) in gf·cm, gf·cm, gf·cm² (rows and columns in that order).
+nlohmann::json CovarianceKesJson(const Eigen::Matrix3d& si) {
+  const double f[3] = {units::SiStiffnessToKes(1.0), units::SiStiffnessToKes(1.0),
+                       units::SiQuadraticToKes(1.0)};
+  nlohmann::json rows = nlohmann::json::array();
+  for (int i = 0; i < 3; ++i) {
+    nlohmann::json row = nlohmann::json::array();
+    for (int j = 0; j < 3; ++j) row.push_back(OrNull(si(i, j) * f[i] * f[j]));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
 Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double rho) {
   DirectFitOptions o;
   o.fit_offset = !a.thickness_given && !a.no_offset;
@@ -91,7 +104,11 @@ Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double
                 {"b2_sd", OrNull(units::SiStiffnessToKes(fit.b2_sd))},
                 {"c1_sd", OrNull(units::SiQuadraticToKes(fit.c1_sd))},
                 {"sd_units", "kes"},
+                {"covariance_kes", CovarianceKesJson(fit.covariance)},
                 {"rms_mm", fit.rms * 1e3},
+                {"start", fit.start},
+                {"point_scatter_mm", fit.point_scatter * 1e3},
+                {"fit_pattern", fit.fit_pattern.empty() ? nlohmann::json() : nlohmann::json(fit.fit_pattern)},
                 {"b1_observed", fit.b1_observed},
                 {"b2_observed", fit.b2_observed},
                 {"c1_observed", fit.c1_observed},

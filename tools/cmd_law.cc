@@ -3,12 +3,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <optional>
 
 #include "common/atomic_file.h"
 #include "common/chart.h"
 #include "common/cli.h"
+#include "textile/fit/moment_curve.h"
 #include "textile/sim/error.h"
 #include "textile/sim/material.h"
 #include "textile/sim/units.h"
@@ -21,6 +23,8 @@ struct LawArgs {
   std::vector<double> kappa;     // as given, in kappa_unit
   std::string kappa_unit = "cm";  // "cm": 1/cm (KES); "m": 1/m
   std::string plot;
+  std::vector<std::string> measured;  // (κ, M) CSVs drawn beside the law
+  bool log_kappa = false;             // logarithmic κ axes on the chart
   bool json = false;
 };
 
@@ -75,10 +79,49 @@ void PrintLawText(const std::string& title, const BendingLaw& law, const std::ve
   std::cout.flush();
 }
 
-void Plot(const Material& m, double kappa_max, const std::string& path) {
+// Curvature i of 0..n up to kappa_max [1/m]: even steps, or four decades in even ratios.
+double SampleKappa(int i, int n, double kappa_max, bool log_kappa) {
+  if (!log_kappa) return kappa_max * i / n;
+  return kappa_max * std::pow(10.0, -4.0 * (1.0 - static_cast<double>(i) / n));
+}
+
+// The covariance of (b1, b2, c1) [SI] from the fit report a material carries
+// (`fit.covariance_kes`), when every sd of the report is known; else none, with why in *why.
+std::optional<Eigen::Matrix3d> FitCovariance(const Material& m, const std::string& path,
+                                             std::string* why) {
+  const nlohmann::json& f = m.fit;
+  if (!f.is_object() || !f.contains("covariance_kes")) {
+    *why = "no band: the material carries no fit covariance";
+    return std::nullopt;
+  }
+  for (const char* k : {"b1_sd", "b2_sd", "c1_sd"}) {
+    if (!f.contains(k) || !f[k].is_number()) {
+      *why = std::string("no band: ") + k + " is undetermined";
+      return std::nullopt;
+    }
+  }
+  const nlohmann::json& c = f["covariance_kes"];
+  const double to_si[3] = {units::KesStiffnessToSi(1.0), units::KesStiffnessToSi(1.0),
+                           units::KesQuadraticToSi(1.0)};
+  Eigen::Matrix3d cov;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      if (!c.is_array() || c.size() != 3 || !c[i].is_array() || c[i].size() != 3 ||
+          !c[i][j].is_number())
+        throw InputError(path + ": fit.covariance_kes must be a 3×3 array of numbers");
+      cov(i, j) = c[i][j].get<double>() * to_si[i] * to_si[j];
+    }
+  }
+  return cov;
+}
+
+void Plot(const Material& m, const std::string& material_path, double kappa_max,
+          const std::vector<MomentCurvePairs>& measured, bool log_kappa, const std::string& path) {
   namespace chart = textile::chart;
-  chart::Panel mk{.title = "Moment-curvature", .x_label = "κ [1/cm]", .y_label = "M [gf·cm/cm]"};
-  chart::Panel bk{.title = "Bending stiffness", .x_label = "κ [1/cm]", .y_label = "B = dM/dκ [gf·cm]"};
+  chart::Panel mk{.title = "Moment-curvature", .x_label = "κ [1/cm]", .y_label = "M [gf·cm/cm]",
+                  .log_x = log_kappa};
+  chart::Panel bk{.title = "Bending stiffness", .x_label = "κ [1/cm]", .y_label = "B = dM/dκ [gf·cm]",
+                  .log_x = log_kappa, .log_y = log_kappa};
   std::vector<std::pair<std::string, BendingLaw>> laws = {
       {m.bending_weft ? "warp" : "law", m.EffectiveLaw()}};
   if (m.bending_weft) laws.emplace_back("weft", m.EffectiveWeftLaw());
@@ -86,7 +129,7 @@ void Plot(const Material& m, double kappa_max, const std::string& path) {
   for (const auto& [label, law] : laws) {
     chart::Series sm{.label = label}, sb{.label = label};
     for (int i = 0; i <= kSamples; ++i) {
-      const double k = kappa_max * i / kSamples;
+      const double k = SampleKappa(i, kSamples, kappa_max, log_kappa);
       sm.x.push_back(units::SiCurvatureToKes(k));
       sm.y.push_back(units::SiMomentToKes(law.Moment(k)));
       sb.x.push_back(units::SiCurvatureToKes(k));
@@ -110,12 +153,49 @@ void Plot(const Material& m, double kappa_max, const std::string& path) {
     mk.notes.push_back(label + ": b1 = " + Num(law.b1_kes(), 4) + ", b2 = " + Num(law.b2_kes(), 4) +
                        " gf·cm, c1 = " + Num(law.c1_kes(), 4) + " gf·cm²");
   }
+  // The fitted law's 1-σ band (linear propagation of its covariance), up to the curvatures
+  // its data reached; measured pairs as markers.
+  std::string no_band;
+  if (!measured.empty() || m.fit.is_object()) {
+    if (const auto cov = m.bending_weft ? std::nullopt : FitCovariance(m, material_path, &no_band)) {
+      const BendingLaw law = m.EffectiveLaw();
+      double reach = kappa_max;
+      if (m.fit.contains("kappa_max_per_cm") && m.fit["kappa_max_per_cm"].is_number())
+        reach = std::min(reach, units::KesCurvatureToSi(m.fit["kappa_max_per_cm"].get<double>()));
+      chart::Series lo{.label = "±1σ of the fit", .dashed = true}, hi{.dashed = true};
+      lo.color = hi.color = chart::PaletteColor(0);
+      lo.line_width = hi.line_width = 1.0;
+      constexpr int kBand = 200;
+      for (int i = 0; i <= kBand; ++i) {
+        const double k = SampleKappa(i, kBand, reach, log_kappa);
+        const double sd = MomentSigma(law, *cov * m.beta * m.beta, k);
+        lo.x.push_back(units::SiCurvatureToKes(k));
+        hi.x.push_back(units::SiCurvatureToKes(k));
+        lo.y.push_back(units::SiMomentToKes(law.Moment(k) - sd));
+        hi.y.push_back(units::SiMomentToKes(law.Moment(k) + sd));
+      }
+      mk.series.push_back(lo);
+      mk.series.push_back(hi);
+    } else if (!measured.empty()) {
+      mk.notes.push_back(no_band);
+    }
+  }
+  for (const MomentCurvePairs& p : measured) {
+    chart::Series s{.label = std::filesystem::path(p.source).filename().string(),
+                    .style = chart::Series::Style::kMarkers};
+    for (size_t i = 0; i < p.kappa.size(); ++i) {
+      s.x.push_back(units::SiCurvatureToKes(p.kappa[i]));
+      s.y.push_back(units::SiMomentToKes(p.moment[i]));
+    }
+    mk.series.push_back(s);
+  }
   if (m.beta != 1.0) mk.notes.push_back("β = " + Num(m.beta) + " applied");
-  bk.y_range = chart::Range{0.0, 0.0};  // set below: B from 0 so that ratios read true
-  double b_max = 0.0;
-  for (const auto& s : bk.series)
-    for (double v : s.y) b_max = std::max(b_max, v);
-  bk.y_range = chart::Range{0.0, 1.15 * b_max};
+  if (!log_kappa) {  // B from 0 so that ratios read true
+    double b_max = 0.0;
+    for (const auto& s : bk.series)
+      for (double v : s.y) b_max = std::max(b_max, v);
+    bk.y_range = chart::Range{0.0, 1.15 * b_max};
+  }
   chart::WritePng({.title = (m.name.empty() ? "Bending law" : m.name) + "  (" +
                             Num(units::SiToGsm(m.areal_density)) + " g/m²)",
                    .width_px = 1200,
@@ -126,7 +206,11 @@ void Plot(const Material& m, double kappa_max, const std::string& path) {
 }
 
 void Run(const LawArgs& a) {
-  CheckDistinctOutputs({{"--plot", a.plot}}, {{"--material", a.material}});
+  std::vector<std::pair<std::string, std::string>> inputs = {{"--material", a.material}};
+  for (const std::string& f : a.measured) inputs.emplace_back("--measured", f);
+  CheckDistinctOutputs({{"--plot", a.plot}}, inputs);
+  if (!a.measured.empty() && a.plot.empty())
+    throw InputError("--measured: drawn on the chart only; give --plot FILE.png");
   const Material m = ReadMaterial(a.material);
   std::vector<double> kappas;
   for (double k : a.kappa) {
@@ -144,7 +228,20 @@ void Run(const LawArgs& a) {
   for (double k : kappas) kappa_max = std::max(kappa_max, std::abs(k));
   if (std::isfinite(law.kappa0())) kappa_max = std::max(kappa_max, 1.5 * law.kappa0());
 
-  if (!a.plot.empty()) Plot(m, kappa_max, a.plot);
+  std::vector<MomentCurvePairs> measured;
+  if (!a.measured.empty()) {
+    // The chart spans the measured pairs and the fit's data, not the default 2 /cm.
+    double reach = 0.0;
+    for (const std::string& f : a.measured) {
+      measured.push_back(ReadMomentCurvatureCsv(f));
+      for (double k : measured.back().kappa) reach = std::max(reach, k);
+    }
+    if (m.fit.is_object() && m.fit.contains("kappa_max_per_cm") &&
+        m.fit["kappa_max_per_cm"].is_number())
+      reach = std::max(reach, units::KesCurvatureToSi(m.fit["kappa_max_per_cm"].get<double>()));
+    if (reach > 0.0) kappa_max = 1.1 * reach;
+  }
+  if (!a.plot.empty()) Plot(m, a.material, kappa_max, measured, a.log_kappa, a.plot);
 
   if (a.json) {
     nlohmann::json j = {{"material", a.material},
@@ -177,6 +274,11 @@ void RegisterLaw(CLI::App& app) {
   sub->add_option("--kappa-unit", args->kappa_unit, "Unit of --kappa: cm (1/cm, KES; default) or m (1/m)")
       ->check(CLI::IsMember({"cm", "m"}));
   sub->add_option("--plot", args->plot, "Write an M-κ / B-κ chart to this PNG file");
+  sub->add_flag("--log-kappa", args->log_kappa,
+                "Logarithmic κ axes on the chart (and B): for laws with a knee at a small curvature");
+  sub->add_option("--measured", args->measured,
+                  "CSV(s) of measured (κ, M) pairs to draw beside the law (header kappa_per_m,M_N "
+                  "or kappa_per_cm,M_gfcm_per_cm; other columns ignored); needs --plot");
   sub->add_flag("--json", args->json, "Print one JSON object instead of text");
   sub->callback([args] { Run(*args); });
 }

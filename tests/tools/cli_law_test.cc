@@ -123,6 +123,41 @@ TEST(CliLaw, WritesPlot) {
   EXPECT_EQ(testing::ReadAll(png).substr(1, 3), "PNG");
 }
 
+TEST(CliLaw, PlotsMeasuredPairsAndTheFitsBand) {
+  // A fitted material carries its covariance (fit.covariance_kes, sds on its diagonal); the
+  // chart draws its band and measured pairs in either unit; without a fit report the chart
+  // says there is no band.
+  const auto d = Scratch("law_measured");
+  const auto profiles = d / "profiles";
+  ASSERT_EQ(RunTextile("synth-profile --material samples/materials/pabst-fig8.json "
+                       "--overhang-mm 40 60 80 --noise-mm 0.1 -o '" + profiles.string() + "'",
+                       "law_measured_synth").exit_code, 0);
+  const auto fitted = d / "fitted.json";
+  std::string inputs;
+  for (const char* L : {"40", "60", "80"})
+    inputs += " '" + (profiles / (std::string("pabst-fig8_L0") + L + "mm.profile.csv")).string() + "'";
+  const auto f = RunTextile("fit" + inputs + " --gsm 200 -o '" + fitted.string() + "'", "law_measured_fit");
+  ASSERT_EQ(f.exit_code, 0) << f.err;
+  const auto report = nlohmann::json::parse(testing::ReadAll(fitted))["fit"];
+  ASSERT_TRUE(report.contains("covariance_kes"));
+  EXPECT_NEAR(std::sqrt(report["covariance_kes"][0][0].get<double>()), report["b1_sd"].get<double>(),
+              1e-9 * report["b1_sd"].get<double>());
+  EXPECT_EQ(report["start"], "Peirce");
+  { std::ofstream(d / "si.csv") << "kappa_per_m,M_N\n0,0\n50,0.05\n100,0.09\n"; }
+  { std::ofstream(d / "lab.csv") << "kappa_per_cm,M_gfcm_per_cm\n0.5,5\n1,9\n"; }
+  const auto png = d / "law.png";
+  const auto r = RunTextile("law --material '" + fitted.string() + "' --plot '" + png.string() +
+                                "' --log-kappa --measured '" + (d / "si.csv").string() + "' '" +
+                                (d / "lab.csv").string() + "'", "law_measured");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_GT(fs::file_size(png), 10000u);
+  const auto plain = RunTextile("law --material samples/materials/pabst-fig8.json --plot '" +
+                                    (d / "plain.png").string() + "' --measured '" +
+                                    (d / "si.csv").string() + "'", "law_measured_plain");
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_TRUE(fs::exists(d / "plain.png"));
+}
+
 TEST(CliLaw, UnwritablePlotExits2AndWritesNothing) {
   const auto r = RunTextile(
       "law --material samples/materials/pabst-fig8.json --plot /nonexistent-dir/law.png", "law_bad_plot");

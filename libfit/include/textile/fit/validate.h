@@ -46,8 +46,8 @@ inline constexpr double kMaxOverRms = 3.0;
 
 struct ValidationOptions {
   // RMS normal distance a simulated curve may miss a profile by [m], in (0, 0.05]; the largest
-  // distance and the tip distance may reach kMaxOverRms times it. 0.5 mm: cantilever.md calls
-  // 0.5 mm of offset larger than the whole error budget.
+  // distance and the tip distance may reach kMaxOverRms times it. 0.5 mm: more than the whole
+  // error budget of a photographed profile (docs/validation.md, "Verdicts").
   double tolerance = 0.5e-3;
   // Which models simulate the cantilevers (at least one).
   bool run_elastica = true;

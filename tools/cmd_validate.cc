@@ -468,7 +468,8 @@ void RegisterValidate(CLI::App& app) {
   CLI::App* sub = AddSubcommand(
       app, "validate",
       "Photos or profiles -> direct fit -> the same cantilevers simulated -> measured vs simulated "
-      "(RMS, max, tip, verdict), report JSON + PNG",
+      "(RMS, max, tip: goodness of fit), and each profile predicted by the law fitted to the "
+      "others (held out); verdicts, report JSON + PNG",
       "textile validate samples/profiles/pabst-fig8_L0*.profile.csv --gsm 200 -o out/validate\n"
       "  textile validate strip_*.jpg --rig rig.json --gsm 200 -o out/validate");
   sub->add_option(
@@ -487,7 +488,9 @@ void RegisterValidate(CLI::App& app) {
       ->check(CLI::IsMember({"both", "elastica", "shell"}));
   sub->add_option("--width-mm", a->width_mm,
                   "Strip width for the shell model [mm], in [5, 200]; default 25");
-  sub->add_flag("--strict", a->strict, "A failed validation is an error (exit 3, nothing written)");
+  sub->add_flag("--strict", a->strict,
+                "A failed verdict, goodness of fit or held out, is an error (exit 3, nothing "
+                "written)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   AddPhotoFlags(sub, &a->photo);
   CLI::Option* width = sub->get_option("--width-mm");

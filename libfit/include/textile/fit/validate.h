@@ -27,6 +27,7 @@
 // Both verdicts grade a comparison alike: rms ≤ tolerance, max and tip distance ≤
 // kMaxOverRms × tolerance.
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -85,7 +86,7 @@ struct ProfileValidation {
   double overhang = 0.0;     // fitted overhang L_i [m]
   ModelComparison elastica, shell;
   // Largest distance of the shell's curve from the elastica's [m]; NaN unless both ran.
-  double model_gap = 0.0;
+  double model_gap = std::numeric_limits<double>::quiet_NaN();
   bool pass = false;  // every model run passes
   std::string why;    // "elastica: ...; shell: ..."
 };

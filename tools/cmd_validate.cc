@@ -9,9 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
-#include <limits>
 #include <string>
-#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -20,15 +18,11 @@
 #include "common/cli.h"
 #include "common/profile_inputs.h"
 #include "textile/fit/direct_fit.h"
-#include "textile/fit/extract.h"
 #include "textile/fit/profile_compare.h"
-#include "textile/fit/rig.h"
 #include "textile/fit/validate.h"
-#include "textile/sim/acpm_shell.h"
 #include "textile/sim/cantilever_outputs.h"
 #include "textile/sim/error.h"
 #include "textile/sim/material.h"
-#include "textile/sim/polyline.h"
 #include "textile/sim/units.h"
 
 namespace textile::cli {

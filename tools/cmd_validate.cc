@@ -1,15 +1,15 @@
 // textile validate: photos or profiles -> direct fit -> the same cantilevers simulated with the
 // fitted law at the photographed overhangs, by the elastica and by the shell model -> measured vs
-// simulated (cantilever.md, "Closing the loop"): RMS and maximum deviation, tip difference, a
-// verdict against a stated tolerance, a report JSON and a picture with all curves.
+// simulated (docs/validation.md): the goodness of fit, and with two or more profiles each one
+// predicted by the law fitted to the others (leave-one-out). RMS and maximum deviation, tip
+// difference, verdicts against a stated tolerance, a report JSON and a picture with all curves.
+// The work is libfit's ValidateFit (validate.h); this file parses, prints and writes.
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
-#include <limits>
 #include <string>
-#include <system_error>
 #include <utility>
 #include <vector>
 
@@ -18,14 +18,11 @@
 #include "common/cli.h"
 #include "common/profile_inputs.h"
 #include "textile/fit/direct_fit.h"
-#include "textile/fit/extract.h"
 #include "textile/fit/profile_compare.h"
-#include "textile/fit/rig.h"
-#include "textile/sim/acpm_shell.h"
+#include "textile/fit/validate.h"
 #include "textile/sim/cantilever_outputs.h"
 #include "textile/sim/error.h"
 #include "textile/sim/material.h"
-#include "textile/sim/polyline.h"
 #include "textile/sim/units.h"
 
 namespace textile::cli {
@@ -44,48 +41,9 @@ struct ValidateArgs {
   std::vector<std::string> photo_flags_given;  // e.g. "--rig": unused when no input is a photo
 };
 
-// Per profile: the verdict's three criteria. The RMS normal distance carries the tolerance; a
-// single point or the tip may stray up to 3× that (a frayed fibre, a speck) before it fails.
-constexpr double kMaxOverRms = 3.0;
-
-// One model's simulation of one profile.
-struct ModelCheck {
-  bool run = false;
-  ProfileComparison c;
-  bool pass = false;
-  std::string why;
-  int solves = 0;
-  std::string notes;
-};
-
-struct Check {
-  std::string source;
-  bool from_photo = false;
-  double data_length = 0.0, overhang = 0.0;  // [m]
-  ModelCheck elastica, shell;
-  double model_gap = std::numeric_limits<double>::quiet_NaN();  // shell vs elastica, max [m]
-  bool pass = false;
-  std::string why;
-};
-
-// Grades one comparison against the tolerance tol [m]; the failed criteria in k->why.
-void Grade(double tol, double tol_mm, ModelCheck* k) {
-  const ProfileComparison& c = k->c;
-  const double tip = std::hypot(c.tip_dx, c.tip_dy);
-  std::vector<std::string> fails;
-  if (c.rms > tol) fails.push_back("rms " + Num(units::MToMm(c.rms), 3) + " mm > " + Num(tol_mm));
-  if (c.max > kMaxOverRms * tol)
-    fails.push_back("max " + Num(units::MToMm(c.max), 3) + " mm > " + Num(kMaxOverRms * tol_mm));
-  if (tip > kMaxOverRms * tol)
-    fails.push_back("tip " + Num(units::MToMm(tip), 3) + " mm > " + Num(kMaxOverRms * tol_mm));
-  k->pass = fails.empty();
-  k->why.clear();
-  for (size_t f = 0; f < fails.size(); ++f) k->why += (f ? ", " : "") + fails[f];
-}
-
-nlohmann::json ModelJson(const ModelCheck& k) {
+nlohmann::json ModelJson(const ModelComparison& k) {
   if (!k.run) return nullptr;
-  const ProfileComparison& c = k.c;
+  const ProfileComparison& c = k.comparison;
   return {
       {"rms_mm", units::MToMm(c.rms)},
       {"max_mm", units::MToMm(c.max)},
@@ -166,9 +124,9 @@ nlohmann::json FitReport(const DirectFitSummary& fit, const DirectFitOptions& op
   return report;
 }
 
-void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles,
-          const BendingLaw& law, double tol_mm, bool pass, AtomicFile& out) {
+void Plot(const ValidationSummary& v, const std::vector<Profile>& profiles, AtomicFile& out) {
   namespace chart = textile::chart;
+  const double tol_mm = units::MToMm(v.options.tolerance);
   chart::Panel p{
       .title = "Measured (dots) and simulated cantilevers: elastica (solid), shell (dashed)",
       .x_label = "x [mm]",
@@ -188,7 +146,8 @@ void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles
   // The notes name each profile by its file stem without the stems' common prefix (cut at a
   // '_' or '-'), so that the box stays narrow enough to find a corner free of curves.
   std::vector<std::string> stems;
-  for (const Check& k : checks) stems.push_back(std::filesystem::path(k.source).stem().string());
+  for (const ProfileValidation& k : v.profiles)
+    stems.push_back(std::filesystem::path(k.source).stem().string());
   size_t common = 0;
   if (stems.size() > 1) {
     common = stems[0].size();
@@ -202,8 +161,8 @@ void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles
     for (const auto& t : stems)
       if (t.size() <= common) common = 0;
   }
-  for (size_t i = 0; i < checks.size(); ++i) {
-    const Check& k = checks[i];
+  for (size_t i = 0; i < v.profiles.size(); ++i) {
+    const ProfileValidation& k = v.profiles[i];
     const std::string name = std::filesystem::path(k.source).filename().string();
     chart::Series data{.label = name,
                        .style = chart::Series::Style::kMarkers,
@@ -215,27 +174,82 @@ void Plot(const std::vector<Check>& checks, const std::vector<Profile>& profiles
     p.series.push_back(data);
     // One short line per profile: rms and max of each model run ("elastica / shell").
     std::string rms, max;
-    for (const ModelCheck* m : {&k.elastica, &k.shell}) {
+    for (const ModelComparison* m : {&k.elastica, &k.shell}) {
       if (!m->run) continue;
-      rms += (rms.empty() ? "" : "/") + Num(units::MToMm(m->c.rms), 2);
-      max += (max.empty() ? "" : "/") + Num(units::MToMm(m->c.max), 2);
+      rms += (rms.empty() ? "" : "/") + Num(units::MToMm(m->comparison.rms), 2);
+      max += (max.empty() ? "" : "/") + Num(units::MToMm(m->comparison.max), 2);
     }
     if (k.elastica.run)
-      lines.push_back(curve(k.elastica.c, i == 0 ? "elastica" : "", false, {0.1, 0.1, 0.1}));
+      lines.push_back(
+          curve(k.elastica.comparison, i == 0 ? "elastica" : "", false, {0.1, 0.1, 0.1}));
     if (k.shell.run)
-      lines.push_back(curve(k.shell.c, i == 0 ? "shell" : "", true, {0.85, 0.1, 0.1}));
+      lines.push_back(curve(k.shell.comparison, i == 0 ? "shell" : "", true, {0.85, 0.1, 0.1}));
     const std::string note = stems[i].substr(common) + ": rms " + rms + ", max " + max + " mm";
     p.notes.push_back(note + (k.pass ? " ok" : " FAIL"));
   }
   for (auto& l : lines) p.series.push_back(std::move(l));
-  if (!checks.empty() && checks[0].elastica.run && checks[0].shell.run)
+  if (!v.profiles.empty() && v.profiles[0].elastica.run && v.profiles[0].shell.run)
     p.notes.push_back("(elastica/shell)");
+  const BendingLaw& law = v.material.bending;
   p.notes.push_back("law b1 = " + Num(law.b1_kes(), 4) + ", b2 = " + Num(law.b2_kes(), 4) +
                     " gf·cm, c1 = " + Num(law.c1_kes(), 4) + " gf·cm²");
-  p.notes.push_back(std::string("verdict: ") + (pass ? "PASS" : "FAIL") + " (rms ≤ " + Num(tol_mm) +
-                    " mm, max and tip ≤ " + Num(kMaxOverRms * tol_mm) + " mm)");
+  p.notes.push_back(std::string("goodness of fit: ") + (v.pass ? "PASS" : "FAIL") + " (rms ≤ " +
+                    Num(tol_mm) + " mm, max and tip ≤ " + Num(kMaxOverRms * tol_mm) + " mm)");
+  // The held-out predictions in one line: each profile's rms by the first model run.
+  std::string held;
+  for (const HeldOutProfile& h : v.holdout) {
+    const ModelComparison& m = h.elastica.check.run ? h.elastica.check : h.shell.check;
+    held += (held.empty() ? "" : ", ") +
+            (h.predicted ? Num(units::MToMm(m.comparison.rms), 2) : std::string("-"));
+  }
+  p.notes.push_back(v.holdout.empty()
+                        ? std::string("held out: nothing (one profile)")
+                        : "held out: rms " + held + " mm " +
+                              (v.holdout_verdict == HoldoutVerdict::kPass ? "PASS" : "FAIL"));
   chart::WritePng({.title = "textile validate", .width_px = 1100, .height_px = 800, .panels = {p}},
                   out);
+}
+
+nlohmann::json MmOrNull(double m) { return OrNull(units::MToMm(m)); }
+
+// validate.json's `holdout`: one entry per held-out profile and model run.
+nlohmann::json HoldoutJson(const ValidationSummary& v) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const HeldOutProfile& h : v.holdout) {
+    for (const auto& [name, m] :
+         {std::pair{"elastica", &h.elastica}, std::pair{"shell", &h.shell}}) {
+      // A profile not predicted gets an entry for each model asked for, with null figures.
+      const bool asked = name == std::string("elastica")
+                             ? v.options.run_elastica
+                             : v.options.run_shell && v.options.hold_out_shell;
+      if (!asked) continue;
+      const ProfileComparison& c = m->check.comparison;
+      const bool ran = h.predicted && m->check.run;
+      const auto fig = [&](double value) { return ran ? MmOrNull(value) : nlohmann::json(); };
+      nlohmann::json e = {
+          {"input", h.source},
+          {"model", name},
+          {"overhang_mm", units::MToMm(h.overhang)},
+          {"rms_mm", fig(c.rms)},
+          {"max_mm", fig(c.max)},
+          {"tip_mm", fig(std::hypot(c.tip_dx, c.tip_dy))},
+          {"tip_dx_mm", fig(c.tip_dx)},
+          {"tip_dy_mm", fig(c.tip_dy)},
+          {"rms_sigma_mm", fig(m->sigma.rms)},
+          {"max_sigma_mm", fig(m->sigma.max)},
+          {"tip_sigma_mm", fig(m->sigma.tip)},
+          {"sigma_complete", h.predicted ? nlohmann::json(h.sigma_complete) : nlohmann::json()},
+          {"law_kes", h.law ? nlohmann::json{{"b1", h.law->b1_kes()},
+                                             {"b2", h.law->b2_kes()},
+                                             {"c1", h.law->c1_kes()}}
+                            : nlohmann::json()},
+          {"fit_rms_mm", h.predicted ? nlohmann::json(units::MToMm(h.fit_rms)) : nlohmann::json()},
+          {"ok", ran && m->check.pass},
+          {"why", ran ? m->check.why : h.why}};
+      list.push_back(e);
+    }
+  }
+  return list;
 }
 
 void Run(const ValidateArgs& a) {
@@ -250,8 +264,12 @@ void Run(const ValidateArgs& a) {
   // As textile fit refuses the direct fit's options with --method clapp.
   if (a.width_given && a.model == "elastica")
     throw InputError("--width-mm: the shell's strip width; --model elastica simulates no shell");
-  const bool run_elastica = a.model != "shell", run_shell = a.model != "elastica";
-  const double rho = units::GsmToSi(a.gsm);
+  ValidationOptions options;
+  options.tolerance = units::MmToM(a.tolerance_mm);
+  options.run_elastica = a.model != "shell";
+  options.run_shell = a.model != "elastica";
+  options.strip_width = units::MmToM(a.width_mm);
+  const bool run_elastica = options.run_elastica, run_shell = options.run_shell;
   const PhotoInputOptions photo = a.photo.Options();
   const std::string report_path = (std::filesystem::path(a.out_dir) / "validate.json").string();
   const std::string png_path = (std::filesystem::path(a.out_dir) / "validate.png").string();
@@ -268,11 +286,13 @@ void Run(const ValidateArgs& a) {
   // Valid photo flags with profiles only are not an error (textile fit takes them too, and a
   // glob may or may not match photos), but the run does not use them: say so.
   std::string note;
+  nlohmann::json notes = nlohmann::json::array();
   if (!any_photo && !a.photo_flags_given.empty()) {
     note = "no input is a photo: ";
     for (size_t f = 0; f < a.photo_flags_given.size(); ++f)
       note += (f ? ", " : "") + a.photo_flags_given[f];
     note += " not used";
+    notes.push_back({{"code", "photo_flags_unused"}, {"text", note}});
   }
   const OutputFolder folder(a.out_dir);  // made when the files are committed
   // Fail fast on an unusable folder; the three files appear together or not at all.
@@ -283,95 +303,38 @@ void Run(const ValidateArgs& a) {
 
   std::vector<Profile> profiles;
   for (const auto& in : loaded) profiles.push_back(in.profile);
-  // The fit textile fit runs: a tilted rig is found and fitted with its rotation (and the
-  // simulated curves below are turned with it).
-  DirectFitOptions fit_options;
-  std::vector<std::string> fit_notes;
-  const DirectFitSummary fit =
-      FitDirectCheckingTilt(profiles, rho, DirectFitOptions{}, &fit_notes, &fit_options);
-  if (!fit.converged || !fit.law) throw ComputeError("fit: " + fit.message);
-  for (const std::string& n : fit_notes) note += (note.empty() ? "" : "; ") + n;
-  const BendingLaw& law = *fit.law;
-  // Only a law a material file accepts is worth simulating (as textile fit checks): a fit to a
-  // straight or vertical strip can run to constants no fabric has.
-  Material fitted;
-  fitted.name = "validated fit";
-  fitted.areal_density = rho;
-  fitted.bending = law;
-  try {
-    ParseMaterialJson(MaterialToJson(fitted).dump(), "fitted law");
-  } catch (const InputError& e) {
-    throw ComputeError(std::string("fit gave an implausible law: ") + e.what());
+  // The fit textile fit runs (a tilted rig is found and fitted with its rotation), the same
+  // cantilevers simulated, and each profile predicted by the law fitted to the others.
+  const ValidationSummary v = ValidateFit(profiles, units::GsmToSi(a.gsm), options);
+  if (!v.completed) throw ComputeError(v.message);
+  const DirectFitSummary& fit = v.fit;
+  const BendingLaw& law = v.material.bending;
+  std::string fit_note;  // as textile fit's report has it: the fit's own notes only
+  std::vector<std::string> holdout_notes;
+  for (const ValidationNote& n : v.notes) {
+    notes.push_back({{"code", ValidationNoteCodeName(n.code)}, {"text", n.text}});
+    if (n.code == ValidationNoteCode::kFit)
+      fit_note += (fit_note.empty() ? "" : "; ") + n.text;
+    else if (n.code != ValidationNoteCode::kHeldOutFitFailed)  // the held-out lines say it
+      holdout_notes.push_back(n.text);
   }
-
-  // The same cantilevers simulated: the fitted law at each photo's overhang. The overhang is the
-  // fitted L_i (the arc length of noisy data is biased long: 0.1 mm noise on 0.6 mm spacing
-  // lengthens it by ~3 %), and the mid-line offset at the edge is the fitted one. The shell is
-  // the 3D engine on a strip --width-mm wide (acpm_shell.h, SolveShellCantilever).
-  const double tol = units::MmToM(a.tolerance_mm);
-  std::vector<Check> checks;
-  bool all_pass = true;
-  std::string shell_notes;
-  int shell_solves = 0;
-  for (size_t i = 0; i < profiles.size(); ++i) {
-    Check k;
-    k.source = loaded[i].source;
-    k.from_photo = loaded[i].from_photo;
-    k.data_length = profiles[i].s.back();
-    k.overhang = fit.profiles[i].overhang;
-    if (run_elastica) {
-      k.elastica.run = true;
-      k.elastica.c =
-          CompareWithElastica(law, rho, profiles[i], k.overhang, fit.offset, fit.rotation);
-      Grade(tol, a.tolerance_mm, &k.elastica);
-    }
-    if (run_shell) {
-      const ShellCantilever sc = SolveShellCantilever(fitted, k.overhang, units::MmToM(a.width_mm));
-      if (!sc.converged) throw ComputeError(k.source + ": " + sc.message);
-      k.shell.run = true;
-      // The shell's curve turned by the fitted rig rotation about the edge (0 for a level rig).
-      std::vector<double> sx(sc.x.size()), sy(sc.y.size());
-      const double cr = std::cos(fit.rotation), sr = std::sin(fit.rotation);
-      for (size_t j = 0; j < sc.x.size(); ++j) {
-        sx[j] = cr * sc.x[j] - sr * sc.y[j];
-        sy[j] = sr * sc.x[j] + cr * sc.y[j];
-      }
-      k.shell.c = CompareWithCurve(profiles[i], sx, sy, fit.offset);
-      k.shell.solves = sc.solves;
-      k.shell.notes = sc.notes;
-      shell_notes = sc.notes;
-      shell_solves += sc.solves;
-      Grade(tol, a.tolerance_mm, &k.shell);
-      if (run_elastica) {
-        // How far the shell's curve lies from the elastica's (both lifted by the offset).
-        std::vector<double> lifted = sy;
-        for (double& y : lifted) y += fit.offset;
-        k.model_gap = MaxDistanceToPolyline(k.elastica.c.model_x, k.elastica.c.model_y, sx, lifted);
-      }
-    }
-    std::vector<std::string> why;
-    for (const auto* m : {&k.elastica, &k.shell})
-      if (m->run && !m->pass) why.push_back((m == &k.elastica ? "elastica: " : "shell: ") + m->why);
-    k.pass = why.empty();
-    for (size_t f = 0; f < why.size(); ++f) k.why += (f ? "; " : "") + why[f];
-    all_pass = all_pass && k.pass;
-    checks.push_back(k);
-  }
+  if (!fit_note.empty()) note += (note.empty() ? "" : "; ") + fit_note;
+  const bool holdout_pass = v.holdout_verdict != HoldoutVerdict::kFail;
 
   nlohmann::json per = nlohmann::json::array();
-  for (const auto& k : checks) {
+  for (size_t i = 0; i < v.profiles.size(); ++i) {
+    const ProfileValidation& k = v.profiles[i];
     per.push_back({{"source", k.source},
-                   {"from_photo", k.from_photo},
+                   {"from_photo", loaded[i].from_photo},
                    {"data_length_mm", units::MToMm(k.data_length)},
                    {"overhang_mm", units::MToMm(k.overhang)},
                    {"elastica", ModelJson(k.elastica)},
                    {"shell", ModelJson(k.shell)},
-                   {"shell_vs_elastica_max_mm", std::isfinite(k.model_gap)
-                                                    ? nlohmann::json(units::MToMm(k.model_gap))
-                                                    : nlohmann::json()},
+                   {"shell_vs_elastica_max_mm", MmOrNull(k.model_gap)},
                    {"pass", k.pass},
                    {"why", k.why}});
   }
+  const std::string shell_notes = v.shell_notes;
   nlohmann::json report = {
       {"inputs", a.inputs},
       {"areal_density_gsm", a.gsm},
@@ -379,12 +342,9 @@ void Run(const ValidateArgs& a) {
       {"fit",
        {{"rms_mm", units::MToMm(fit.rms)},
         {"offset_mm", units::MToMm(fit.offset)},
-        {"b1_sd_kes", std::isfinite(fit.b1_sd) ? nlohmann::json(units::SiStiffnessToKes(fit.b1_sd))
-                                               : nlohmann::json()},
-        {"b2_sd_kes", std::isfinite(fit.b2_sd) ? nlohmann::json(units::SiStiffnessToKes(fit.b2_sd))
-                                               : nlohmann::json()},
-        {"c1_sd_kes", std::isfinite(fit.c1_sd) ? nlohmann::json(units::SiQuadraticToKes(fit.c1_sd))
-                                               : nlohmann::json()},
+        {"b1_sd_kes", OrNull(units::SiStiffnessToKes(fit.b1_sd))},
+        {"b2_sd_kes", OrNull(units::SiStiffnessToKes(fit.b2_sd))},
+        {"c1_sd_kes", OrNull(units::SiQuadraticToKes(fit.c1_sd))},
         {"observability", fit.observability}}},
       {"models",
        {{"elastica", run_elastica ? "simulated" : "not run (--model shell)"},
@@ -396,26 +356,36 @@ void Run(const ValidateArgs& a) {
         {"max_mm", kMaxOverRms * a.tolerance_mm},
         {"tip_mm", kMaxOverRms * a.tolerance_mm}}},
       {"profiles", per},
-      {"verdict", all_pass ? "pass" : "fail"},
+      {"verdict", v.pass ? "pass" : "fail"},
+      {"holdout_method",
+       "leave-one-out: each profile predicted at its fitted overhang by the law, offset and "
+       "rotation fitted to the other profiles, graded by the tolerance; sigma: that fit's "
+       "covariance through the elastica's sensitivities (docs/validation.md)"},
+      {"holdout", HoldoutJson(v)},
+      {"holdout_verdict", HoldoutVerdictName(v.holdout_verdict)},
       {"note", note.empty() ? nlohmann::json() : nlohmann::json(note)},
+      {"notes", notes},
       {"png", png_path},
       {"material", material_path}};
+  const bool all_pass = v.pass && holdout_pass;
   if (all_pass || !a.strict) {
-    fitted.fit = FitReport(fit, fit_options, loaded, a.gsm);
-    std::string fit_note;  // as textile fit's report has it: the fit's own notes only
-    for (const std::string& n : fit_notes) fit_note += (fit_note.empty() ? "" : "; ") + n;
+    Material fitted = v.material;
+    fitted.fit = FitReport(fit, v.fit_options, loaded, a.gsm);
     fitted.fit["note"] = fit_note.empty() ? nlohmann::json() : nlohmann::json(fit_note);
     fitted.fit["validate"] = report_path;
-    fitted.fit["verdict"] = all_pass ? "pass" : "fail";
+    fitted.fit["verdict"] = v.pass ? "pass" : "fail";
+    fitted.fit["holdout_verdict"] = HoldoutVerdictName(v.holdout_verdict);
     material_file.Write(MaterialToJson(fitted).dump(2) + "\n");
-    Plot(checks, profiles, law, a.tolerance_mm, all_pass, png_file);
+    Plot(v, profiles, png_file);
     report_file.Write(report.dump(2) + "\n");
     outputs.Commit();
   }
   if (!all_pass && a.strict) {
     std::string why;
-    for (const auto& k : checks)
+    for (const auto& k : v.profiles)
       if (!k.pass) why += (why.empty() ? "" : "; ") + k.source + ": " + k.why;
+    for (const auto& h : v.holdout)
+      if (!h.ok) why += (why.empty() ? "" : "; ") + h.source + " held out: " + h.why;
     throw ComputeError("validation failed (--strict): " + why);
   }
 
@@ -423,34 +393,66 @@ void Run(const ValidateArgs& a) {
     PrintJson(report);
     return;
   }
+  const double tol_mm = a.tolerance_mm;
   std::cout << "fitted law: b1 = " << Num(law.b1_kes(), 5)
             << " gf·cm, b2 = " << Num(law.b2_kes(), 5) << " gf·cm, c1 = " << Num(law.c1_kes(), 5)
             << " gf·cm² (fit rms " << Num(units::MToMm(fit.rms), 3) << " mm, offset "
             << Num(units::MToMm(fit.offset), 3) << " mm)\n"
-            << "simulated at each fitted overhang with " << (run_elastica ? "the elastica" : "")
-            << (run_elastica && run_shell ? " and " : "")
-            << (run_shell ? "the shell (" + shell_notes + "; " + std::to_string(shell_solves) +
+            << "goodness of fit: simulated at each fitted overhang with "
+            << (run_elastica ? "the elastica" : "") << (run_elastica && run_shell ? " and " : "")
+            << (run_shell ? "the shell (" + shell_notes + "; " + std::to_string(v.shell_solves) +
                                 " static solves in all)"
                           : "")
             << "\n";
-  const auto line = [](const char* name, const ModelCheck& m) {
-    std::cout << "    " << name << ": rms " << Num(units::MToMm(m.c.rms), 3) << " mm, max "
-              << Num(units::MToMm(m.c.max), 3) << " mm, tip (" << Num(units::MToMm(m.c.tip_dx), 3)
-              << ", " << Num(units::MToMm(m.c.tip_dy), 3) << ") mm  "
-              << (m.pass ? "ok" : "FAIL: " + m.why) << "\n";
+  const auto figures = [](const ModelComparison& m) {
+    const ProfileComparison& c = m.comparison;
+    return "rms " + Num(units::MToMm(c.rms), 3) + " mm, max " + Num(units::MToMm(c.max), 3) +
+           " mm, tip (" + Num(units::MToMm(c.tip_dx), 3) + ", " + Num(units::MToMm(c.tip_dy), 3) +
+           ") mm  " + (m.pass ? "ok" : "FAIL: " + m.why);
   };
-  for (const auto& k : checks) {
+  for (const auto& k : v.profiles) {
     std::cout << "  " << k.source << ": L = " << Num(units::MToMm(k.overhang), 5) << " mm";
     if (std::isfinite(k.model_gap))
       std::cout << ", shell within " << Num(units::MToMm(k.model_gap), 3) << " mm of the elastica";
     std::cout << "\n";
-    if (k.elastica.run) line("elastica", k.elastica);
-    if (k.shell.run) line("shell   ", k.shell);
+    if (k.elastica.run) std::cout << "    elastica: " << figures(k.elastica) << "\n";
+    if (k.shell.run) std::cout << "    shell   : " << figures(k.shell) << "\n";
+  }
+  if (!v.holdout.empty()) {
+    std::cout << "held out: each profile predicted by the law fitted to the others, at its "
+                 "fitted overhang (± 1σ of the prediction)\n";
+    const auto pm = [](double value, double sigma) {
+      return Num(units::MToMm(value), 3) + " ± " + Num(units::MToMm(sigma), 2);
+    };
+    for (const HeldOutProfile& h : v.holdout) {
+      std::cout << "  " << h.source << ": L = " << Num(units::MToMm(h.overhang), 5) << " mm";
+      if (!h.predicted) {
+        std::cout << ", not predicted: " << h.why << "\n";
+        continue;
+      }
+      std::cout << ", law without it b1 = " << Num(h.law->b1_kes(), 4)
+                << ", b2 = " << Num(h.law->b2_kes(), 4) << ", c1 = " << Num(h.law->c1_kes(), 4)
+                << "\n";
+      for (const auto& [name, m] :
+           {std::pair{"elastica", &h.elastica}, std::pair{"shell   ", &h.shell}}) {
+        if (!m->check.run) continue;
+        const ProfileComparison& c = m->check.comparison;
+        std::cout << "    " << name << ": rms " << pm(c.rms, m->sigma.rms) << " mm, max "
+                  << pm(c.max, m->sigma.max) << " mm, tip "
+                  << pm(std::hypot(c.tip_dx, c.tip_dy), m->sigma.tip) << " mm  "
+                  << (m->check.pass ? "ok" : "FAIL: " + m->check.why) << "\n";
+      }
+    }
   }
   if (!note.empty()) std::cout << "note: " << note << "\n";
-  std::cout << "verdict: " << (all_pass ? "PASS" : "FAIL") << " (tolerance: rms ≤ "
-            << Num(a.tolerance_mm) << " mm, max and tip ≤ " << Num(kMaxOverRms * a.tolerance_mm)
-            << " mm)\nwrote " << report_path << ", " << png_path << ", " << material_path << "\n";
+  for (const std::string& n : holdout_notes) std::cout << "note: " << n << "\n";
+  std::cout << "goodness of fit: " << (v.pass ? "PASS" : "FAIL") << " (tolerance: rms ≤ "
+            << Num(tol_mm) << " mm, max and tip ≤ " << Num(kMaxOverRms * tol_mm) << " mm)\n"
+            << "held out: "
+            << (v.holdout_verdict == HoldoutVerdict::kNone ? "nothing (one profile)"
+                : holdout_pass                             ? "PASS (the same tolerance)"
+                                                           : "FAIL (the same tolerance)")
+            << "\nwrote " << report_path << ", " << png_path << ", " << material_path << "\n";
 }
 
 }  // namespace
@@ -460,7 +462,8 @@ void RegisterValidate(CLI::App& app) {
   CLI::App* sub = AddSubcommand(
       app, "validate",
       "Photos or profiles -> direct fit -> the same cantilevers simulated -> measured vs simulated "
-      "(RMS, max, tip, verdict), report JSON + PNG",
+      "(RMS, max, tip: goodness of fit), and each profile predicted by the law fitted to the "
+      "others (held out); verdicts, report JSON + PNG",
       "textile validate samples/profiles/pabst-fig8_L0*.profile.csv --gsm 200 -o out/validate\n"
       "  textile validate strip_*.jpg --rig rig.json --gsm 200 -o out/validate");
   sub->add_option(
@@ -479,7 +482,9 @@ void RegisterValidate(CLI::App& app) {
       ->check(CLI::IsMember({"both", "elastica", "shell"}));
   sub->add_option("--width-mm", a->width_mm,
                   "Strip width for the shell model [mm], in [5, 200]; default 25");
-  sub->add_flag("--strict", a->strict, "A failed validation is an error (exit 3, nothing written)");
+  sub->add_flag("--strict", a->strict,
+                "A failed verdict, goodness of fit or held out, is an error (exit 3, nothing "
+                "written)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   AddPhotoFlags(sub, &a->photo);
   CLI::Option* width = sub->get_option("--width-mm");

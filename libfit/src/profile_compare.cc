@@ -11,21 +11,36 @@
 
 namespace textile {
 
-ProfileComparison CompareWithElastica(const BendingLaw& law, double areal_density,
-                                      const Profile& measured, double overhang, double offset,
-                                      double rotation, int curve_samples) {
-  CheckProfile(measured);
-  if (!(overhang > 0.0) || !std::isfinite(overhang)) {
-    throw InputError(measured.source + ": overhang must be a finite length > 0");
-  }
-  internal::ProfileModel model(measured, areal_density, curve_samples, 1e-10);
+namespace {
+
+// The model of `measured` evaluated at the law (with its derivatives when `jacobians`); throws
+// as CompareWithElastica.
+void SolveModel(internal::ProfileModel* model, const BendingLaw& law, const Profile& measured,
+                double overhang, double offset, double rotation, bool jacobians) {
   // The model's parametrisation (ln b1, ln b2, ln κ0) holds every law but c1 = 0 with b1 ≠ b2
   // exactly; that one is approximated by κ0 = 1e6 /m, far beyond any textile curvature.
   const auto p = internal::ParametersFromLaw(law);
   const double rig[2] = {offset, rotation};
-  if (!model.Update(p.data(), &overhang, rig, false)) {
+  if (!model->Update(p.data(), &overhang, rig, jacobians)) {
     throw ComputeError(measured.source + ": the elastica did not converge for this law");
   }
+}
+
+void CheckOverhang(const Profile& measured, double overhang) {
+  CheckProfile(measured);
+  if (!(overhang > 0.0) || !std::isfinite(overhang)) {
+    throw InputError(measured.source + ": overhang must be a finite length > 0");
+  }
+}
+
+}  // namespace
+
+ProfileComparison CompareWithElastica(const BendingLaw& law, double areal_density,
+                                      const Profile& measured, double overhang, double offset,
+                                      double rotation, int curve_samples) {
+  CheckOverhang(measured, overhang);
+  internal::ProfileModel model(measured, areal_density, curve_samples, 1e-10);
+  SolveModel(&model, law, measured, overhang, offset, rotation, false);
   ProfileComparison c;
   double s2 = 0.0;
   for (int j = 0; j < model.num_points(); ++j) {
@@ -39,6 +54,46 @@ ProfileComparison CompareWithElastica(const BendingLaw& law, double areal_densit
   c.clamp_curvature = model.solution().clamp_curvature;
   model.ModelCurve(&c.model_x, &c.model_y);
   return c;
+}
+
+CurveSpread ElasticaSpread(const BendingLaw& law, double areal_density, const Profile& measured,
+                           double overhang, double offset, double rotation,
+                           const Eigen::Matrix3d& covariance, int curve_samples) {
+  CheckOverhang(measured, overhang);
+  if (!covariance.allFinite()) {
+    throw InputError(measured.source + ": the law's covariance has a non-finite entry");
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double b1 = law.b1(), b2 = law.b2(), c1 = law.c1(), k0 = law.kappa0();
+  if (!(k0 > internal::kMinKappa0) || !(k0 < internal::kMaxKappa0)) return {nan, nan, nan};
+  internal::ProfileModel model(measured, areal_density, curve_samples, 1e-10);
+  SolveModel(&model, law, measured, overhang, offset, rotation, true);
+  // ∂(ln b1, ln b2, ln κ0)/∂(b1, b2, c1) at the law, κ0 = (b2 − b1) / (2 c1): the model's
+  // gradients are in its own parameters, the covariance in the constants.
+  Eigen::Matrix3d dp;
+  dp << 1.0 / b1, 0.0, 0.0,  //
+      0.0, 1.0 / b2, 0.0,    //
+      -1.0 / (2.0 * k0 * c1), 1.0 / (2.0 * k0 * c1), -1.0 / c1;
+  const auto to_constants = [&](const std::array<double, 6>& g) -> Eigen::RowVector3d {
+    // [mm per unit of p] -> [m per unit of (b1, b2, c1)]
+    return Eigen::RowVector3d(g[0], g[1], g[2]) * dp * 1e-3;
+  };
+  CurveSpread spread;
+  double s2 = 0.0;
+  for (int j = 0; j < model.num_points(); ++j) {
+    const Eigen::RowVector3d J = to_constants(model.gradient(j));
+    const double var = std::max(0.0, (J * covariance * J.transpose())(0, 0));
+    s2 += var;
+    spread.max = std::max(spread.max, std::sqrt(var));
+  }
+  spread.rms = std::sqrt(s2 / model.num_points());
+  double tip2 = 0.0;
+  for (int c = 0; c < 2; ++c) {
+    const Eigen::RowVector3d J = to_constants(model.tip_gradient()[c]);
+    tip2 += std::max(0.0, (J * covariance * J.transpose())(0, 0));
+  }
+  spread.tip = std::sqrt(tip2);
+  return spread;
 }
 
 namespace {

@@ -94,5 +94,70 @@ TEST(CompareWithCurve, RefusesBadCurves) {
   EXPECT_THROW(CompareWithCurve(measured, {0.0, 0.01}, {0.0, -0.01}, INFINITY), InputError);
 }
 
+// Noise-free points on the curve of `law` at `overhang`, offset and rotation 0.
+Profile OnTheCurve(const BendingLaw& law, double rho, double overhang) {
+  ElasticaOptions eo;
+  eo.num_samples = 81;
+  const ElasticaProfile e = SolveHeavyElastica(law, rho, overhang, eo);
+  EXPECT_TRUE(e.converged) << e.message;
+  Profile p;
+  p.source = "on the curve";
+  p.s = e.s;
+  p.x = e.x;
+  p.y = e.y;
+  return p;
+}
+
+// The spread is the curve's motion: with points on the curve of a law and a covariance h² in one
+// constant alone, moving that constant by h moves the curve by as much as the spread says: the
+// comparison of the points with the moved law's curve has rms ≈ spread.rms, max ≈ spread.max,
+// tip distance ≈ spread.tip. h is 0.1 % of the constant: the second-order term is then ~0.3 %
+// of the motion (3.4 % at h = 1 %), inside the 0.5 % allowed.
+TEST(ElasticaSpread, IsTheCurvesMotionUnderAOneSigmaStep) {
+  const BendingLaw law = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+  const double rho = 0.2, overhang = 0.08;
+  const Profile measured = OnTheCurve(law, rho, overhang);
+  const double constants[3] = {law.b1(), law.b2(), law.c1()};
+  for (int k = 0; k < 3; ++k) {
+    const double h = 1e-3 * std::abs(constants[k]);
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    cov(k, k) = h * h;
+    const CurveSpread spread = ElasticaSpread(law, rho, measured, overhang, 0.0, 0.0, cov);
+    double moved[3] = {law.b1(), law.b2(), law.c1()};
+    moved[k] += h;
+    const ProfileComparison c = CompareWithElastica(
+        BendingLaw::FromSi(moved[0], moved[1], moved[2]), rho, measured, overhang, 0.0);
+    EXPECT_GT(spread.rms, 1e-7) << k;  // each constant moves an 80 mm strip measurably
+    EXPECT_NEAR(spread.rms, c.rms, 0.005 * c.rms + 1e-9) << k;
+    EXPECT_NEAR(spread.max, c.max, 0.005 * c.max + 1e-9) << k;
+    EXPECT_NEAR(spread.tip, std::hypot(c.tip_dx, c.tip_dy), 0.005 * spread.tip + 1e-9) << k;
+    // Linear in σ: four times the variance, twice the spread.
+    const CurveSpread twice = ElasticaSpread(law, rho, measured, overhang, 0.0, 0.0, 4.0 * cov);
+    EXPECT_NEAR(twice.rms, 2.0 * spread.rms, 1e-9 * spread.rms) << k;
+  }
+  // No uncertainty, no spread.
+  const CurveSpread none =
+      ElasticaSpread(law, rho, measured, overhang, 0.0, 0.0, Eigen::Matrix3d::Zero());
+  EXPECT_EQ(none.rms, 0.0);
+  EXPECT_EQ(none.tip, 0.0);
+}
+
+TEST(ElasticaSpread, LinearLawsAndBadCovariancesAreNotSpread) {
+  const double rho = 0.2, overhang = 0.06;
+  const BendingLaw law = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+  const Profile measured = OnTheCurve(law, rho, overhang);
+  const Eigen::Matrix3d cov = Eigen::Matrix3d::Identity() * 1e-16;
+  // κ0 = ∞ (c1 = 0) and κ0 = 0 (b1 = b2): the fit's parameters do not reach them smoothly.
+  for (const BendingLaw& linear :
+       {BendingLaw::FromKes(0.1, 0.09, 0.0), BendingLaw::FromKes(0.1, 0.1, 0.01)}) {
+    const CurveSpread s = ElasticaSpread(linear, rho, measured, overhang, 0.0, 0.0, cov);
+    EXPECT_TRUE(std::isnan(s.rms) && std::isnan(s.max) && std::isnan(s.tip));
+  }
+  Eigen::Matrix3d bad = cov;
+  bad(1, 2) = std::nan("");
+  EXPECT_THROW(ElasticaSpread(law, rho, measured, overhang, 0.0, 0.0, bad), InputError);
+  EXPECT_THROW(ElasticaSpread(law, rho, measured, -1.0, 0.0, 0.0, cov), InputError);
+}
+
 }  // namespace
 }  // namespace textile

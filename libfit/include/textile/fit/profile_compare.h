@@ -10,6 +10,8 @@
 
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "textile/fit/profile.h"
 #include "textile/sim/bending_law.h"
 
@@ -40,6 +42,27 @@ ProfileComparison CompareWithElastica(const BendingLaw& law, double areal_densit
 // the end's tangent line). clamp_curvature is NaN. Throws InputError for bad arguments.
 ProfileComparison CompareWithCurve(const Profile& measured, const std::vector<double>& curve_x,
                                    const std::vector<double>& curve_y, double offset);
+
+// How far the simulated curve of CompareWithElastica moves when the law moves within a
+// covariance of {b1, b2, c1} [SI] (DirectFitSummary::covariance), the overhang, offset and
+// rotation held. Linear propagation through the elastica's variational equations (the direct
+// fit's own analytic derivatives, docs/fitting.md): J_j = ∂(normal distance of point j)/∂(b1,
+// b2, c1), and the curve's normal displacement at point j has variance σ_j² = J_j C J_jᵀ; the
+// tip's 2×2 covariance is J_tip C J_tipᵀ. Each figure bounds how far the comparison's own
+// figure can move when the curve moves by it (rms: triangle inequality; max; tip distance).
+struct CurveSpread {
+  double rms = 0.0;  // √(mean σ_j²) over the measured points [m]
+  double max = 0.0;  // max σ_j [m]
+  double tip = 0.0;  // √trace of the tip's covariance [m]
+};
+
+// The spread of CompareWithElastica(law, areal_density, measured, overhang, offset, rotation)
+// under `covariance` (3×3, symmetric positive semi-definite, SI). NaN figures for a law the
+// fit's parametrisation (ln b1, ln b2, ln κ0) does not reach smoothly: κ0 = 0 (b1 = b2) or ∞
+// (c1 = 0). Throws as CompareWithElastica; InputError for a non-finite covariance.
+CurveSpread ElasticaSpread(const BendingLaw& law, double areal_density, const Profile& measured,
+                           double overhang, double offset, double rotation,
+                           const Eigen::Matrix3d& covariance, int curve_samples = 201);
 
 }  // namespace textile
 

@@ -294,6 +294,27 @@ std::string DescribeMisfit(const std::vector<Profile>& profiles,
   return s.str();
 }
 
+// What a fit that did not converge left: its last law and rms, so that a user sees whether it
+// was close (a cap too tight) or far (a law that cannot follow the data).
+std::string LastIterateSummary(const std::vector<std::unique_ptr<ProfileModel>>& models,
+                               std::array<double, 3> law_p, std::vector<double> lengths,
+                               std::array<double, 2> rig) {
+  double sum2 = 0.0;
+  int n = 0;
+  for (size_t i = 0; i < models.size(); ++i) {
+    if (!models[i]->Update(law_p.data(), &lengths[i], rig.data(), false)) return "";
+    for (int j = 0; j < models[i]->num_points(); ++j, ++n)
+      sum2 += models[i]->residual(j) * models[i]->residual(j);
+  }
+  std::ostringstream s;
+  s.precision(4);
+  const BendingLaw law = internal::LawFromParameters(law_p.data());
+  s << "; at its last step b1 = " << law.b1_kes() << ", b2 = " << law.b2_kes()
+    << " gf·cm, kappa0 = " << units::SiCurvatureToKes(law.kappa0()) << " /cm, rms "
+    << std::sqrt(sum2 / std::max(1, n)) << " mm";
+  return s.str();
+}
+
 DirectFitSummary FitDirectFrom(const std::vector<Profile>& profiles, double areal_density,
                                const DirectFitOptions& options, const LawStart& start) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -419,7 +440,8 @@ DirectFitSummary FitDirectFrom(const std::vector<Profile>& profiles, double area
   };
   if (!solver_summary.IsSolutionUsable() ||
       solver_summary.termination_type == ceres::NO_CONVERGENCE) {
-    out.message = "the fit did not converge (" + solver_summary.message + ")";
+    out.message = "the fit did not converge (" + solver_summary.message + ")" +
+                  LastIterateSummary(models, law_p, lengths, rig);
     return finish();
   }
   // Final state, with jacobians, for reports and the covariance.

@@ -340,7 +340,9 @@ TEST(DirectFit, RecoversTechnicalFabricsAndCompositesAcrossTheRange) {
     EXPECT_LT(std::abs(fit.law->b1_kes() / c.f.b1 - 1.0), 0.15);
     EXPECT_LT(fit.rms, 0.13e-3);
     EXPECT_TRUE(fit.fit_pattern.empty()) << fit.fit_pattern;
-    if (c.f.b1 != c.f.b2) EXPECT_LT(std::abs(fit.law->b2_kes() / c.f.b2 - 1.0), 0.02);
+    if (c.f.b1 != c.f.b2) {
+      EXPECT_LT(std::abs(fit.law->b2_kes() / c.f.b2 - 1.0), 0.02);
+    }
   }
 }
 
@@ -395,6 +397,9 @@ TEST(DirectFit, IterationCapReportsNotConvergedWithoutALaw) {
   EXPECT_FALSE(fit.converged);
   EXPECT_FALSE(fit.law.has_value());
   EXPECT_NE(fit.message.find("did not converge"), std::string::npos) << fit.message;
+  // Where it stopped, so that a user sees how far it was: the last law and rms.
+  EXPECT_NE(fit.message.find("at its last step b1 = "), std::string::npos) << fit.message;
+  EXPECT_NE(fit.message.find(" mm"), std::string::npos) << fit.message;
 }
 
 }  // namespace

@@ -63,11 +63,6 @@ class LawPrior : public ceres::SizedCostFunction<2, 3> {
   double w_, log_kappa_ref_;
 };
 
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 std::string Mm(double m) {
   std::ostringstream s;
@@ -192,22 +187,6 @@ std::optional<LawStart> ClappStart(const std::vector<Profile>& profiles, double 
 
 DirectFitSummary FitDirectFrom(const std::vector<Profile>& profiles, double areal_density,
                                const DirectFitOptions& options, const LawStart& start);
-
-// The RMS normal distance of each point from the line through its neighbours, divided by
-// √1.5 (white noise σ gives σ √1.5 there), median-based so that fibres do not count: the
-// points' own scatter, against which a fit's rms says whether the law follows the data [m].
-double PointScatter(const Profile& p) {
-  std::vector<double> d;
-  for (size_t i = 1; i + 1 < p.size(); ++i) {
-    const double tx = p.x[i + 1] - p.x[i - 1], ty = p.y[i + 1] - p.y[i - 1];
-    const double t = std::hypot(tx, ty);
-    if (!(t > 0.0)) continue;
-    const double mx = 0.5 * (p.x[i + 1] + p.x[i - 1]), my = 0.5 * (p.y[i + 1] + p.y[i - 1]);
-    d.push_back(std::abs((p.x[i] - mx) * ty - (p.y[i] - my) * tx) / t);
-  }
-  if (d.empty()) return 0.0;
-  return 1.4826 * Median(d) / std::sqrt(1.5);
-}
 
 // A fit whose rms exceeds this many times the points' scatter (and kLackOfFitFloor) is one the
 // law does not follow: the fit tries its other start, and the report says where it misses.
@@ -479,7 +458,7 @@ DirectFitSummary FitDirectFrom(const std::vector<Profile>& profiles, double area
   }
   out.rms = std::sqrt(sum2 / count);
   double scatter2 = 0.0;
-  for (const Profile& p : profiles) scatter2 += std::pow(PointScatter(p), 2);
+  for (const Profile& p : profiles) scatter2 += std::pow(ProfilePointScatter(p), 2);
   const double scatter = std::sqrt(scatter2 / profiles.size());
   out.cost = solver_summary.final_cost;
   out.offset = rig[0];

@@ -172,4 +172,18 @@ std::string ProfileToCsv(const Profile& p) {
   return out.str();
 }
 
+double ProfilePointScatter(const Profile& p) {
+  std::vector<double> d;
+  for (size_t i = 1; i + 1 < p.size(); ++i) {
+    const double tx = p.x[i + 1] - p.x[i - 1], ty = p.y[i + 1] - p.y[i - 1];
+    const double t = std::hypot(tx, ty);
+    if (!(t > 0.0)) continue;
+    const double mx = 0.5 * (p.x[i + 1] + p.x[i - 1]), my = 0.5 * (p.y[i + 1] + p.y[i - 1]);
+    d.push_back(std::abs((p.x[i] - mx) * ty - (p.y[i] - my) * tx) / t);
+  }
+  if (d.empty()) return 0.0;
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return 1.4826 * d[d.size() / 2] / std::sqrt(1.5);
+}
+
 }  // namespace textile

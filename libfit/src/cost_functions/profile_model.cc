@@ -36,6 +36,48 @@ CurvePoint Hermite(const ElasticaProfile& e, int k, double t) {
 
 }  // namespace
 
+FootPoint FindFootPoint(const ElasticaProfile& e, double dx, double dy) {
+  const int n = static_cast<int>(e.s.size());
+  int best = 0;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < n; ++k) {
+    const double d2 = (e.x[k] - dx) * (e.x[k] - dx) + (e.y[k] - dy) * (e.y[k] - dy);
+    if (d2 < best_d2) best_d2 = d2, best = k;
+  }
+  int seg = std::min(best, n - 2);
+  double t = best == seg ? 0.0 : 1.0;
+  for (int it = 0; it < 8; ++it) {
+    const CurvePoint q = Hermite(e, seg, t);
+    const double h = e.s[seg + 1] - e.s[seg];
+    const double f = (q.x - dx) * q.dx + (q.y - dy) * q.dy;  // ½ d|q - d|²/ds
+    const double step = -f / (q.dx * q.dx + q.dy * q.dy) / h;  // Gauss-Newton in t
+    t += step;
+    if (t < 0.0 && seg > 0) --seg, t += 1.0;
+    else if (t > 1.0 && seg < n - 2) ++seg, t -= 1.0;
+    t = std::clamp(t, 0.0, 1.0);
+    if (std::abs(step) < 1e-12) break;
+  }
+  const CurvePoint q = Hermite(e, seg, t);
+  return {seg, t, q.x, q.y, q.dx, q.dy};
+}
+
+void CurveResiduals(const ElasticaProfile& e, const std::vector<double>& data_x,
+                    const std::vector<double>& data_y, const double* rig,
+                    std::vector<double>* residual, std::array<double, 2>* tip) {
+  const double c = std::cos(rig[1]), s = std::sin(rig[1]);
+  residual->resize(data_x.size());
+  for (size_t j = 0; j < data_x.size(); ++j) {
+    const double ux = data_x[j], uy = data_y[j] - rig[0];
+    const double dx = c * ux + s * uy, dy = -s * ux + c * uy;
+    const FootPoint f = FindFootPoint(e, dx, dy);
+    const double tn = std::hypot(f.dx, f.dy);
+    (*residual)[j] = ((dx - f.x) * (-f.dy / tn) + (dy - f.y) * (f.dx / tn)) * kMmPerM;
+  }
+  const size_t n = e.s.size();
+  const double tx = c * e.x[n - 1] - s * e.y[n - 1], ty = s * e.x[n - 1] + c * e.y[n - 1] + rig[0];
+  *tip = {(tx - data_x.back()) * kMmPerM, (ty - data_y.back()) * kMmPerM};
+}
+
 ProfileModel::ProfileModel(const Profile& profile, double areal_density, int samples, double tol)
     : data_x_(profile.x), data_y_(profile.y), areal_density_(areal_density), samples_(samples),
       tol_(tol) {
@@ -140,26 +182,10 @@ bool ProfileModel::Update(const double* p, const double* length, const double* r
     // Data into the model frame: d' = R(-φ) (d - (0, offset)).
     const double ux = data_x_[j], uy = data_y_[j] - rig[0];
     const double dx = c * ux + s * uy, dy = -s * ux + c * uy;
-    int best = 0;
-    double best_d2 = std::numeric_limits<double>::infinity();
-    for (int k = 0; k < n; ++k) {
-      const double d2 = (e.x[k] - dx) * (e.x[k] - dx) + (e.y[k] - dy) * (e.y[k] - dy);
-      if (d2 < best_d2) best_d2 = d2, best = k;
-    }
-    int seg = std::min(best, n - 2);
-    double t = best == seg ? 0.0 : 1.0;
-    for (int it = 0; it < 8; ++it) {
-      const CurvePoint q = Hermite(e, seg, t);
-      const double h = e.s[seg + 1] - e.s[seg];
-      const double f = (q.x - dx) * q.dx + (q.y - dy) * q.dy;  // ½ d|q - d|²/ds
-      const double step = -f / (q.dx * q.dx + q.dy * q.dy) / h;  // Gauss-Newton in t
-      t += step;
-      if (t < 0.0 && seg > 0) --seg, t += 1.0;
-      else if (t > 1.0 && seg < n - 2) ++seg, t -= 1.0;
-      t = std::clamp(t, 0.0, 1.0);
-      if (std::abs(step) < 1e-12) break;
-    }
-    const CurvePoint q = Hermite(e, seg, t);
+    const FootPoint f = FindFootPoint(e, dx, dy);
+    const int seg = f.seg;
+    const double t = f.t;
+    const CurvePoint q = {f.x, f.y, f.dx, f.dy};
     const double tn = std::hypot(q.dx, q.dy);
     const double nx = -q.dy / tn, ny = q.dx / tn;  // normal, model frame
     residual_[j] = ((dx - q.x) * nx + (dy - q.y) * ny) * kMmPerM;

@@ -18,6 +18,22 @@
 
 namespace textile::internal {
 
+// The nearest point of an elastica curve to d = (dx, dy) (model frame): the nearest sample,
+// then Gauss-Newton on the cubic Hermite segment through it; (x, y) and d/ds there [m].
+struct FootPoint {
+  int seg = 0;
+  double t = 0.0;  // in [0, 1] along the segment
+  double x = 0.0, y = 0.0, dx = 0.0, dy = 0.0;
+};
+FootPoint FindFootPoint(const ElasticaProfile& e, double dx, double dy);
+
+// The residuals ProfileModel computes, without derivatives, for any solved curve: the signed
+// normal distance [mm] of each data point (measurement frame [m]) under the rig (offset [m],
+// rotation [rad]), and the tip (model minus measured, x and y [mm]).
+void CurveResiduals(const ElasticaProfile& e, const std::vector<double>& data_x,
+                    const std::vector<double>& data_y, const double* rig,
+                    std::vector<double>* residual, std::array<double, 2>* tip);
+
 class ProfileModel {
  public:
   // profile: the data [m]; areal_density [kg/m²]; samples: elastica samples along the curve.

@@ -34,6 +34,10 @@ Profile ReadProfileCsv(const std::string& path);
 void CheckProfile(const Profile& profile);
 // CSV text with the header s_mm,x_mm,y_mm, 6 decimals (1 nm).
 std::string ProfileToCsv(const Profile& profile);
+// The points' own scatter [m]: the median distance of each point from the line through its
+// neighbours, as a σ (÷ √1.5, what white noise σ gives there, × 1.4826 for the median), so
+// that fibres do not count. A fit's rms far above it is a law that does not follow the data.
+double ProfilePointScatter(const Profile& profile);
 
 }  // namespace textile
 

@@ -3,13 +3,43 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "cost_functions/profile_model.h"
 #include "law_parameters.h"
+#include "textile/sim/elastica.h"
 #include "textile/sim/error.h"
 #include "textile/sim/polyline.h"
 
 namespace textile {
+namespace {
+
+// A spline law has no (ln b1, ln b2, ln κ0) for the profile model: its strip is solved as it
+// is, turned and lifted into the measurement frame (q = R(φ) c(s) + (0, offset), as the
+// model does), and compared as a curve.
+ProfileComparison CompareSplineStrip(const BendingLaw& law, double areal_density,
+                                     const Profile& measured, double overhang, double offset,
+                                     double rotation, int curve_samples) {
+  ElasticaOptions options;
+  options.rel_tol = 1e-10;
+  options.num_samples = std::max(curve_samples, 2);
+  const ElasticaProfile strip = SolveHeavyElastica(law, areal_density, overhang, options);
+  if (!strip.converged) {
+    throw ComputeError(measured.source +
+                       ": the elastica did not converge for this law: " + strip.message);
+  }
+  const double c = std::cos(rotation), s = std::sin(rotation);
+  std::vector<double> x(strip.x.size()), y(strip.y.size());
+  for (size_t k = 0; k < x.size(); ++k) {
+    x[k] = c * strip.x[k] - s * strip.y[k];
+    y[k] = s * strip.x[k] + c * strip.y[k];
+  }
+  ProfileComparison comparison = CompareWithCurve(measured, x, y, offset);
+  comparison.clamp_curvature = strip.clamp_curvature;
+  return comparison;
+}
+
+}  // namespace
 
 ProfileComparison CompareWithElastica(const BendingLaw& law, double areal_density,
                                       const Profile& measured, double overhang, double offset,
@@ -18,6 +48,9 @@ ProfileComparison CompareWithElastica(const BendingLaw& law, double areal_densit
   if (!(overhang > 0.0) || !std::isfinite(overhang)) {
     throw InputError(measured.source + ": overhang must be a finite length > 0");
   }
+  if (law.is_spline())
+    return CompareSplineStrip(law, areal_density, measured, overhang, offset, rotation,
+                              curve_samples);
   internal::ProfileModel model(measured, areal_density, curve_samples, 1e-10);
   // The model's parametrisation (ln b1, ln b2, ln κ0) holds every law but c1 = 0 with b1 ≠ b2
   // exactly; that one is approximated by κ0 = 1e6 /m, far beyond any textile curvature.

@@ -1,5 +1,5 @@
-// textile law: inspect a material's bending law (κ0, M0, M and B at given curvatures) and
-// plot M-κ and B-κ.
+// textile law: inspect a material's bending law (κ0, M0 or a spline's knots, M and B at given
+// curvatures) and plot M-κ and B-κ.
 
 #include <algorithm>
 #include <cmath>
@@ -28,17 +28,39 @@ struct LawArgs {
   bool json = false;
 };
 
+// Which part of the law κ falls in: the quadratic (a spline's cubic pieces) or the line.
+const char* Branch(const BendingLaw& law, double k) {
+  if (std::abs(k) > law.kappa0()) return "linear";
+  return law.is_spline() ? "spline" : "quadratic";
+}
+
 nlohmann::json PointJson(const BendingLaw& law, double k) {
-  return {{"kappa_per_m", k},
-          {"kappa_per_cm", units::SiCurvatureToKes(k)},
-          {"M_N", law.Moment(k)},
-          {"M_gfcm_per_cm", units::SiMomentToKes(law.Moment(k))},
-          {"B_Nm", law.Stiffness(k)},
-          {"B_gfcm", units::SiStiffnessToKes(law.Stiffness(k))},
-          {"branch", std::abs(k) <= law.kappa0() ? "quadratic" : "linear"}};
+  return {{"kappa_per_m", k},         {"kappa_per_cm", units::SiCurvatureToKes(k)},
+          {"M_N", law.Moment(k)},     {"M_gfcm_per_cm", units::SiMomentToKes(law.Moment(k))},
+          {"B_Nm", law.Stiffness(k)}, {"B_gfcm", units::SiStiffnessToKes(law.Stiffness(k))},
+          {"branch", Branch(law, k)}};
+}
+
+// A spline law: its knots, B(0), and the line past the last knot.
+nlohmann::json SplineLawJson(const BendingLaw& law, const std::vector<double>& kappas) {
+  nlohmann::json j = {{"law", "spline"},
+                      {"B0_gfcm", law.b1_kes()},
+                      {"B0_Nm", law.b1()},
+                      {"kappa_end_per_cm", units::SiCurvatureToKes(law.kappa0())},
+                      {"kappa_end_per_m", law.kappa0()},
+                      {"M_end_gfcm_per_cm", units::SiMomentToKes(law.moment_at_kappa0())},
+                      {"M_end_N", law.moment_at_kappa0()},
+                      {"B_end_gfcm", law.b2_kes()},
+                      {"B_end_Nm", law.b2()}};
+  j["knots"] = nlohmann::json::array();
+  for (double k : law.knot_kappa()) j["knots"].push_back(PointJson(law, k));
+  j["points"] = nlohmann::json::array();
+  for (double k : kappas) j["points"].push_back(PointJson(law, k));
+  return j;
 }
 
 nlohmann::json LawJson(const BendingLaw& law, const std::vector<double>& kappas) {
+  if (law.is_spline()) return SplineLawJson(law, kappas);
   nlohmann::json j = {
       {"b1_gfcm", law.b1_kes()}, {"b2_gfcm", law.b2_kes()}, {"c1_gfcm2", law.c1_kes()},
       {"b1_Nm", law.b1()}, {"b2_Nm", law.b2()}, {"c1_Nm2", law.c1()},
@@ -55,7 +77,32 @@ nlohmann::json LawJson(const BendingLaw& law, const std::vector<double>& kappas)
   return j;
 }
 
+void PrintPoints(const BendingLaw& law, const std::vector<double>& kappas) {
+  std::printf("  %10s %10s %14s %12s %12s %12s  %s\n", "κ [1/cm]", "κ [1/m]", "M [gf·cm/cm]",
+              "M [N]", "B [gf·cm]", "B [N·m]", "branch");
+  for (double k : kappas) {
+    std::printf("  %10.4g %10.4g %14.6g %12.5g %12.6g %12.5g  %s\n", units::SiCurvatureToKes(k), k,
+                units::SiMomentToKes(law.Moment(k)), law.Moment(k),
+                units::SiStiffnessToKes(law.Stiffness(k)), law.Stiffness(k), Branch(law, k));
+  }
+}
+
+void PrintSplineLawText(const std::string& title, const BendingLaw& law,
+                        const std::vector<double>& kappas) {
+  std::cout << title << ": monotone spline through " << law.knot_kappa().size()
+            << " knots (Steffen), B(0) = " << Num(law.b1_kes()) << " gf·cm (" << Num(law.b1())
+            << " N·m)\n  beyond the last knot, kappa = "
+            << Num(units::SiCurvatureToKes(law.kappa0())) << " /cm (" << Num(law.kappa0())
+            << " /m): linear, B = " << Num(law.b2_kes()) << " gf·cm (" << Num(law.b2())
+            << " N·m)\n  knots:\n";
+  PrintPoints(law, law.knot_kappa());
+  std::cout << "  at the curvatures asked:\n";
+  PrintPoints(law, kappas);
+  std::cout.flush();
+}
+
 void PrintLawText(const std::string& title, const BendingLaw& law, const std::vector<double>& kappas) {
+  if (law.is_spline()) return PrintSplineLawText(title, law, kappas);
   std::cout << title << ": b1 = " << Num(law.b1_kes()) << " gf·cm, b2 = " << Num(law.b2_kes())
             << " gf·cm, c1 = " << Num(law.c1_kes()) << " gf·cm²   (SI: " << Num(law.b1()) << ", "
             << Num(law.b2()) << " N·m, " << Num(law.c1()) << " N·m²)\n";
@@ -68,14 +115,7 @@ void PrintLawText(const std::string& title, const BendingLaw& law, const std::ve
               << Num(law.kappa0()) << " /m), M0 = " << Num(units::SiMomentToKes(law.moment0()))
               << " gf·cm/cm (" << Num(law.moment0()) << " N)\n";
   }
-  std::printf("  %10s %10s %14s %12s %12s %12s  %s\n", "κ [1/cm]", "κ [1/m]", "M [gf·cm/cm]",
-              "M [N]", "B [gf·cm]", "B [N·m]", "branch");
-  for (double k : kappas) {
-    std::printf("  %10.4g %10.4g %14.6g %12.5g %12.6g %12.5g  %s\n", units::SiCurvatureToKes(k), k,
-                units::SiMomentToKes(law.Moment(k)), law.Moment(k),
-                units::SiStiffnessToKes(law.Stiffness(k)), law.Stiffness(k),
-                std::abs(k) <= law.kappa0() ? "quadratic" : "linear");
-  }
+  PrintPoints(law, kappas);
   std::cout.flush();
 }
 
@@ -139,6 +179,25 @@ void Plot(const Material& m, const std::string& material_path, double kappa_max,
     sm.color = sb.color = color;
     mk.series.push_back(sm);
     bk.series.push_back(sb);
+    if (law.is_spline()) {
+      chart::Series p{.label = "knots (" + label + ")",
+                      .style = chart::Series::Style::kMarkers,
+                      .color = color};
+      chart::Series pb = p;
+      for (double k : law.knot_kappa()) {
+        if (k > kappa_max) break;
+        p.x.push_back(units::SiCurvatureToKes(k));
+        p.y.push_back(units::SiMomentToKes(law.Moment(k)));
+        pb.x.push_back(units::SiCurvatureToKes(k));
+        pb.y.push_back(units::SiStiffnessToKes(law.Stiffness(k)));
+      }
+      mk.series.push_back(p);
+      bk.series.push_back(pb);
+      mk.notes.push_back(label + ": spline, " + std::to_string(law.knot_kappa().size()) +
+                         " knots, B(0) = " + Num(law.b1_kes(), 4) +
+                         ", B past the last = " + Num(law.b2_kes(), 4) + " gf·cm");
+      continue;
+    }
     if (law.kappa0() > 0.0 && law.kappa0() <= kappa_max) {
       const double k0 = law.kappa0();
       chart::Series p{.label = "κ0 (" + label + ")",
@@ -221,7 +280,9 @@ void Run(const LawArgs& a) {
   const BendingLaw law = m.EffectiveLaw();
   if (kappas.empty()) {
     for (double k : {0.25, 0.5, 1.0, 2.0}) kappas.push_back(units::KesCurvatureToSi(k));
-    if (law.kappa0() > 0.0 && std::isfinite(law.kappa0())) kappas.push_back(law.kappa0());
+    // κ0 of a Pabst law; a spline's knots are listed apart.
+    if (!law.is_spline() && law.kappa0() > 0.0 && std::isfinite(law.kappa0()))
+      kappas.push_back(law.kappa0());
     std::sort(kappas.begin(), kappas.end());
   }
   double kappa_max = units::KesCurvatureToSi(2.0);
@@ -270,7 +331,9 @@ void RegisterLaw(CLI::App& app) {
       app, "law", "Inspect a material's moment-curvature law: kappa0, M0, M and B; plot M-κ and B-κ",
       "textile law --material samples/materials/pabst-fig8.json --kappa 0.5 1 2 --plot law.png");
   sub->add_option("-m,--material", args->material, "Material JSON file (cli.md format)")->required();
-  sub->add_option("-k,--kappa", args->kappa, "Curvatures to evaluate (default 0.25 0.5 1 2 /cm and kappa0)");
+  sub->add_option("-k,--kappa", args->kappa,
+                  "Curvatures to evaluate (default 0.25 0.5 1 2 /cm and kappa0; a spline also "
+                  "lists its knots)");
   sub->add_option("--kappa-unit", args->kappa_unit, "Unit of --kappa: cm (1/cm, KES; default) or m (1/m)")
       ->check(CLI::IsMember({"cm", "m"}));
   sub->add_option("--plot", args->plot, "Write an M-κ / B-κ chart to this PNG file");

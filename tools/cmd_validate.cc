@@ -338,7 +338,7 @@ void Run(const ValidateArgs& a) {
   nlohmann::json report = {
       {"inputs", a.inputs},
       {"areal_density_gsm", a.gsm},
-      {"law_kes", {{"b1", law.b1_kes()}, {"b2", law.b2_kes()}, {"c1", law.c1_kes()}}},
+      {"law_kes", LawToJson(law, false)},
       {"fit",
        {{"rms_mm", units::MToMm(fit.rms)},
         {"offset_mm", units::MToMm(fit.offset)},

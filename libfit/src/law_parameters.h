@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 
 #include "textile/sim/bending_law.h"
@@ -43,7 +44,9 @@ inline BendingLaw LawFromParameters(const double* p) {
   return BendingLaw::FromSi(b1, b2, (b2 - b1) / (2.0 * k0));
 }
 
+// A Pabst law only (a spline has no κ0 = (b2 - b1)/(2 c1): callers route splines elsewhere).
 inline std::array<double, 3> ParametersFromLaw(const BendingLaw& law) {
+  assert(!law.is_spline());
   const double k0 = std::clamp(law.kappa0(), kMinKappa0, kMaxKappa0);
   return {std::log(law.b1()), std::log(law.b2()), std::log(k0)};
 }

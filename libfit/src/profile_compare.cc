@@ -3,15 +3,43 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "cost_functions/profile_model.h"
 #include "law_parameters.h"
+#include "textile/sim/elastica.h"
 #include "textile/sim/error.h"
 #include "textile/sim/polyline.h"
 
 namespace textile {
 
 namespace {
+
+// A spline law has no (ln b1, ln b2, ln κ0) for the profile model: its strip is solved as it
+// is, turned and lifted into the measurement frame (q = R(φ) c(s) + (0, offset), as the
+// model does), and compared as a curve.
+ProfileComparison CompareSplineStrip(const BendingLaw& law, double areal_density,
+                                     const Profile& measured, double overhang, double offset,
+                                     double rotation, int curve_samples) {
+  ElasticaOptions options;
+  options.rel_tol = 1e-10;
+  options.num_samples = std::max(curve_samples, 2);
+  const ElasticaProfile strip = SolveHeavyElastica(law, areal_density, overhang, options);
+  if (!strip.converged) {
+    throw ComputeError(measured.source +
+                       ": the elastica did not converge for this law: " + strip.message);
+  }
+  const double c = std::cos(rotation), s = std::sin(rotation);
+  std::vector<double> x(strip.x.size()), y(strip.y.size());
+  for (size_t k = 0; k < x.size(); ++k) {
+    x[k] = c * strip.x[k] - s * strip.y[k];
+    y[k] = s * strip.x[k] + c * strip.y[k];
+  }
+  ProfileComparison comparison = CompareWithCurve(measured, x, y, offset);
+  comparison.clamp_curvature = strip.clamp_curvature;
+  return comparison;
+}
+
 
 // The model of `measured` evaluated at the law (with its derivatives when `jacobians`); throws
 // as CompareWithElastica.
@@ -39,6 +67,9 @@ ProfileComparison CompareWithElastica(const BendingLaw& law, double areal_densit
                                       const Profile& measured, double overhang, double offset,
                                       double rotation, int curve_samples) {
   CheckOverhang(measured, overhang);
+  if (law.is_spline())
+    return CompareSplineStrip(law, areal_density, measured, overhang, offset, rotation,
+                              curve_samples);
   internal::ProfileModel model(measured, areal_density, curve_samples, 1e-10);
   SolveModel(&model, law, measured, overhang, offset, rotation, false);
   ProfileComparison c;
@@ -64,6 +95,7 @@ CurveSpread ElasticaSpread(const BendingLaw& law, double areal_density, const Pr
     throw InputError(measured.source + ": the law's covariance has a non-finite entry");
   }
   const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (law.is_spline()) return {nan, nan, nan};  // its covariance is of knots, not (b1, b2, c1)
   const double b1 = law.b1(), b2 = law.b2(), c1 = law.c1(), k0 = law.kappa0();
   if (!(k0 > internal::kMinKappa0) || !(k0 < internal::kMaxKappa0)) return {nan, nan, nan};
   internal::ProfileModel model(measured, areal_density, curve_samples, 1e-10);

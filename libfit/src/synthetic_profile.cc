@@ -55,8 +55,14 @@ Profile SyntheticProfile(const BendingLaw& law, double areal_density, double ove
 
   std::ostringstream source;
   source.precision(6);
-  source << "synthetic{b1=" << law.b1_kes() << ",b2=" << law.b2_kes() << ",c1=" << law.c1_kes()
-         << " KES; " << units::SiToGsm(areal_density) << " g/m2; L=" << units::MToMm(overhang)
+  if (law.is_spline()) {
+    source << "synthetic{spline law, " << law.knot_kappa().size()
+           << " knots to kappa=" << units::SiCurvatureToKes(law.kappa0()) << " /cm; ";
+  } else {
+    source << "synthetic{b1=" << law.b1_kes() << ",b2=" << law.b2_kes() << ",c1=" << law.c1_kes()
+           << " KES; ";
+  }
+  source << units::SiToGsm(areal_density) << " g/m2; L=" << units::MToMm(overhang)
          << " mm; sigma=" << units::MToMm(options.noise_sigma) << " mm; seed=" << options.seed
          << "}";
   Profile profile;

@@ -8,6 +8,7 @@
 #include "textile/sim/acpm_shell.h"
 #include "textile/sim/elastica.h"
 #include "textile/sim/error.h"
+#include "textile/sim/material.h"
 #include "textile/sim/units.h"
 
 // The elastica model (docs/acpm.md). The push is quasi-static and the heavy elastica has one
@@ -378,7 +379,7 @@ nlohmann::json AcpmResultToJson(const AcpmResult& r, const Material& material,
   j["model_reason"] = r.model_reason;
   j["material"] = {{"name", material.name},
                    {"areal_density_gsm", units::SiToGsm(material.areal_density)},
-                   {"law_kes", {{"b1", law.b1_kes()}, {"b2", law.b2_kes()}, {"c1", law.c1_kes()}}}};
+                   {"law_kes", LawToJson(law, false)}};
   j["sample"] = {{"width_mm", units::MToMm(o.width)},
                  {"length_mm", units::MToMm(o.length)},
                  {"rays", o.num_rays},

@@ -85,6 +85,7 @@ struct LanePositions {
 // BendingLaw, so that the results are the same bits).
 struct LawCoefficients {
   double b1, b2, c1, kappa0, moment0, energy0;
+  // A spline law's coefficients are not used (BendingElements::hinge_by_hinge_).
   explicit LawCoefficients(const BendingLaw& law)
       : b1(law.b1()),
         b2(law.b2()),
@@ -649,6 +650,8 @@ BendingElements::BendingElements(const TriangleMesh& rest, const std::vector<Hin
       num_vertices_(rest.num_vertices()),
       hinges_(hinges) {
   if (std::string why; !options.Check(&why)) throw InputError(why);
+  hinge_by_hinge_ =
+      options_.model == BendingModel::kPabst && (warp_.is_spline() || weft_.is_spline());
   const int nh = static_cast<int>(hinges.size());
   if (!stiffness_multiplier.empty() && static_cast<int>(stiffness_multiplier.size()) != nh) {
     throw InputError("bending: stiffness multiplier has " +
@@ -912,9 +915,32 @@ double BendingElements::Evaluate(const Vertices& x, double* grad) const {
     partial[thread] = DihedralBlocks(in, begin, end, kWithEnergy,
                                      kWithGradient && direct ? grad : nullptr, hinge_grad);
   };
+  // A spline law: each hinge's angle and gradient, and the law through BendingLaw.
+  auto hinge_run = [&](long begin, long end, int thread) {
+    double energy = 0.0;
+    std::array<Vec3, 4> g;
+    for (long h = begin; h < end; ++h) {
+      const HingeRest& r = rest_[h];
+      const hinge_angle::AngleTerms t =
+          hinge_angle::AngleTermsAndGradient(x, r.v, kWithGradient ? &g : nullptr);
+      double d_energy = 0.0;
+      energy += DihedralTerms(t.cos_term, t.sin_term, static_cast<int>(h),
+                              kWithGradient ? &d_energy : nullptr, nullptr, kWithEnergy);
+      if constexpr (!kWithGradient) continue;
+      if (direct) {
+        for (int i = 0; i < 4; ++i) Eigen::Map<Vec3>(grad + 3 * r.v[i]) += d_energy * g[i];
+      } else {
+        double* out = hinge_gradient_.data() + 12 * h;
+        for (int i = 0; i < 4; ++i) Eigen::Map<Vec3>(out + 3 * i) = d_energy * g[i];
+      }
+    }
+    partial[thread] = energy;
+  };
   auto run = [&](long begin, long end, int thread) {
     if (linear) {
       linear_run(begin, end, thread);
+    } else if (hinge_by_hinge_) {
+      hinge_run(begin, end, thread);
     } else {
       dihedral_run(begin, end, thread);
     }
@@ -1059,7 +1085,7 @@ void BendingElements::HessianBlocks(const Vertices& x, HessianProjection project
   auto* lanes = reinterpret_cast<LaneHessian*>(u);
   const bool linear =
       options_.model == BendingModel::kVolino || options_.model == BendingModel::kIsometric;
-  if (linear || projection == HessianProjection::kEigen) {
+  if (linear || projection == HessianProjection::kEigen || hinge_by_hinge_) {
     double block[kPackedSize];
     for (int l = 0; l < count; ++l) {
       HingeHessianUpper(x, static_cast<int>(first + l), projection, block);

@@ -278,6 +278,12 @@ double ClassicOutputs::rigidity_gf_cm() const { return units::SiRigidityToGfCm(f
 std::string ClassicOutputs::RelationToLaw(const BendingLaw& law) const {
   std::ostringstream s;
   s.precision(4);
+  if (law.is_spline()) {
+    s << "G = " << flexural_rigidity / law.b1() << " B(0) = " << flexural_rigidity / law.b2()
+      << " B(end) (spline law: B(0) = " << law.b1_kes()
+      << ", B beyond the last knot = " << law.b2_kes() << " gf·cm)";
+    return s.str();
+  }
   s << "G = " << flexural_rigidity / law.b1() << " b1 = " << flexural_rigidity / law.b2()
     << " b2 (b1 = " << law.b1_kes() << ", b2 = " << law.b2_kes() << " gf·cm)";
   return s.str();

@@ -570,7 +570,7 @@ double RimTurnDownLength(const Material& material, const DrapeOptions& o) {
   if (!(overhang > 0.0) || !Finite(overhang))
     throw InputError("rim turn-down length: the specimen must be larger than the support");
   const BendingLaw warp = material.EffectiveLaw(), weft = material.EffectiveWeftLaw();
-  const double b = std::min({warp.b1(), warp.b2(), weft.b1(), weft.b2()});
+  const double b = std::min(warp.MinStiffness(), weft.MinStiffness());  // the softest B
   const double g = ClothOptions{}.gravity.norm();  // [m/s²]
   return std::sqrt(b / (material.areal_density * g * overhang));
 }

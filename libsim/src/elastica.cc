@@ -42,10 +42,11 @@
 // the root, and integrating them further would wander into curled-back states. As θ_L < π/2 for
 // every trial, the curled-back equilibria (θ > π/2 somewhere) are never found.
 //
-// The law's kink: B(κ) has a corner at κ0 (M is C1, not C2), where m = M(κ0); m grows
-// monotonically from the tip, so this is crossed at most once. It is an integration event: the
-// step that crosses it is redone to end exactly there (cubic Hermite guess, then Newton on m̃),
-// so each rk8pd step sees a smooth right-hand side.
+// The law's kinks: B(κ) has a corner at each of the law's breakpoints (M is C1, not C2): κ0 of
+// a Pabst law, every knot of a spline law. m grows monotonically from the tip, so each moment
+// M(κ_k) is crossed at most once, in ascending order. Each is an integration event: the step
+// that crosses it is redone to end exactly there (cubic Hermite guess, then Newton on m̃), so
+// each rk8pd step sees a smooth right-hand side.
 
 namespace textile {
 namespace {
@@ -264,8 +265,11 @@ class Shooter {
     const double ratio = bending_length / length;
     strip_.param_scale = {law.b1(), law.b2(),
                           strip_.stiffness0 * bending_length * std::max(1.0, ratio * ratio)};
-    const double m0k = law.moment_at_kappa0();
-    kink_moment_ = (m0k > 0.0 && std::isfinite(m0k)) ? m0k / strip_.moment_scale : kNaN;
+    // A Pabst law's one breakpoint is κ0, whose moment the law keeps; a spline's are its knots.
+    for (double k : law.Breakpoints()) {
+      const double m = law.is_spline() ? law.Moment(k) : law.moment_at_kappa0();
+      kink_moments_.push_back(m / strip_.moment_scale);
+    }
 
     // Expected sizes of the components, θ-like ones scaled by the deflection (small loads).
     const double a = std::min(1.0, angle_scale), a2 = a * a;
@@ -321,8 +325,8 @@ class Shooter {
     // shots), else small: the controller grows it by up to 4.9× per step.
     h_ = std::isnan(first_step_) ? 1e-3 : first_step_;
     first_step_ = kNaN;
-    // With a varying stiffness m/S may cross M(κ0) more than once: no event then.
-    kink_done_ = std::isnan(kink_moment_) || strip_.variation != nullptr;
+    // With a varying stiffness m/S may cross M(κ0) more than once: no events then.
+    next_kink_ = strip_.variation != nullptr ? kink_moments_.size() : 0;
     kink_t_ = kNaN;
     steps_ = 0;
 
@@ -393,12 +397,17 @@ class Shooter {
       }
       ++total_steps_;
       if (std::isnan(first_step_)) first_step_ = t_ - t_prev;
-      if (!kink_done_) {
-        const double g_prev = ScaledMoment(log_form_, y_prev.data()) - kink_moment_;
-        const double g = ScaledMoment(log_form_, y_.data()) - kink_moment_;
-        if (g_prev < 0.0 && g >= 0.0) {
-          LocateKink(t_prev, y_prev, g_prev, t_, g, h_prev);
-          kink_done_ = true;
+      while (next_kink_ < kink_moments_.size()) {
+        const double kink = kink_moments_[next_kink_];
+        const double g_prev = ScaledMoment(log_form_, y_prev.data()) - kink;
+        const double g = ScaledMoment(log_form_, y_.data()) - kink;
+        if (g < 0.0) break;  // not reached yet
+        ++next_kink_;
+        if (g_prev < 0.0) {
+          // Crossed in this step: redo it to end there (before any later kink).
+          LocateKink(kink, t_prev, y_prev, g_prev, t_, g, h_prev);
+          if (next_kink_ == kink_moments_.size()) kink_t_ = t_;  // the last: κ0
+          break;
         }
       }
       if (Angle(log_form_, y_.data()) < kAbortAngle) {
@@ -409,9 +418,9 @@ class Shooter {
     return true;
   }
 
-  // The last step [t_prev, t_next] crossed m̃ = kink_moment_; redo it so that it ends there.
-  void LocateKink(double t_prev, const std::array<double, kMaxDim>& y_prev, double g_prev,
-                  double t_next, double g_next, double h_prev) {
+  // The last step [t_prev, t_next] crossed m̃ = kink; redo it so that it ends there.
+  void LocateKink(double kink, double t_prev, const std::array<double, kMaxDim>& y_prev,
+                  double g_prev, double t_next, double g_next, double h_prev) {
     gsl_odeiv2_evolve* evolve = integ_->evolve.get();
     gsl_odeiv2_control* control = integ_->control[log_form_ ? 1 : 0].get();
     gsl_odeiv2_step* step = integ_->step.get();
@@ -441,20 +450,19 @@ class Shooter {
           break;
         ++total_steps_;
       }
-      const double g = ScaledMoment(log_form_, y_.data()) - kink_moment_;
+      const double g = ScaledMoment(log_form_, y_.data()) - kink;
       const double rate = ScaledMomentRate(log_form_, t_, y_.data());
-      if (std::abs(g) <= 1e-14 * kink_moment_ || !(rate > 0.0)) break;
+      if (std::abs(g) <= 1e-14 * kink || !(rate > 0.0)) break;
       const double next = std::clamp(t_kink - g / rate, t_prev, t_next);
       if (std::abs(next - t_kink) <= 1e-15) break;
       t_kink = next;
     }
-    kink_t_ = t_;
     h_ = h_prev;
   }
 
   Strip strip_;
   std::vector<double> breaks_t_;  // breakpoints of the variation in t, ascending, in (0, 1)
-  double kink_moment_ = kNaN;  // M(κ0)/(ρgL²), NaN when there is no kink to cross
+  std::vector<double> kink_moments_;  // M(κ_k)/(ρgL²) at the law's breakpoints, ascending
   std::unique_ptr<Integrator> cheap_, full_;
 
   // Current shot.
@@ -464,7 +472,7 @@ class Shooter {
   bool log_form_ = false;
   std::array<double, kMaxDim> y_{};
   double t_ = 0.0, h_ = 0.0;
-  bool kink_done_ = true;
+  size_t next_kink_ = 0;  // the first of kink_moments_ not crossed yet
   double kink_t_ = kNaN;
   int steps_ = 0;
   int total_steps_ = 0;
@@ -571,6 +579,10 @@ ElasticaProfile SolveHeavyElastica(const BendingLaw& law, double areal_density, 
                      Describe(areal_density));
   if (!(std::isfinite(length) && length > 0.0))
     throw InputError("overhang length must be a finite number > 0 m, got " + Describe(length));
+  if (options.sensitivities && law.is_spline())
+    throw InputError(
+        "elastica sensitivities are derivatives by the Pabst constants {b1, b2, c1}: a spline law "
+        "has none");
   if (!options.arc_lengths.empty() && options.arc_lengths.back() > length)
     throw InputError("arc length " + Describe(options.arc_lengths.back(), 10) +
                      " m lies beyond the overhang length " + Describe(length, 10) + " m");

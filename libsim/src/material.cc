@@ -4,6 +4,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <vector>
 
 #include "textile/sim/error.h"
 #include "textile/sim/json_text.h"
@@ -57,17 +58,26 @@ class Reader {
 
   BendingLaw Law(const json& root, const std::string& key) const {
     const json& b = root.at(key);
-    if (!b.is_object()) Fail(key, "must be an object {\"units\", \"b1\", \"b2\", \"c1\"}");
-    CheckKeys(b, key, {"units", "b1", "b2", "c1"});
+    if (!b.is_object()) {
+      Fail(key,
+           "must be an object {\"units\", \"b1\", \"b2\", \"c1\"} or {\"law\": \"spline\", "
+           "\"units\", \"kappa\", \"moment\"}");
+    }
+    std::string law = "pabst";
+    if (b.contains("law")) {
+      if (!b.at("law").is_string()) Fail(key + ".law", "must be \"pabst\" or \"spline\"");
+      law = b.at("law").get<std::string>();
+      if (law != "pabst" && law != "spline") {
+        Fail(key + ".law",
+             "unknown law '" + law + "' (use \"pabst\": b1, b2, c1; or \"spline\": kappa, moment)");
+      }
+    }
+    if (law == "spline") return SplineLaw(b, key);
+    CheckKeys(b, key, {"law", "units", "b1", "b2", "c1"});
     for (const char* k : {"units", "b1", "b2", "c1"}) {
       if (!b.contains(k)) Fail(key + "." + k, "missing");
     }
-    if (!b.at("units").is_string()) Fail(key + ".units", "must be \"kes\" or \"si\"");
-    const std::string units = b.at("units").get<std::string>();
-    if (units != "kes" && units != "si") {
-      Fail(key + ".units", "unknown units '" + units + "' (use \"kes\": gf·cm, gf·cm²; or \"si\": N·m, N·m²)");
-    }
-    const bool kes = units == "kes";
+    const bool kes = Units(b, key, "gf·cm, gf·cm²", "N·m, N·m²");
     double v[3];
     const char* names[3] = {"b1", "b2", "c1"};
     for (int i = 0; i < 3; ++i) v[i] = Number(b, names[i], key + "." + names[i]);
@@ -106,6 +116,68 @@ class Reader {
     const double sc1 = units::KesQuadraticToSi(c1);
     if (std::string why = BendingLaw::Invalidity(sb1, sb2, sc1); !why.empty()) Fail(key, why);
     return BendingLaw::FromSi(sb1, sb2, sc1);
+  }
+
+  // The "units" field of a law object: true for "kes", false for "si".
+  bool Units(const json& b, const std::string& key, const char* kes_units,
+             const char* si_units) const {
+    if (!b.at("units").is_string()) Fail(key + ".units", "must be \"kes\" or \"si\"");
+    const std::string units = b.at("units").get<std::string>();
+    if (units != "kes" && units != "si") {
+      Fail(key + ".units", "unknown units '" + units + "' (use \"kes\": " + kes_units +
+                               "; or \"si\": " + si_units + ")");
+    }
+    return units == "kes";
+  }
+
+  std::vector<double> Numbers(const json& obj, const std::string& key,
+                              const std::string& field) const {
+    const json& v = obj.at(key);
+    if (!v.is_array()) Fail(field, "must be an array of numbers, got " + Brief(v));
+    std::vector<double> out;
+    for (size_t i = 0; i < v.size(); ++i) {
+      if (!v[i].is_number())
+        Fail(field + "[" + std::to_string(i) + "]", "must be a number, got " + Brief(v[i]));
+      out.push_back(v[i].get<double>());
+    }
+    return out;
+  }
+
+  // {"law": "spline", "units", "kappa", "moment"[, "moment_sd"]}: knots in 1/cm and gf·cm/cm
+  // ("kes") or 1/m and N ("si").
+  BendingLaw SplineLaw(const json& b, const std::string& key) const {
+    CheckKeys(b, key, {"law", "units", "kappa", "moment", "moment_sd"});
+    for (const char* k : {"units", "kappa", "moment"}) {
+      if (!b.contains(k))
+        Fail(key + "." + k,
+             "missing (a spline law is {\"law\": \"spline\", \"units\", \"kappa\", \"moment\"})");
+    }
+    const bool kes =
+        Units(b, key, "kappa in 1/cm, moment in gf·cm/cm", "kappa in 1/m, moment in N");
+    std::vector<double> kappa = Numbers(b, "kappa", key + ".kappa");
+    std::vector<double> moment = Numbers(b, "moment", key + ".moment");
+    std::vector<double> sd;
+    if (b.contains("moment_sd")) sd = Numbers(b, "moment_sd", key + ".moment_sd");
+    if (std::string why = BendingLaw::SplineInvalidity(kappa, moment, sd, key + ".kappa",
+                                                       key + ".moment", key + ".moment_sd");
+        !why.empty()) {
+      throw InputError(source_ + ": " + why);  // why starts with the field
+    }
+    // The secant stiffness M_i/κ_i of each knot against the bounds of b1, b2 (KES), where a
+    // unit mix-up shows.
+    const std::string unit_hint = kes ? " (units: kes)" : " (units: si; is this file in kes?)";
+    for (size_t i = 1; i < kappa.size(); ++i) {
+      const double secant =
+          kes ? moment[i] / kappa[i] : units::SiStiffnessToKes(moment[i] / kappa[i]);
+      if (secant < kMinBKes || secant > kMaxBKes) {
+        std::ostringstream s;
+        s << "suspicious secant stiffness M/kappa = " << secant << " gf·cm at this knot, outside "
+          << "the textile range " << kMinBKes << " .. " << kMaxBKes << " gf·cm" << unit_hint;
+        Fail(key + ".moment[" + std::to_string(i) + "]", s.str());
+      }
+    }
+    if (kes) return BendingLaw::FromSplineKes(std::move(kappa), std::move(moment), std::move(sd));
+    return BendingLaw::FromSpline(std::move(kappa), std::move(moment), std::move(sd));
   }
 
  private:
@@ -188,11 +260,25 @@ Material ReadMaterial(const std::string& path) {
   return ParseMaterialJson(buffer.str(), path);
 }
 
-namespace {
-nlohmann::json LawToJson(const BendingLaw& law) {
-  return {{"units", "kes"}, {"b1", law.b1_kes()}, {"b2", law.b2_kes()}, {"c1", law.c1_kes()}};
+nlohmann::json LawToJson(const BendingLaw& law, bool with_units) {
+  nlohmann::json j;
+  if (law.is_spline()) {
+    const auto kes = [](const std::vector<double>& v, double (*to_kes)(double)) {
+      nlohmann::json a = nlohmann::json::array();
+      for (double x : v) a.push_back(to_kes(x));
+      return a;
+    };
+    j = {{"law", "spline"},
+         {"kappa", kes(law.knot_kappa(), units::SiCurvatureToKes)},
+         {"moment", kes(law.knot_moment(), units::SiMomentToKes)}};
+    if (!law.knot_moment_sd().empty())
+      j["moment_sd"] = kes(law.knot_moment_sd(), units::SiMomentToKes);
+  } else {
+    j = {{"b1", law.b1_kes()}, {"b2", law.b2_kes()}, {"c1", law.c1_kes()}};
+  }
+  if (with_units) j["units"] = "kes";
+  return j;
 }
-}  // namespace
 
 nlohmann::json MaterialToJson(const Material& m) {
   nlohmann::json j;

@@ -25,12 +25,9 @@ TEST(MomentCurveError, ScaledLinearLawHasClosedForm) {
   EXPECT_NEAR(MomentCurveError(fit, truth, 120.0), eps / std::sqrt(3.0), kRoundingTol);
 }
 
-TEST(MomentCurveError, MatchesDenseSamplingAcrossKinks) {
-  // Both laws have κ0 inside [0, κmax]; a fine midpoint rule (error O(h²) ~ 1e-9 at 2e5
-  // cells, worse at the kinks) checks the piecewise Gauss-Legendre.
-  const auto truth = BendingLaw::FromKes(0.1, 0.0892, -0.0092);  // κ0 = 0.587 /cm
-  const auto fit = BendingLaw::FromKes(0.11, 0.085, -0.02);      // κ0 = 0.625 /cm
-  const double kappa_max = 150.0;                                // 1.5 /cm
+// The error measure by a fine midpoint rule (error O(h²) ~ 1e-9 at 2e5 cells, worse at the
+// kinks), to check the piecewise Gauss-Legendre against.
+double MidpointError(const BendingLaw& fit, const BendingLaw& truth, double kappa_max) {
   const int cells = 200000;
   double sum = 0.0;
   for (int i = 0; i < cells; ++i) {
@@ -38,9 +35,33 @@ TEST(MomentCurveError, MatchesDenseSamplingAcrossKinks) {
     const double d = fit.Moment(k) - truth.Moment(k);
     sum += d * d;
   }
-  const double expected = std::sqrt(sum / cells) / truth.Moment(kappa_max);
-  const double kMidpointTol = 1e-7;
+  return std::sqrt(sum / cells) / truth.Moment(kappa_max);
+}
+constexpr double kMidpointTol = 1e-7;
+
+TEST(MomentCurveError, MatchesDenseSamplingAcrossKinks) {
+  // Both laws have κ0 inside [0, κmax].
+  const auto truth = BendingLaw::FromKes(0.1, 0.0892, -0.0092);  // κ0 = 0.587 /cm
+  const auto fit = BendingLaw::FromKes(0.11, 0.085, -0.02);      // κ0 = 0.625 /cm
+  const double kappa_max = 150.0;                                // 1.5 /cm
+  const double expected = MidpointError(fit, truth, kappa_max);
   EXPECT_NEAR(MomentCurveError(fit, truth, kappa_max), expected, kMidpointTol * expected);
+}
+
+TEST(MomentCurveError, SplineLawsSplitAtTheirKnots) {
+  // A spline against a Pabst law: (ΔM)² is a sextic between the knots and κ0, integrated by
+  // 4-point Gauss-Legendre (exact to degree 7); checked against the fine midpoint rule.
+  const auto truth = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+  const auto fit =
+      BendingLaw::FromSplineKes({0.0, 0.3, 0.7, 1.2, 2.0}, {0.0, 0.028, 0.062, 0.11, 0.18});
+  EXPECT_EQ(MomentCurveError(fit, fit, 150.0), 0.0);
+  const double kappa_max = 150.0;
+  const double expected = MidpointError(fit, truth, kappa_max);
+  EXPECT_NEAR(MomentCurveError(fit, truth, kappa_max), expected, kMidpointTol * expected);
+  // Symmetric but for the normalisation by the reference's M(κmax).
+  const double rms = expected * truth.Moment(kappa_max);
+  EXPECT_NEAR(MomentCurveError(truth, fit, kappa_max) * fit.Moment(kappa_max), rms,
+              kMidpointTol * rms);
 }
 
 TEST(MomentCurveError, RejectsNonPositiveRange) {

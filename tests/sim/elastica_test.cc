@@ -563,5 +563,81 @@ TEST(Elastica, BriefReportSummarises) {
   EXPECT_NE(report.find("integrations"), std::string::npos) << report;
 }
 
+// ---- Spline laws ----
+
+// The Pabst law sampled at 41 knots, 0 .. 4 /cm (every strip below stays under 4 /cm).
+BendingLaw SampledSpline(const BendingLaw& law) {
+  std::vector<double> kappa, moment;
+  for (int i = 0; i <= 40; ++i) {
+    kappa.push_back(10.0 * i);
+    moment.push_back(law.Moment(10.0 * i));
+  }
+  return BendingLaw::FromSpline(kappa, moment);
+}
+
+TEST(Elastica, SplineOfAPabstLawGivesItsStrip) {
+  // Largest |Δx|, |Δy| over the samples, relative to L, at L = 50, 100, 200 mm. The spline
+  // differs from the law only on the pieces around κ0 (bending_law_test.cc): the dress fabric
+  // (linear) is exact, Fig. 8 (κ0 = 0.59 /cm, small B corner) is within 5e-7 L measured, the
+  // interlining (κ0 = 0.30 /cm, a 4.5 gf·cm² jump in B', strips whose whole curvature range is
+  // 0 .. 0.26 /cm at 50 mm) within 3.3e-4 L measured. Tolerances 2× that.
+  const double kTolerance[] = {1e-6, 1e-13, 7e-4};
+  for (size_t n = 0; n < std::size(kFabrics); ++n) {
+    const Fabric& f = kFabrics[n];
+    const BendingLaw pabst = LawOf(f), spline = SampledSpline(pabst);
+    const double rho = units::GsmToSi(f.gsm);
+    for (double length : {0.05, 0.1, 0.2}) {
+      const ElasticaProfile a = Solve(pabst, rho, length), b = Solve(spline, rho, length);
+      ASSERT_EQ(a.s.size(), b.s.size());
+      for (size_t i = 0; i < a.s.size(); ++i) {
+        EXPECT_NEAR(b.x[i], a.x[i], kTolerance[n] * length) << f.name << " L " << length;
+        EXPECT_NEAR(b.y[i], a.y[i], kTolerance[n] * length) << f.name << " L " << length;
+      }
+    }
+  }
+}
+
+TEST(Elastica, SplineKnotsAreEvents) {
+  // The knee law: each knot's moment is crossed as an event; the reported kink is the last
+  // knot (κ0 of a spline, where it turns linear), and sampling there gives that curvature.
+  const BendingLaw knee =
+      BendingLaw::FromSpline({0.0, 0.3, 2.0, 10.0, 20.0}, {0.0, 0.23, 0.25, 0.30, 0.39});
+  // From barely bent (clamp 0.003 /m) to hanging past the knee (clamp 121 /m).
+  for (double rho : {0.2, 2.0, 20.0}) {
+    for (double length : {0.05, 0.2, 0.4}) {
+      const ElasticaProfile p = Solve(knee, rho, length);
+      ASSERT_TRUE(p.converged) << rho << " " << length << ": " << p.message;
+      for (size_t i = 0; i < p.s.size(); ++i) {
+        EXPECT_NEAR(knee.Moment(p.kappa[i]), p.moment[i], 1e-13 * p.clamp_moment);
+      }
+      if (p.clamp_curvature > knee.kappa0()) {
+        ASSERT_FALSE(std::isnan(p.kink_arc_length));
+        ElasticaOptions at_kink;
+        at_kink.arc_lengths = {p.kink_arc_length};
+        const ElasticaProfile q = Solve(knee, rho, length, at_kink);
+        // The kink's arc length is the last shot's, before the final Newton correction of
+        // the shooting unknown (≤ 1e-6 relative): good to ~1e-7 in the moment, amplified
+        // 40-fold in κ by the knee's small B past the last knot (measured 6e-8 in κ).
+        EXPECT_NEAR(q.moment[0], knee.moment_at_kappa0(), 1e-6 * knee.moment_at_kappa0());
+        EXPECT_NEAR(q.kappa[0], knee.kappa0(), 1e-6 * knee.kappa0());
+      } else {
+        EXPECT_TRUE(std::isnan(p.kink_arc_length));
+      }
+    }
+  }
+}
+
+TEST(Elastica, SensitivitiesRefuseASplineLaw) {
+  ElasticaOptions o;
+  o.sensitivities = true;
+  const BendingLaw spline = SampledSpline(LawOf(kFabrics[0]));
+  try {
+    SolveHeavyElastica(spline, 0.2, 0.1, o);
+    FAIL() << "sensitivities of a spline law were computed";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("a spline law has none"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace textile

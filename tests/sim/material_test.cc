@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
 
 #include "textile/sim/error.h"
 #include "textile/sim/units.h"
@@ -98,6 +99,57 @@ TEST(Material, JsonRoundTrip) {
   EXPECT_EQ(b.extra, a.extra);
 }
 
+TEST(Material, SplineLawsReadInKesAndSiAndSurviveTheRoundTrip) {
+  const Material kes = ParseMaterialJson(
+      R"({"areal_density_gsm": 300, "bending": {"law": "spline", "units": "kes",
+          "kappa": [0, 0.02, 0.1, 0.5, 2], "moment": [0, 0.2, 0.45, 0.56, 0.72],
+          "moment_sd": [0, 0.01, 0.01, 0.02, 0.03]},
+          "bending_weft": {"law": "spline", "units": "si", "kappa": [0, 2, 10, 50, 200],
+          "moment": [0, 0.0019613, 0.0044130, 0.0054917, 0.0070608]}})",
+      "spline");
+  ASSERT_TRUE(kes.bending.is_spline());
+  ASSERT_TRUE(kes.bending_weft && kes.bending_weft->is_spline());
+  // The same knots, once in KES and once in SI (moments to 5 digits).
+  for (size_t i = 0; i < 5; ++i) {
+    EXPECT_NEAR(kes.bending.knot_kappa()[i], kes.bending_weft->knot_kappa()[i], 1e-13);
+    EXPECT_NEAR(kes.bending.knot_moment()[i], kes.bending_weft->knot_moment()[i], 1e-7);
+  }
+  EXPECT_NEAR(kes.bending.knot_moment_sd()[4], 0.03 * units::kGramForce, 1e-18);
+  EXPECT_TRUE(kes.bending_weft->knot_moment_sd().empty());
+  // Written in KES; read back to rounding (1/cm -> 1/m -> 1/cm: an ulp or two).
+  const nlohmann::json written = MaterialToJson(kes);
+  EXPECT_EQ(written["bending"]["law"], "spline");
+  EXPECT_EQ(written["bending"]["units"], "kes");
+  EXPECT_FALSE(written["bending"].contains("b1"));
+  EXPECT_FALSE(written["bending_weft"].contains("moment_sd"));
+  const Material back = ParseMaterialJson(written.dump(), "round trip");
+  for (const auto& [a, b] : {std::pair{&kes.bending, &back.bending},
+                             std::pair{&*kes.bending_weft, &*back.bending_weft}}) {
+    ASSERT_TRUE(b->is_spline());
+    ASSERT_EQ(b->knot_kappa().size(), a->knot_kappa().size());
+    for (size_t i = 0; i < a->knot_kappa().size(); ++i) {
+      EXPECT_NEAR(b->knot_kappa()[i], a->knot_kappa()[i], 1e-15 * a->knot_kappa().back());
+      EXPECT_NEAR(b->knot_moment()[i], a->knot_moment()[i], 1e-15 * a->knot_moment().back());
+    }
+    EXPECT_EQ(b->knot_moment_sd().size(), a->knot_moment_sd().size());
+  }
+  // β scales the spline like any law.
+  Material scaled = kes;
+  scaled.beta = 2.0;
+  EXPECT_NEAR(scaled.EffectiveLaw().Moment(30.0), 2.0 * kes.bending.Moment(30.0),
+              1e-14 * kes.bending.Moment(30.0));
+  // A Pabst law is written as before (no "law" key), and "law": "pabst" reads as one.
+  const Material fig8 = ReadMaterial(kSamples + "pabst-fig8.json");
+  EXPECT_EQ(MaterialToJson(fig8)["bending"].dump(),
+            R"({"b1":0.1,"b2":0.0892,"c1":-0.0092,"units":"kes"})");
+  const Material explicit_pabst = ParseMaterialJson(
+      R"({"areal_density_gsm": 200,
+          "bending": {"law": "pabst", "units": "kes", "b1": 0.1, "b2": 0.0892, "c1": -0.0092}})",
+      "explicit");
+  EXPECT_FALSE(explicit_pabst.bending.is_spline());
+  EXPECT_EQ(explicit_pabst.bending.b1(), fig8.bending.b1());
+}
+
 struct BadCase {
   const char* file;
   const char* field;    // must appear in the message
@@ -151,7 +203,23 @@ INSTANTIATE_TEST_SUITE_P(
                       BadCase{"stretch-negative.json", "stretch.stiffness_N_per_m", "must be > 0"},
                       BadCase{"compression-zero.json", "stretch.compression_ratio", "[0.001, 1]"},
                       BadCase{"friction-negative.json", "friction", "[0, 10]"},
-                      BadCase{"bending-not-object.json", "bending", "must be an object"}),
+                      BadCase{"bending-not-object.json", "bending", "must be an object"},
+                      BadCase{"spline-not-monotone.json", "bending.moment[3]", "is not above"},
+                      BadCase{"spline-length-mismatch.json", "bending.moment",
+                              "3 values for 4 knots"},
+                      BadCase{"spline-kappa0-nonzero.json", "bending.kappa[0]", "must be 0"},
+                      BadCase{"spline-negative.json", "bending.moment[1]", "-0.01 is not above"},
+                      BadCase{"spline-null.json", "bending.moment[2]",
+                              "must be a number, got null"},
+                      BadCase{"spline-too-few.json", "bending.kappa", "at least 3"},
+                      BadCase{"spline-with-b1.json", "bending.b1", "unknown field"},
+                      BadCase{"spline-unknown-law.json", "bending.law", "unknown law 'cubic'"},
+                      BadCase{"spline-si-with-kes-numbers.json", "bending.moment[1]",
+                              "is this file in kes?"},
+                      BadCase{"spline-missing-moment.json", "bending.moment", "missing"},
+                      BadCase{"spline-sd-negative.json", "bending.moment_sd[1]", "must be >= 0"},
+                      BadCase{"spline-kappa-not-array.json", "bending.kappa", "must be an array"},
+                      BadCase{"spline-weft-invalid.json", "bending_weft.kappa[2]", "is not above"}),
     [](const auto& info) {
       std::string n = info.param.file;
       n = n.substr(0, n.find('.'));

@@ -165,15 +165,16 @@ Eigen::MatrixXd DenseHessian(const TensorBending& b, const Vertices& x, HessianP
   return Eigen::MatrixXd(h);
 }
 
-TEST(TensorBending, GradientAndHessianMatchFiniteDifferences) {
+// Gradient = finite difference of the energy, Hessian = finite difference of the gradient, on
+// a jittered mesh with seam multipliers and random bends.
+void ExpectDerivativesMatchFiniteDifferences(const BendingLaw& warp, const BendingLaw& weft) {
   std::mt19937 rng(5);
   TriangleMesh mesh = Jittered(RegularGridMesh(0.04, 0.04, 4, 4), 4, 0.2, &rng);
   const std::vector<Hinge> hinges = BuildHinges(mesh);
   std::vector<double> seam(hinges.size());
   std::uniform_real_distribution<double> s(1.0, 4.0), u(-0.005, 0.005);
   for (double& v : seam) v = s(rng);
-  // A nonlinear law on both branches (κ0 of the interlining is small) and a different weft.
-  const TensorBending b(mesh, hinges, Interlining(), Fig8(), seam);
+  const TensorBending b(mesh, hinges, warp, weft, seam);
   for (int trial = 0; trial < 3; ++trial) {
     Vertices x = mesh.vertices;
     for (int v = 0; v < x.rows(); ++v)
@@ -199,6 +200,23 @@ TEST(TensorBending, GradientAndHessianMatchFiniteDifferences) {
     }
     EXPECT_LT((h - h.transpose()).cwiseAbs().maxCoeff(), 1e-12 * hscale);
   }
+}
+
+TEST(TensorBending, GradientAndHessianMatchFiniteDifferences) {
+  // A nonlinear law on both branches (κ0 of the interlining is small) and a different weft.
+  ExpectDerivativesMatchFiniteDifferences(Interlining(), Fig8());
+}
+
+TEST(TensorBending, GradientAndHessianMatchFiniteDifferencesForSplineLaws) {
+  // A knee (stiff to 3 /m, nearly flat past 20 /m) and the Fig. 8 law sampled at 0.5 /cm.
+  std::vector<double> kappa, moment;
+  for (int i = 0; i <= 8; ++i) {
+    kappa.push_back(50.0 * i);
+    moment.push_back(Fig8().Moment(50.0 * i));
+  }
+  ExpectDerivativesMatchFiniteDifferences(
+      BendingLaw::FromSpline({0.0, 3.0, 20.0, 100.0, 200.0}, {0.0, 2.3e-4, 2.5e-4, 3.0e-4, 3.9e-4}),
+      BendingLaw::FromSpline(kappa, moment));
 }
 
 TEST(TensorBending, ProjectedHessiansArePositiveSemiDefinite) {

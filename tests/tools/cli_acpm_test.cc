@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "run_cli.h"
+#include "textile/sim/bending_law.h"
+#include "textile/sim/units.h"
 
 namespace textile {
 namespace {
@@ -44,6 +46,32 @@ TEST(CliAcpm, PlainSamplePrintsTheRayTableAndWritesJsonAndPng) {
   EXPECT_NEAR(j["device_time_s"].get<double>(), 33.5864 / 2.0, 1e-4);
   EXPECT_EQ(j["side_profile"]["x_mm"].size(), 201u);
   EXPECT_GT(fs::file_size(dir / "front.png"), 10000u);
+}
+
+// A material whose law is the Fig. 8 law sampled as a spline (41 knots, 0 .. 4 /cm) crosses
+// where the law does: 33.5864 mm (the 41-knot spline moves L* by 1e-6 relative,
+// cantilever_outputs_test.cc), the rays' table unchanged to its printed digits.
+TEST(CliAcpm, SplineMaterialCrossesWhereItsPabstLawDoes) {
+  const auto dir = Scratch("CliAcpm.Spline");
+  const BendingLaw fig8 = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+  nlohmann::json kappa = nlohmann::json::array(), moment = nlohmann::json::array();
+  for (int i = 0; i <= 40; ++i) {
+    kappa.push_back(0.1 * i);
+    moment.push_back(units::SiMomentToKes(fig8.Moment(units::KesCurvatureToSi(0.1 * i))));
+  }
+  const nlohmann::json material = {
+      {"name", "Fig. 8 as a spline"},
+      {"areal_density_gsm", 200},
+      {"bending", {{"law", "spline"}, {"units", "kes"}, {"kappa", kappa}, {"moment", moment}}}};
+  std::ofstream(dir / "spline.json") << material.dump(2);
+  const auto r = Textile("acpm --material " + (dir / "spline.json").string() + " -o " +
+                         (dir / "r.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find(" 17   195.00        -    33.5864"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(ReadAll(dir / "r.json"));
+  EXPECT_EQ(j["material"]["law_kes"]["law"], "spline");
+  EXPECT_EQ(j["material"]["law_kes"]["kappa"].size(), 41u);
+  EXPECT_NEAR(j["plain"]["overhang_mm"].get<double>(), 33.5864, 33.5864 * 2e-6);
 }
 
 // Away from 41.5° the bending length is not L/2: the plain figures use the barrier's angle as

@@ -172,6 +172,7 @@ TEST(CliLaw, BadMaterialsExit2NamingFileAndField) {
     const char* fragment;
   };
   for (const Case& c : {Case{"kappa0-negative.json", "bending: kappa0"},
+                        Case{"spline-not-monotone.json", "bending.moment[3]: 0.03 is not above"},
                         Case{"gsm-zero.json", "areal_density_gsm: must be > 0"},
                         Case{"unknown-units.json", "bending.units: unknown units"},
                         Case{"not-json.json", "not valid JSON"},
@@ -184,6 +185,33 @@ TEST(CliLaw, BadMaterialsExit2NamingFileAndField) {
     EXPECT_EQ(CountLines(r.err), 1) << r.err;
     EXPECT_TRUE(r.out.empty()) << r.out;
   }
+}
+
+TEST(CliLaw, SplineMaterialPrintsItsKnotsAndTheLineBeyond) {
+  const std::string knee = "law --material samples/materials/knee-spline.json --kappa 0.02 3";
+  const auto t = RunTextile(knee, "law_spline_text");
+  ASSERT_EQ(t.exit_code, 0) << t.err;
+  EXPECT_NE(t.out.find("monotone spline through 8 knots"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("B(0) = 11.6 gf·cm"), std::string::npos) << t.out;
+  EXPECT_NE(t.out.find("beyond the last knot, kappa = 2 /cm"), std::string::npos) << t.out;
+  const auto r =
+      RunTextile(knee + " --json --plot '" + (Scratch("law_spline") / "k.png").string() + "'",
+                 "law_spline_json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto law = nlohmann::json::parse(r.out).at("law");
+  EXPECT_EQ(law.at("law"), "spline");
+  ASSERT_EQ(law.at("knots").size(), 8u);
+  EXPECT_NEAR(law.at("knots")[7].at("M_gfcm_per_cm").get<double>(), 0.72, 1e-14);
+  // At a knot the spline is the knot; past the last one, the line with the last slope.
+  const auto& at_knot = law.at("points")[0];
+  EXPECT_NEAR(at_knot.at("M_gfcm_per_cm").get<double>(), 0.2, 1e-14);
+  EXPECT_EQ(at_knot.at("branch"), "spline");
+  const auto& beyond = law.at("points")[1];
+  const double b_end = law.at("B_end_gfcm").get<double>();
+  EXPECT_EQ(beyond.at("branch"), "linear");
+  EXPECT_NEAR(beyond.at("M_gfcm_per_cm").get<double>(), 0.72 + b_end * (3.0 - 2.0), 1e-13);
+  EXPECT_NEAR(beyond.at("B_gfcm").get<double>(), b_end, 1e-14);
+  EXPECT_GT(law.at("B0_gfcm").get<double>() / b_end, 100.0);  // the knee
 }
 
 TEST(CliLaw, RejectsNonFiniteKappa) {

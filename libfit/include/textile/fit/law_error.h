@@ -23,7 +23,8 @@ namespace textile {
 //                   data showed)
 // @return           the relative RMS error above (dimensionless; 0.01 = 1 %)
 // Throws InputError when kappa_max is not a positive finite number. Exact up to rounding:
-// the squared difference is a piecewise quartic, integrated by Gauss-Legendre per piece.
+// the squared difference is a piecewise quartic (a sextic where a spline law is involved),
+// integrated by Gauss-Legendre per piece between the laws' breakpoints.
 double MomentCurveError(const BendingLaw& fit, const BendingLaw& truth, double kappa_max);
 
 }  // namespace textile

@@ -29,7 +29,8 @@ struct ProfileComparison {
 // Simulates the strip (law [SI], areal density [kg/m²], overhang [m]) and compares it with
 // the measured profile, the simulation lifted by `offset` [m] (the mid-line's height at the
 // edge) and turned by `rotation` [rad] about the edge (a fitted rig tilt). Throws ComputeError if
-// the elastica fails, InputError for bad arguments.
+// the elastica fails, InputError for bad arguments. A spline law's strip is compared as a curve
+// of curve_samples points (CompareWithCurve below; clamp_curvature is then the strip's).
 ProfileComparison CompareWithElastica(const BendingLaw& law, double areal_density,
                                       const Profile& measured, double overhang, double offset,
                                       double rotation = 0.0, int curve_samples = 201);

@@ -244,6 +244,9 @@ class BendingElements {
   BendingOptions options_;
   BendingLaw warp_, weft_;
   bool anisotropic_ = false;
+  // The Pabst model with a spline law: hinge by hinge through BendingLaw (the SIMD kernels
+  // inline the three-constant law).
+  bool hinge_by_hinge_ = false;
   int num_vertices_ = 0;
   std::vector<Hinge> hinges_;
   std::vector<HingeRest> rest_;

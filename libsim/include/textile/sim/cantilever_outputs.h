@@ -101,7 +101,8 @@ struct ClassicOutputs {
   double rigidity_mg_cm() const;     // G [mg·cm]
   double rigidity_gf_cm() const;     // G [gf·cm]
 
-  // "G = 0.947 b1 = 1.062 b2 (b1 = ..., b2 = ... gf·cm)": how the lab number relates to a law.
+  // "G = 0.947 b1 = 1.062 b2 (b1 = ..., b2 = ... gf·cm)": how the lab number relates to a law
+  // (a spline law: to B(0) and the slope past its last knot).
   std::string RelationToLaw(const BendingLaw& law) const;
   // One line: c, G in µN·m, mg·cm and gf·cm, and the rule used.
   std::string BriefReport() const;

@@ -70,6 +70,7 @@ struct ElasticaOptions {
   std::vector<double> arc_lengths;
   // Also compute the derivatives of x, y and θ at the samples w.r.t. the law constants
   // {b1, b2, c1} (variational equations, no finite differences). About 2.5× the cost.
+  // Pabst laws only: SolveHeavyElastica refuses it for a spline law (InputError).
   bool sensitivities = false;
   // Cap on integrations of the strip during shooting (each one is an initial value problem).
   int max_shooting_iterations = 60;
@@ -113,6 +114,7 @@ struct ElasticaProfile {
   double clamp_curvature = std::numeric_limits<double>::quiet_NaN();  // κ(0) [1/m]
   double clamp_moment = std::numeric_limits<double>::quiet_NaN();     // m(0) [N]
   // Arc length where κ passes the law's kink κ0 [m]; NaN when κ0 is not reached (or is 0).
+  // For a spline law κ0 is its last knot, where it turns linear.
   double kink_arc_length = std::numeric_limits<double>::quiet_NaN();
 
   int shooting_iterations = 0;  // integrations of the strip
@@ -133,8 +135,9 @@ struct ElasticaProfile {
 
 // Solves the heavy elastica for a strip of areal density areal_density [kg/m²] with overhang
 // length [m]. Throws InputError when the options fail Check, when areal_density or length is not
-// a finite number > 0, or when an arc length lies outside [0, length]. Never returns garbage: a
-// solve that does not converge returns converged = false and a message.
+// a finite number > 0, when an arc length lies outside [0, length], or when sensitivities are
+// asked of a spline law. Never returns garbage: a solve that does not converge returns
+// converged = false and a message.
 ElasticaProfile SolveHeavyElastica(const BendingLaw& law, double areal_density, double length,
                                    const ElasticaOptions& options = {});
 

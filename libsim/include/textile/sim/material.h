@@ -7,7 +7,8 @@
 //   textile::BendingLaw law = m.EffectiveLaw();   // β applied; SI inside
 //   double rho = m.areal_density;                  // [kg/m²]
 //
-// Files carry lab units ("kes": b in gf·cm, c1 in gf·cm²; or "si"); areal density in g/m².
+// Files carry lab units ("kes": b in gf·cm, c1 in gf·cm², a spline's κ in 1/cm and M in
+// gf·cm/cm; or "si"); areal density in g/m².
 // Every problem in a file is an InputError "<file>: <field>: <problem>", one line.
 
 #include <optional>
@@ -52,6 +53,11 @@ Material ParseMaterialJson(const std::string& text, const std::string& source);
 Material ReadMaterial(const std::string& path);
 // The material as JSON in the file format, bending constants in KES units.
 nlohmann::json MaterialToJson(const Material& material);
+// A law as the file format's "bending" object, KES units: {"units": "kes", "b1", "b2", "c1"}, or
+// {"units": "kes", "law": "spline", "kappa" [1/cm], "moment" [gf·cm/cm], "moment_sd"} (the
+// band only when the law carries one). with_units = false leaves "units" out, for reports
+// whose key says the units ("law_kes").
+nlohmann::json LawToJson(const BendingLaw& law, bool with_units = true);
 
 }  // namespace textile
 

@@ -9,6 +9,7 @@
 #include <limits>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <queue>
 #include <sstream>
 
@@ -40,6 +41,11 @@ constexpr double kAcrossStep = 0.5;
 // reduced image's diagonal long.
 constexpr double kMinElongation = 5.0;
 constexpr double kMinLengthFraction = 0.08;
+// A second band of the strip's shade with at least this fraction of its length × contrast is
+// a second strip (SecondStrip).
+constexpr double kSecondStripScore = 0.3;
+// What a photo whose strip's free tip is cut off by its border needs.
+constexpr const char* kWholeStripInView = "; the whole strip, its tip included, must be in view";
 
 // Image borders, as bits.
 enum Border : int { kNoBorder = 0, kLeft = 1, kRight = 2, kTop = 4, kBottom = 8 };
@@ -360,6 +366,62 @@ void RemoveLooseFibres(Strip* strip) {
 }
 
 // Distance from a reduced-image point to the nearest block pixel, searched within 40 px [px].
+// Cleans the chosen band: cut at half its own contrast in `hat` (its top- or black-hat), gaps
+// bridged, thick parts reaching in from the border split off (returned as blocks), fibres
+// removed.
+std::vector<Block> PrepareStrip(const cv::Mat& hat, Strip* strip) {
+  // Faint structures touching the strip (the slanted edge of a platform leaves a thin trace
+  // in the hats, a shadow's rim, a faint face) are cut off at half the strip's own contrast.
+  double threshold = HatThreshold(hat);
+  {
+    std::vector<double> values;
+    for (int y = 0; y < hat.rows; ++y) {
+      for (int x = 0; x < hat.cols; ++x) {
+        if (strip->mask.at<uchar>(y, x)) values.push_back(hat.at<uchar>(y, x));
+      }
+    }
+    threshold = std::max(threshold, 0.5 * Median(values));
+    const cv::Mat core = LargestComponent(strip->mask & (hat > threshold));
+    if (!core.empty()) strip->mask = core;
+  }
+  MergeContinuations(hat, threshold, strip);
+
+  std::vector<Block> own_blocks = SplitOffThickParts(strip);
+  RemoveLooseFibres(strip);
+  return own_blocks;
+}
+
+// Distance from a reduced-image point to the nearest pixel of a mask [reduced px] (1e300 if
+// the mask is empty).
+double DistanceToMask(const cv::Mat& mask, const cv::Point& p) {
+  std::vector<cv::Point> on;
+  cv::findNonZero(mask, on);
+  double best = 1e300;
+  for (const cv::Point& q : on) best = std::min(best, std::hypot(q.x - p.x, q.y - p.y));
+  return best;
+}
+
+// A second strip beside the chosen, prepared one (`strips` sorted by score, the chosen strip
+// first): the strongest other candidate of the same polarity with at least
+// kSecondStripScore of its score and a thickness within a factor 2 that lies clear of it (no
+// pixel within 3 thicknesses + 2 px: pieces of one strip split by a dim stretch are joined to
+// it or touch it). Returns its index in `strips`.
+std::optional<size_t> SecondStrip(const std::vector<Strip>& strips, const Strip& strip) {
+  cv::Mat zone;  // made only if a candidate gets this far (none on the shipped photos)
+  for (size_t k = 1; k < strips.size(); ++k) {
+    const Strip& c = strips[k];
+    if (c.polarity != strip.polarity || c.score < kSecondStripScore * strip.score) continue;
+    if (c.thickness > 2.0 * strip.thickness || 2.0 * c.thickness < strip.thickness) continue;
+    if (zone.empty()) {
+      const int r = static_cast<int>(std::ceil(3.0 * strip.thickness + 2.0));
+      cv::dilate(strip.mask, zone,
+                 cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * r + 1, 2 * r + 1}));
+    }
+    if (cv::countNonZero(c.mask & zone) == 0) return k;
+  }
+  return std::nullopt;
+}
+
 double DistanceToBlocks(const std::vector<Block>& blocks, const cv::Point& p) {
   double best = 1e300;
   for (const Block& b : blocks) {
@@ -370,6 +432,47 @@ double DistanceToBlocks(const std::vector<Block>& blocks, const cv::Point& p) {
     }
   }
   return best;
+}
+
+// The refusal of a strip that hangs off both ends of a platform, `at` the platform's top [full
+// px].
+std::string DrapedMessage(const Vec2& at) {
+  return "the strip hangs off both ends of the platform (the top at about " +
+         std::to_string(std::lround(at.x())) + "," + std::to_string(std::lround(at.y())) +
+         " px): not a cantilever from one edge; lay it so that only one end overhangs";
+}
+
+// Two bands that are the two overhangs of one strip lying over a whole platform, whose part on
+// the platform is not seen (a dark strip on a dark platform): each band's higher end lies at one
+// block (within 3 thicknesses + 5 px), and the bands hang down away from each other, more than
+// that below their higher ends. Sets `at` to the middle of the higher ends [reduced px].
+bool OverhangsOnBothSides(const cv::Mat& small, const Strip& a, const Strip& b, Vec2* at) {
+  const double t = std::max(a.thickness, b.thickness);
+  const double near = 3.0 * t + 5.0;
+  const auto ends = [](const Strip& s) {
+    const Sweep e = DoubleSweep(s.mask);
+    return e.a.y <= e.b.y ? std::make_pair(e.a, e.b) : std::make_pair(e.b, e.a);
+  };
+  const auto [high_a, low_a] = ends(a);
+  const auto [high_b, low_b] = ends(b);
+  if (low_a.y - high_a.y < near || low_b.y - high_b.y < near) return false;
+  // Away from each other: the band whose high end is on the left hangs further left.
+  const bool a_left = high_a.x <= high_b.x;
+  const cv::Point& left_low = a_left ? low_a : low_b;
+  const cv::Point& left_high = a_left ? high_a : high_b;
+  const cv::Point& right_low = a_left ? low_b : low_a;
+  const cv::Point& right_high = a_left ? high_b : high_a;
+  if (!(left_low.x < left_high.x && right_low.x > right_high.x)) return false;
+  cv::Mat zone = a.mask | b.mask;
+  const int r = static_cast<int>(std::ceil(2.0 * t + 1.0));
+  cv::dilate(zone, zone, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * r + 1, 2 * r + 1}));
+  for (const Block& block : extract_internal::FindBlocks(small, zone, t)) {
+    if (DistanceToBlocks({block}, high_a) <= near && DistanceToBlocks({block}, high_b) <= near) {
+      *at = Vec2(0.5 * (high_a.x + high_b.x), 0.5 * (high_a.y + high_b.y));
+      return true;
+    }
+  }
+  return false;
 }
 
 // Which image borders a set of mask pixels (those within `radius` of an end) touches. `dist` is
@@ -1104,9 +1207,16 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   r.trace = options.trace == TraceLine::kUpper   ? "upper"
             : options.trace == TraceLine::kLower ? "lower"
                                                  : "mid";
+  // A photo that fails once the detection image exists is first checked for being a
+  // calibration board, so that the error names the mix-up rather than the stage it broke (the
+  // check costs nothing on photos that extract, and cannot refuse one).
+  const cv::Mat* detection_image = nullptr;
   const auto fail = [&](const std::string& message) {
     r.success = false;
-    r.message = message;
+    r.message = detection_image && extract_internal::LooksLikeCalibrationBoard(*detection_image)
+                    ? "this looks like a calibration board (a chessboard), not a strip: give "
+                      "board photos to textile calibrate, which writes the rig file for --rig"
+                    : message;
     r.seconds = deadline.Elapsed();
     return r;
   };
@@ -1116,7 +1226,9 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
     const std::optional<std::string> why = deadline.Reached(stage);
     if (!why) return false;
     r.profile = Profile{};
-    fail(*why + "; no profile");
+    r.success = false;
+    r.message = *why + "; no profile";
+    r.seconds = deadline.Elapsed();
     return true;
   };
 
@@ -1147,6 +1259,7 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   const auto full = [&](const Vec2& p) {
     return Vec2((p.x() + 0.5) / scale - 0.5, (p.y() + 0.5) / scale - 0.5);
   };
+  detection_image = &small;
   // Background flattening: hats with a kernel far wider than any strip but smaller than the
   // light's gradients and broad shadows; a light and a dark strip show in one of the two.
   const int kernel = std::max(15, static_cast<int>(std::max(small.cols, small.rows) / 10)) | 1;
@@ -1170,26 +1283,34 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
       break;
     }
   }
-  r.polarity = strip.polarity > 0 ? "light" : "dark";
-  // Faint structures touching the strip (the slanted edge of a platform leaves a thin trace
-  // in the hats, a shadow's rim, a faint face) are cut off at half the strip's own contrast.
-  const cv::Mat& hat = strip.polarity > 0 ? light : dark;
-  double threshold = HatThreshold(hat);
-  {
-    std::vector<double> values;
-    for (int y = 0; y < hat.rows; ++y) {
-      for (int x = 0; x < hat.cols; ++x) {
-        if (strip.mask.at<uchar>(y, x)) values.push_back(hat.at<uchar>(y, x));
-      }
+  const cv::Mat& chosen_hat = strip.polarity > 0 ? light : dark;
+  std::vector<Block> own_blocks = PrepareStrip(chosen_hat, &strip);
+  // A second strip, as long and clear as this one, apart from it: the photo shows two
+  // cantilevers and nothing says which one to measure, unless --edge-px does.
+  if (const std::optional<size_t> k = SecondStrip(strips, strip)) {
+    const auto ends = [&](const cv::Mat& mask) {
+      const Sweep e = DoubleSweep(mask);
+      const Vec2 a = full(Vec2(e.a.x, e.a.y)), b = full(Vec2(e.b.x, e.b.y));
+      return "(" + Fmt(a.x(), 0) + "," + Fmt(a.y(), 0) + ")-(" + Fmt(b.x(), 0) + "," +
+             Fmt(b.y(), 0) + ") px";
+    };
+    if (Vec2 at; OverhangsOnBothSides(small, strip, strips[*k], &at)) {
+      return fail(DrapedMessage(full(at)));
     }
-    threshold = std::max(threshold, 0.5 * Median(values));
-    const cv::Mat core = LargestComponent(strip.mask & (hat > threshold));
-    if (!core.empty()) strip.mask = core;
+    if (!options.edge_px) {
+      return fail("two strips in the photo, one from " + ends(strip.mask) + ", the other from " +
+                  ends(strips[*k].mask) +
+                  "; photograph one at a time, or give --edge-px X,Y at the held end of the "
+                  "one to measure");
+    }
+    const cv::Point e(static_cast<int>(std::lround((options.edge_px->x() + 0.5) * scale - 0.5)),
+                      static_cast<int>(std::lround((options.edge_px->y() + 0.5) * scale - 0.5)));
+    if (DistanceToMask(strips[*k].mask, e) < DistanceToMask(strip.mask, e)) {
+      strip = strips[*k];
+      own_blocks = PrepareStrip(strip.polarity > 0 ? light : dark, &strip);
+    }
   }
-  MergeContinuations(hat, threshold, &strip);
-
-  std::vector<Block> own_blocks = SplitOffThickParts(&strip);
-  RemoveLooseFibres(&strip);
+  r.polarity = strip.polarity > 0 ? "light" : "dark";
   const Sweep sweep = DoubleSweep(strip.mask);
   const double t_small = std::max(1.0, cv::countNonZero(strip.mask) / std::max(1.0, sweep.length));
   cv::Mat strip_zone;
@@ -1228,7 +1349,8 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
     root_is_a = false;
     root_how = "border";
   } else if ((at_a & sides) && (at_b & sides)) {
-    return fail("the free tip is cut off by the image border (the strip crosses the whole photo)");
+    return fail("the free tip is cut off by the image border (the strip crosses the whole photo)" +
+                std::string(kWholeStripInView));
   } else if (at_a != kNoBorder || at_b != kNoBorder) {
     root_is_a = at_a == kNoBorder;  // the end at the top/bottom border is the cut tip
     root_how = "block";
@@ -1250,7 +1372,7 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   const int tip_borders = root_is_a ? at_b : at_a;
   if (tip_borders != kNoBorder) {
     return fail(std::string("the free tip is cut off by the image border (") +
-                BorderName(tip_borders) + ")");
+                BorderName(tip_borders) + ")" + kWholeStripInView);
   }
 
   // ---- 3. Coarse centre line from the held end, at full resolution.
@@ -1269,6 +1391,10 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   std::vector<double> widths_small;
   std::vector<Vec2> coarse = LevelSetCentreline(strip.mask, seeds, &widths_small);
   if (coarse.size() < 5) return fail("no strip found: the detected band is too short");
+  if (Vec2 peak; extract_internal::DrapedOverBlock(coarse, blocks, t_small, &peak)) {
+    const Vec2 p = full(peak);
+    return fail(DrapedMessage(p));
+  }
   for (Vec2& p : coarse) p = full(p);
   coarse = SmoothPolyline(coarse, std::max(2.0, 0.5 * t_small));
   coarse = ResampleByArc(coarse, 1.0);
@@ -1468,7 +1594,7 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
     if (status == TipStatus::kLeftImage || clearance < 0.5 * w_end + 2.0) {
       r.trace_px = trace;
       return fail("the free tip is cut off by the image border (or lies within " +
-                  Fmt(0.5 * w_end + 2.0, 0) + " px of it)");
+                  Fmt(0.5 * w_end + 2.0, 0) + " px of it)" + kWholeStripInView);
     }
   }
 

@@ -78,6 +78,19 @@ struct PlatformFit {
 PlatformFit FitPlatform(const cv::Mat& gray, const Block& block, double scale, int direction,
                         const std::vector<Vec2>& path, double thickness);
 
+// Whether the reduced grey image `small` shows a chessboard (a calibration board given as a strip
+// photo): at least 8 dark and 4 light squares of one size, in the Otsu threshold eroded by a
+// pixel. Strip photos show none (a strip is one long component).
+bool LooksLikeCalibrationBoard(const cv::Mat& small);
+
+// Whether a strip is draped over a block rather than held at one end: its centre line `line`
+// (from one end to the other) has both ends more than 3 `thickness` + 5 px below its highest
+// point, and its top stretch lies on one of `blocks` (within 2 `thickness` + 4 px above its
+// mask); all on the reduced image [px]. Sets `peak` to the highest point. Such a strip lies over
+// a whole platform and off its far edge too: not a cantilever from one edge.
+bool DrapedOverBlock(const std::vector<Vec2>& line, const std::vector<Block>& blocks,
+                     double thickness, Vec2* peak);
+
 }  // namespace textile::extract_internal
 
 #endif  // TEXTILE_FIT_SRC_EXTRACT_INTERNAL_H_

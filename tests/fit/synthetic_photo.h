@@ -233,6 +233,61 @@ inline SyntheticPhoto Render(const PhotoScene& s) {
   return photo;
 }
 
+// Two cantilevers in one photo (two strips side by side or one above the other): both scenes
+// rendered and the darker of the two kept at each pixel, so both must show dark strips on the
+// same background.
+inline cv::Mat RenderTwoStrips(const PhotoScene& a, const PhotoScene& b) {
+  return cv::min(Render(a).gray, Render(b).gray);
+}
+
+// A strip lying over the whole top of a platform block that stands in the photo (it reaches in
+// from the bottom border only) and hanging off both of its ends: not a cantilever from one
+// edge. Grey levels, not reflectances; x right, y down [px].
+struct DrapedScene {
+  int width = 400, height = 260;                                        // [px]
+  double platform_left = 120, platform_right = 250, platform_top = 90;  // [px]
+  double radius = 100;                                  // bend radius of both overhangs [px]
+  double left_deg = 70, right_deg = 50;                 // angle turned by each overhang [deg]
+  double thickness = 10;                                // [px]
+  double strip = 50, background = 190, platform = 100;  // grey levels
+  double blur_sigma = 1.0, noise_sigma = 1.0;           // [px], [grey levels]
+  unsigned seed = 1;
+};
+
+inline cv::Mat RenderDraped(const DrapedScene& s) {
+  constexpr int kSub = 4;  // drawn at 4x and reduced: anti-aliased
+  cv::Mat big(s.height * kSub, s.width * kSub, CV_8U, cv::Scalar(s.background));
+  cv::rectangle(big, cv::Point(int(s.platform_left * kSub), int(s.platform_top * kSub)),
+                cv::Point(int(s.platform_right * kSub), s.height * kSub), cv::Scalar(s.platform),
+                cv::FILLED);
+  // The mid-line: down the left overhang to the platform's left corner, over the top, and down
+  // the right overhang.
+  const double y = s.platform_top - s.thickness / 2;
+  std::vector<cv::Point> line;
+  for (double a = s.left_deg; a >= 0; a -= 1) {
+    const double r = a * M_PI / 180;
+    line.emplace_back(int(kSub * (s.platform_left - s.radius * std::sin(r))),
+                      int(kSub * (y + s.radius * (1 - std::cos(r)))));
+  }
+  for (double a = 0; a <= s.right_deg; a += 1) {
+    const double r = a * M_PI / 180;
+    line.emplace_back(int(kSub * (s.platform_right + s.radius * std::sin(r))),
+                      int(kSub * (y + s.radius * (1 - std::cos(r)))));
+  }
+  cv::polylines(big, line, false, cv::Scalar(s.strip), int(s.thickness * kSub), cv::LINE_AA);
+  cv::Mat img;
+  cv::resize(big, img, cv::Size(s.width, s.height), 0, 0, cv::INTER_AREA);
+  img.convertTo(img, CV_64F);
+  if (s.blur_sigma > 0) cv::GaussianBlur(img, img, cv::Size(0, 0), s.blur_sigma);
+  cv::Mat noise(img.size(), CV_64F);
+  cv::RNG rng(s.seed);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, s.noise_sigma);
+  img += noise;
+  cv::Mat gray;
+  img.convertTo(gray, CV_8U);
+  return gray;
+}
+
 }  // namespace textile::testing
 
 #endif  // TEXTILE_TESTS_FIT_SYNTHETIC_PHOTO_H_

@@ -79,5 +79,41 @@ int main(int argc, char** argv) {
   Write(out / "tiny.png", Encode(cv::Mat(20, 20, CV_8UC1, cv::Scalar(200)), ".png"));
   // Blank: a uniform grey photo (nothing to find).
   Write(out / "blank.png", Encode(cv::Mat(130, 200, CV_8UC1, cv::Scalar(128)), ".png"));
+  // Photos that show no usable cantilever (exit 3): two strips side by side (from the left
+  // and the right border) and one above the other, a tip cut off by the bottom border, and a
+  // strip hanging off both ends of a platform standing in the photo, lying on it in view
+  // (light platform) or unseen (dark platform).
+  PhotoScene left = clamp;
+  left.straight = 20;
+  left.radius = 80;
+  left.bend_deg = 40;
+  PhotoScene right = left;
+  right.mirror = true;
+  right.root_y = 50;
+  right.seed = 2;
+  Write(out / "two-strips-side.png",
+        Encode(textile::testing::RenderTwoStrips(left, right), ".png"));
+  PhotoScene upper = clamp;
+  upper.root_y = 30;
+  upper.straight = 30;
+  upper.radius = 100;
+  upper.bend_deg = 40;
+  PhotoScene lower = upper;
+  lower.root_y = 75;
+  lower.radius = 150;
+  lower.bend_deg = 30;
+  lower.seed = 3;
+  Write(out / "two-strips-stacked.png",
+        Encode(textile::testing::RenderTwoStrips(upper, lower), ".png"));
+  PhotoScene cut = clamp;
+  cut.root_y = 60;
+  cut.radius = 110;
+  cut.bend_deg = 80;  // ends 30 px below the photo
+  Write(out / "tip-cut.png", Encode(textile::testing::Render(cut).gray, ".png"));
+  textile::testing::DrapedScene draped;
+  draped.platform = 240;
+  Write(out / "draped.png", Encode(textile::testing::RenderDraped(draped), ".png"));
+  draped.platform = 100;
+  Write(out / "draped-dark.png", Encode(textile::testing::RenderDraped(draped), ".png"));
   return 0;
 }

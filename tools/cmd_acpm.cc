@@ -1,6 +1,6 @@
 // textile acpm: the virtual ACPM200 bending tester (Pabst et al. sections 4.1, 5.1): per-ray
-// crossing lengths, bending lengths, rigidities and seam factors, a result JSON (cli.md) and a
-// picture of the front across the width and the side profile at the crossing.
+// crossing lengths, bending lengths, rigidities and seam factors, a result JSON (docs/spec/cli.md)
+// and a picture of the front across the width and the side profile at the crossing.
 
 #include <chrono>
 #include <cmath>
@@ -261,7 +261,8 @@ void RegisterAcpm(CLI::App& app) {
       "  textile acpm --material samples/materials/pabst-fig8.json --seam C-plain --seam-dir "
       "across "
       "--seam-at 20 -o acpm.json");
-  sub->add_option("-m,--material", a->material, "Material JSON file (cli.md format)")->required();
+  sub->add_option("-m,--material", a->material, "Material JSON file (docs/spec/cli.md format)")
+      ->required();
   sub->add_option("--seam", a->seam,
                   "Seam: a Table 2 type (A-plain .. C-twill) or a seam JSON file");
   sub->add_option("--seam-at", a->seam_at_mm,
@@ -273,7 +274,8 @@ void RegisterAcpm(CLI::App& app) {
   sub->add_option("--model", a->model,
                   "auto (default: the elastica when it is exact), elastica or shell")
       ->check(CLI::IsMember({"auto", "elastica", "shell"}));
-  sub->add_option("-o,--out", a->out, "Result JSON to write (cli.md's ACPM result)")->required();
+  sub->add_option("-o,--out", a->out, "Result JSON to write (docs/spec/cli.md's ACPM result)")
+      ->required();
   sub->add_option("--png", a->png,
                   "Write the front across the width and the side profile to a PNG");
   sub->add_option("--obj", a->obj,

@@ -1,5 +1,5 @@
-// textile bench: the named benchmarks of benchmarks.md (CSV + PNG per benchmark, a table, or
-// with --json one object per benchmark {"benchmark": NAME, "rows": [...]}).
+// textile bench: the named benchmarks of docs/spec/benchmarks.md (CSV + PNG per benchmark, a table,
+// or with --json one object per benchmark {"benchmark": NAME, "rows": [...]}).
 
 #include <iostream>
 

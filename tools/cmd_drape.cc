@@ -471,7 +471,7 @@ void Run(const DrapeArgs& a) {
   AtomicFile* ply_file = a.ply.empty() ? nullptr : &outputs.Add(a.ply);
 
   // Progress lines (the mesh, each seed's solves) only on a terminal or with --progress: a
-  // failed run's stderr holds its one error line (cli.md).
+  // failed run's stderr holds its one error line (docs/spec/cli.md).
   o.progress = [progress = a.progress](const std::string& line) {
     Progress("drape: " + line, progress);
   };
@@ -618,7 +618,8 @@ void RegisterDrape(CLI::App& app) {
       "with or without seams",
       "textile drape --material samples/materials/pabst-fig8.json --seams weft --seam-type C-plain "
       "--seeds 3 -o drape.json --png drape.png");
-  sub->add_option("-m,--material", a->material, "Material JSON file (cli.md format)")->required();
+  sub->add_option("-m,--material", a->material, "Material JSON file (docs/spec/cli.md format)")
+      ->required();
   sub->add_option("--seams", a->seams, "none (default), weft, weft+warp or shifted");
   sub->add_option("--seam-type", a->seam_type,
                   "Table 2 seam type A-plain .. C-twill (default C-plain)");

@@ -1,4 +1,5 @@
-// textile extract: cantilever photos -> profile CSVs (frame of cantilever.md) and overlays.
+// textile extract: cantilever photos -> profile CSVs (frame of docs/spec/cantilever.md) and
+// overlays.
 
 #include <cmath>
 #include <filesystem>
@@ -52,7 +53,8 @@ void Run(const ExtractArgs& a) {
 
   // All or nothing: every photo's profile and overlay wait in temporary files until the last
   // photo has succeeded, so a photo that cannot be read or extracted leaves no output of the
-  // others behind either; the report waits as well (stdout stays empty on failure, cli.md).
+  // others behind either; the report waits as well (stdout stays empty on failure,
+  // docs/spec/cli.md).
   AtomicFileSet outputs;
   std::string report;
   nlohmann::json results = nlohmann::json::array();

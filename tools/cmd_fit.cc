@@ -166,7 +166,7 @@ Outcome RunClapp(const std::vector<Profile>& profiles, double rho) {
   return out;
 }
 
-// Classic outputs of the fitted law (cantilever.md): what the 41.5° test would report for
+// Classic outputs of the fitted law (docs/spec/cantilever.md): what the 41.5° test would report for
 // this material, and how that G relates to b1 and b2.
 void AddClassicOutputs(const BendingLaw& law, double rho, nlohmann::json* report) {
   const BarrierCrossing x = FindBarrierCrossing(law, rho);

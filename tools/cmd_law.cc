@@ -330,7 +330,8 @@ void RegisterLaw(CLI::App& app) {
   CLI::App* sub = AddSubcommand(
       app, "law", "Inspect a material's moment-curvature law: kappa0, M0, M and B; plot M-κ and B-κ",
       "textile law --material samples/materials/pabst-fig8.json --kappa 0.5 1 2 --plot law.png");
-  sub->add_option("-m,--material", args->material, "Material JSON file (cli.md format)")->required();
+  sub->add_option("-m,--material", args->material, "Material JSON file (docs/spec/cli.md format)")
+      ->required();
   sub->add_option("-k,--kappa", args->kappa,
                   "Curvatures to evaluate (default 0.25 0.5 1 2 /cm and kappa0; a spline also "
                   "lists its knots)");

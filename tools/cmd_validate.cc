@@ -61,8 +61,8 @@ nlohmann::json ModelJson(const ModelComparison& k) {
 // JSON null for a value that is not available (an undetermined constant's σ).
 nlohmann::json OrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
 
-// The fit report `textile fit` writes into a material's `fit` (cli.md; cmd_fit.cc's RunDirect
-// and AddClassicOutputs), for the direct fit with default options that validate runs: no
+// The fit report `textile fit` writes into a material's `fit` (docs/spec/cli.md; cmd_fit.cc's
+// RunDirect and AddClassicOutputs), for the direct fit with default options that validate runs: no
 // rotation, offset fitted, Cauchy scale options.robust_scale. The classic outputs: what the
 // 41.5° test would report for this law, and how that G relates to b1 and b2.
 nlohmann::json FitReport(const DirectFitSummary& fit, const DirectFitOptions& options,

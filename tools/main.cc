@@ -1,5 +1,5 @@
 // textile: the command line. Each subcommand lives in tools/cmd_<name>.cc; this file only
-// wires them up and maps failures to the exit codes of cli.md.
+// wires them up and maps failures to the exit codes of docs/spec/cli.md.
 
 #include <algorithm>
 #include <csignal>
@@ -16,7 +16,7 @@
 #include "textile/sim/error.h"
 
 namespace {
-// Errors are one line (cli.md), whatever a library put into the message.
+// Errors are one line (docs/spec/cli.md), whatever a library put into the message.
 std::string OneLine(const char* what) {
   std::string s = what;
   for (char& c : s) if (c == '\n' || c == '\r') c = ' ';

@@ -553,7 +553,7 @@ DirectFitSummary FitDirectFrom(const std::vector<Profile>& profiles, double area
     out.c1_sd = null_weight(2) > 0.5 && c1 != 0.0 ? nan : std::sqrt(out.covariance(2, 2));
   }
 
-  // Observability (cantilever.md): which constants the data determine.
+  // Observability (docs/spec/cantilever.md): which constants the data determine.
   const double k0 = law.kappa0();
   const auto undetermined = [](double sd, double v) {
     return !std::isfinite(sd) || sd > kUndeterminedRelSd * std::abs(v);

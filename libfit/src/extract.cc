@@ -1,6 +1,6 @@
 // The photo extractor: strip detection on a reduced image, rig recognition, sub-pixel
-// silhouette boundaries at full resolution, and the profile in the frame of cantilever.md.
-// The method and its choices are described in docs/extraction.md.
+// silhouette boundaries at full resolution, and the profile in the frame of
+// docs/spec/cantilever.md. The method and its choices are described in docs/extraction.md.
 
 #include "textile/fit/extract.h"
 
@@ -1711,7 +1711,7 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   }
   r.level_deg = level / kDeg;
 
-  // ---- 8. Millimetres in the frame of cantilever.md.
+  // ---- 8. Millimetres in the frame of docs/spec/cantilever.md.
   const Vec2 x_img = direction * Vec2(std::cos(level), -std::sin(level));
   const Vec2 up_img(-std::sin(level), -std::cos(level));
   const Vec2 o = rig.PlaneFromImage(r.origin_px);
@@ -1735,9 +1735,9 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   if (mm.front().x() >= 0.0) {
     const Vec2 d = (mm[std::min<size_t>(5, mm.size() - 1)] - mm[0]).normalized();
     if (platform.found && !options.edge_px && d.x() > 1e-3) {
-      // A strip resting on a platform leaves its edge level (θ(0) = 0, cantilever.md): the gap
-      // to the first measured point is bridged by the parabola that is level at x = 0 and meets
-      // that point with its slope. A straight line along that slope would put the start too
+      // A strip resting on a platform leaves its edge level (θ(0) = 0, docs/spec/cantilever.md):
+      // the gap to the first measured point is bridged by the parabola that is level at x = 0 and
+      // meets that point with its slope. A straight line along that slope would put the start too
       // high by half the drop across the gap.
       const double x1 = mm[0].x(), m1 = d.y() / d.x();
       const double c = m1 / (2.0 * std::max(x1, 1e-9));

@@ -440,7 +440,7 @@ RenderedPhoto RenderPhoto(const BendingLaw& law, double areal_density,
   const int n = static_cast<int>(e.s.size());
   std::vector<Eigen::Vector2d> mid(n), upper(n), lower(n), normal(n);
   for (int i = 0; i < n; ++i) {
-    // Resting on the platform, the mid-line starts at (0, t/2) (cantilever.md).
+    // Resting on the platform, the mid-line starts at (0, t/2) (docs/spec/cantilever.md).
     mid[i] = Eigen::Vector2d(e.x[i], e.y[i]) * 1e3 + Eigen::Vector2d(0, t_mm / 2);
     normal[i] = Eigen::Vector2d(std::sin(e.theta[i]), std::cos(e.theta[i]));
     upper[i] = mid[i] + 0.5 * t_mm * normal[i];

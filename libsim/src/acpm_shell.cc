@@ -140,7 +140,8 @@ class PushedSample {
       seams.push_back({seam_.profile, line});
     } else if (seam_.direction == AcpmSeamDirection::kAcross) {
       // On the overhang, or on the platform (then the platform's first row): either way the
-      // hinges past the edge get S(d) by their distance d to the line (physics.md, "Seams").
+      // hinges past the edge get S(d) by their distance d to the line (docs/spec/physics.md,
+      // "Seams").
       SeamLine line(2, 2);
       line << overhang - seam_.position, 0.0, overhang - seam_.position, options_.width;
       seams.push_back({seam_.profile, line});

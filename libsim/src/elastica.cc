@@ -25,9 +25,9 @@
 //
 // and the shooting condition is θ(t = 1) = 0; x(s) = L (X̃(1) - X̃(t)), y(s) = -L (Ỹ(1) - Ỹ(t)).
 //
-// Near-vertical strips (cantilever.md, "two traps"): for a strip many bending lengths long the
-// tip hangs with φ = π/2 - θ ≈ φ_L exp((2/3)(s'/ℓ)^{3/2}) (Airy growth), so φ_L underflows and
-// θ_L = π/2 in double precision. There the state is (ψ = log φ, μ̃ = m̃/φ) instead, which obeys
+// Near-vertical strips (docs/spec/cantilever.md, "two traps"): for a strip many bending lengths
+// long the tip hangs with φ = π/2 - θ ≈ φ_L exp((2/3)(s'/ℓ)^{3/2}) (Airy growth), so φ_L underflows
+// and θ_L = π/2 in double precision. There the state is (ψ = log φ, μ̃ = m̃/φ) instead, which obeys
 //
 //   dψ/dt = R μ̃,  dμ̃/dt = t sin(φ)/φ - R μ̃²,  R = ρgL³ κ(m)/m,
 //

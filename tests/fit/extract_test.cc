@@ -93,7 +93,7 @@ TEST(ExtractSynthetic, DarkStripLeavingTheBorderIsTracedToSubpixelAccuracy) {
   EXPECT_LT((r.origin_px - photo.origin).norm(), kOriginPx);
   EXPECT_NEAR(r.mm_per_px, kScale, 1e-12);
   EXPECT_NEAR(r.width_px, photo.scene.thickness, 0.5);
-  // Frame of cantilever.md: starts at the origin, x towards the overhang, hanging below.
+  // Frame of docs/spec/cantilever.md: starts at the origin, x towards the overhang, hanging below.
   EXPECT_NEAR(r.profile.x.front(), 0.0, 1e-9);
   EXPECT_NEAR(r.profile.y.front(), 0.0, 1e-9);
   EXPECT_GT(r.tip_mm.x(), 0.0);
@@ -181,7 +181,7 @@ TEST(ExtractSynthetic, PlatformCornerIsTheOriginAndTheMidlineStartsHalfAThicknes
   EXPECT_LT((r.origin_px - photo.origin).norm(), kOriginPx);
   EXPECT_NEAR(r.level_deg, 0.0, 0.05);
   ASSERT_EQ(r.platform_px.size(), 3u);
-  // cantilever.md: the mid-line starts at (0, t/2), not at (0, 0).
+  // docs/spec/cantilever.md: the mid-line starts at (0, t/2), not at (0, 0).
   EXPECT_NEAR(r.profile.x.front(), 0.0, 1e-9);
   EXPECT_NEAR(r.profile.y.front() * 1e3, s.thickness / 2.0 * kScale, kOriginPx * kScale);
   // Forcing the platform finds the same.

@@ -16,10 +16,10 @@
 //   fuzzer keeps looking for new ones (KnownBug below; delete each skip with its fix). None
 //   at the moment.
 //
-// Checks, as tools/main.cc maps failures (cli.md): a parse error, InputError or ComputeError is
-// an answer; any other exception would reach the user as "error: internal: ..." and is a bug,
-// as is a crash or a sanitizer report. A run that fails leaves no new file in the scratch folder
-// and the inputs byte-identical (outputs are atomic).
+// Checks, as tools/main.cc maps failures (docs/spec/cli.md): a parse error, InputError or
+// ComputeError is an answer; any other exception would reach the user as "error: internal: ..." and
+// is a bug, as is a crash or a sanitizer report. A run that fails leaves no new file in the scratch
+// folder and the inputs byte-identical (outputs are atomic).
 #include <fcntl.h>
 #include <unistd.h>
 

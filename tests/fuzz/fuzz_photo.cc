@@ -61,7 +61,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     gray = textile::ReadPhotoGray(PhotoPath());
   } catch (const textile::InputError& e) {
-    // The message names the photo (cli.md: errors name the file).
+    // The message names the photo (docs/spec/cli.md: errors name the file).
     if (std::string(e.what()).rfind(PhotoPath(), 0) != 0) __builtin_trap();
     return 0;
   }

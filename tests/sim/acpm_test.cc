@@ -141,7 +141,7 @@ TEST(ElasticaVariation, SensitivitiesMatchFiniteDifferences) {
 // ---- The scene ----
 
 TEST(Acpm, PlainSampleIsTheElasticaCrossingOnEveryRay) {
-  // cantilever.md's reference crossings (independent exact elastica), 1e-6 relative.
+  // docs/spec/cantilever.md's reference crossings (independent exact elastica), 1e-6 relative.
   struct Case {
     Material m;
     double crossing_mm;

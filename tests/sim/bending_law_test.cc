@@ -42,7 +42,7 @@ TEST(BendingLaw, PaperFig8Constants) {
 }
 
 TEST(BendingLaw, DressFabricIsLinear) {
-  // b1 = b2: κ0 = 0 and M = b2 κ whatever c1 says (physics.md, degenerate cases).
+  // b1 = b2: κ0 = 0 and M = b2 κ whatever c1 says (docs/spec/physics.md, degenerate cases).
   const auto law = BendingLaw::FromKes(0.0973, 0.0973, 0.0453);
   EXPECT_EQ(law.kappa0(), 0.0);
   for (double k : {-300.0, -1.0, 0.0, 0.5, 250.0}) {

@@ -16,7 +16,7 @@ namespace {
 
 constexpr double kDegree = std::numbers::pi / 180.0;
 
-// cantilever.md's reference table: the paper's fabrics at this project's densities.
+// docs/spec/cantilever.md's reference table: the paper's fabrics at this project's densities.
 struct Reference {
   const char* name;
   double b1, b2, c1;      // KES: gf·cm, gf·cm, gf·cm²
@@ -86,7 +86,7 @@ TEST(BarrierCrossing, IsInvariantUnderScalingForALinearLaw) {
 }
 
 TEST(ClassicOutputs, HalfRuleIsWithinTwoHundredthsOfAPercentForALinearLaw) {
-  // cantilever.md: for a linear law the L/2 rule at 41.5° is within 0.02 % of the exact
+  // docs/spec/cantilever.md: for a linear law the L/2 rule at 41.5° is within 0.02 % of the exact
   // elastica (we find c = 1.000175 ℓ, so G = 1.00052 B), and exactly L/2 at 41.487°.
   const BendingLaw law = BendingLaw::FromKes(0.1, 0.1, 0.0);
   const double rho = 0.2;
@@ -109,7 +109,7 @@ TEST(ClassicOutputs, HalfRuleIsWithinTwoHundredthsOfAPercentForALinearLaw) {
 }
 
 TEST(ClassicOutputs, PeirceAtTheStandardAngleIsSixPercentHigh) {
-  // cantilever.md: Peirce's general formula at 41.5° gives c = 0.509 L, i.e. G 5.8 % high
+  // docs/spec/cantilever.md: Peirce's general formula at 41.5° gives c = 0.509 L, i.e. G 5.8 % high
   // (against the true B of a linear law; 5.75 % computed).
   EXPECT_NEAR(PeirceBendingLength(1.0, kStandardBarrierAngle), 0.509, 0.0005);
   const BendingLaw law = BendingLaw::FromKes(0.1, 0.1, 0.0);
@@ -123,7 +123,7 @@ TEST(ClassicOutputs, PeirceAtTheStandardAngleIsSixPercentHigh) {
 }
 
 TEST(ClassicOutputs, NonlinearFabricsAreNeitherB1NorB2) {
-  // cantilever.md: G is about 0.75-0.95 b1 for softening fabrics, up to 2.1 b1 for the
+  // docs/spec/cantilever.md: G is about 0.75-0.95 b1 for softening fabrics, up to 2.1 b1 for the
   // interlining. Computed: Fig. 8 (softening) 0.9472 b1 = 1.062 b2; interlining 2.119 b1 =
   // 0.581 b2; the dress (linear) 1.0005 b. Checked to 1e-4.
   const double expected_over_b1[] = {0.9472, 1.0005, 2.1188};

@@ -1,5 +1,5 @@
-// The cylinder test of physics.md ("Discrete bending"): a flat sheet laid isometrically on a
-// cylinder of radius R must have a bending energy per area that converges to Ψ(1/R) under
+// The cylinder test of docs/spec/physics.md ("Discrete bending"): a flat sheet laid isometrically
+// on a cylinder of radius R must have a bending energy per area that converges to Ψ(1/R) under
 // refinement. Pabst et al.'s "resolution independence" (section 3.3, Fig. 3), measured.
 //
 // What holds and what does not (docs/bending.md, "Cylinder test"): a hinge energy sees only

@@ -18,7 +18,7 @@ namespace {
 constexpr double kHalfPi = std::numbers::pi / 2.0;
 
 // The paper's three fabrics (KES constants as printed) with this project's densities
-// (cantilever.md, reference table).
+// (docs/spec/cantilever.md, reference table).
 struct Fabric {
   const char* name;
   double b1, b2, c1;  // KES: gf·cm, gf·cm, gf·cm²
@@ -85,8 +85,8 @@ double HermiteIntegral(double h, double fa, double fb, double dfa, double dfb) {
 }
 
 TEST(Elastica, MomentBalanceHoldsAtEverySample) {
-  // cantilever.md: m(s) = ρ g ∫_s^L (x(s') - x(s)) ds', by quadrature of the output itself
-  // (dx/ds = cos θ). With 2001 samples the quadrature error is ~1e-12 relative; 1e-7 of the
+  // docs/spec/cantilever.md: m(s) = ρ g ∫_s^L (x(s') - x(s)) ds', by quadrature of the output
+  // itself (dx/ds = cos θ). With 2001 samples the quadrature error is ~1e-12 relative; 1e-7 of the
   // clamp moment is the brief's bar.
   for (const Fabric& f : kFabrics) {
     for (double length : {0.03, 0.1}) {
@@ -169,8 +169,8 @@ TEST(Elastica, ToleranceRefinementConverges) {
 }
 
 TEST(Elastica, ReproducesReferenceTipsAt100mm) {
-  // cantilever.md's table prints the tip to 1e-4 mm; agreement to that rounding (half a unit in
-  // the last digit) is ~1e-6 relative. The crossing columns are tested with the outputs.
+  // docs/spec/cantilever.md's table prints the tip to 1e-4 mm; agreement to that rounding (half a
+  // unit in the last digit) is ~1e-6 relative. The crossing columns are tested with the outputs.
   for (const Fabric& f : kFabrics) {
     const ElasticaProfile p = Solve(LawOf(f), units::GsmToSi(f.gsm), 0.1);
     EXPECT_NEAR(units::MToMm(p.tip_x), f.tip_x_100mm, 0.5e-4 + 1e-9) << f.name;
@@ -215,8 +215,8 @@ TEST(Elastica, KinkBeyondTheRangeChangesNothing) {
 }
 
 TEST(Elastica, DegenerateLawsAreLinear) {
-  // b1 = b2 (κ0 = 0, any c1) and c1 = 0 (κ0 = ∞) are both M = b κ (physics.md): same strip as
-  // the plain linear law, to 1e-12 of L.
+  // b1 = b2 (κ0 = 0, any c1) and c1 = 0 (κ0 = ∞) are both M = b κ (docs/spec/physics.md): same
+  // strip as the plain linear law, to 1e-12 of L.
   const BendingLaw linear = BendingLaw::FromKes(0.1, 0.1, 0.0);
   const BendingLaw equal_b = BendingLaw::FromKes(0.1, 0.1, 0.05);
   const BendingLaw no_c1 = BendingLaw::FromKes(0.1, 0.3, 0.0);
@@ -234,8 +234,8 @@ TEST(Elastica, DegenerateLawsAreLinear) {
 }
 
 TEST(Elastica, ShapeDependsOnlyOnMomentOverDensity) {
-  // cantilever.md: only M/ρ is identifiable. Scaling the law and the density by β leaves the
-  // strip unchanged (to solver accuracy, 1e-9 of L).
+  // docs/spec/cantilever.md: only M/ρ is identifiable. Scaling the law and the density by β leaves
+  // the strip unchanged (to solver accuracy, 1e-9 of L).
   const BendingLaw law = LawOf(kFabrics[0]);
   const ElasticaProfile p = Solve(law, 0.2, 0.07);
   for (double beta : {0.1, 7.0}) {

@@ -15,7 +15,7 @@
 namespace textile {
 namespace {
 
-constexpr double kStiffness = 1000.0;  // physics.md default [N/m]
+constexpr double kStiffness = 1000.0;  // docs/spec/physics.md default [N/m]
 constexpr double kPoisson = 0.3;
 const MembraneModel kModels[] = {MembraneModel::kCorotationalLinear, MembraneModel::kStVK};
 

@@ -1,6 +1,6 @@
 // The bad-input corpus (tests/bad_inputs/, issue 9): every case of every manifest
 // tests/bad_inputs/*.cases runs through the real `textile` executable, which must refuse it the
-// way cli.md promises:
+// way docs/spec/cli.md promises:
 //   - it exits (no signal, no hang) with the expected code (2 bad input, 3 computation failed);
 //   - stderr is exactly one line, starting with "error: " and containing the expected fragment;
 //   - stdout is empty (unless the case allows output);
@@ -307,7 +307,7 @@ TEST(BadInputs, ManifestsAreWellFormed) {
   EXPECT_GT(cases.size(), 0u);
 }
 
-// Every subcommand of cli.md that exists has cases: `textile --help` lists them.
+// Every subcommand of docs/spec/cli.md that exists has cases: `textile --help` lists them.
 TEST(BadInputs, EverySubcommandHasCases) {
   const RunResult help = RunArgs({"--help"}, "help");
   ASSERT_EQ(help.exit_code, 0) << help.err;

@@ -31,7 +31,7 @@ TEST(CliAcpm, PlainSamplePrintsTheRayTableAndWritesJsonAndPng) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("model: elastica (auto: nothing varies across the width"), std::string::npos)
       << r.out;
-  // cantilever.md: Fig. 8 at 200 g/m² crosses at 33.5864 mm; ray 17 at z = 195 mm.
+  // docs/spec/cantilever.md: Fig. 8 at 200 g/m² crosses at 33.5864 mm; ray 17 at z = 195 mm.
   EXPECT_NE(r.out.find(" 17   195.00        -    33.5864"), std::string::npos) << r.out;
   const auto j = nlohmann::json::parse(ReadAll(dir / "r.json"));
   EXPECT_EQ(j["model"], "elastica");

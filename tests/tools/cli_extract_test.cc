@@ -1,7 +1,7 @@
 // `textile extract` through the real executable: synthetic photos give profile CSVs that the
 // rest of the tool chain reads and overlays that OpenCV reads; every kind of bad input exits 2
 // and every detection failure exits 3, with one line on stderr, and neither leaves an output
-// behind or replaces a good one (cli.md).
+// behind or replaces a good one (docs/spec/cli.md).
 
 #include <gtest/gtest.h>
 

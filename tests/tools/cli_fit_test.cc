@@ -1,7 +1,7 @@
 // `textile fit` through the real executable: profiles made by `textile synth-profile` from a
 // known material are fitted back, and the fitted material must reproduce the known moment
 // curve; bad input is refused with exit 2, failed computations exit 3, and in both cases no
-// output is written or replaced (cli.md).
+// output is written or replaced (docs/spec/cli.md).
 
 #include <gtest/gtest.h>
 
@@ -131,7 +131,7 @@ nlohmann::json FitRoundTrip(const std::string& method, const fs::path& dir, doub
   }
   EXPECT_EQ(fit.at("method"), method);
   EXPECT_TRUE(fit.at("b2_observed").is_boolean());
-  // Classic outputs are self-consistent: G = ρ g c³ (cantilever.md), 1e-9 for rounding.
+  // Classic outputs are self-consistent: G = ρ g c³ (docs/spec/cantilever.md), 1e-9 for rounding.
   const double c = fit.at("bending_length_mm").get<double>() * 1e-3;
   const double g_uNm = kFig8Gsm * 1e-3 * 9.80665 * c * c * c * 1e6;
   EXPECT_NEAR(fit.at("flexural_rigidity_uNm").get<double>(), g_uNm, 1e-9 * g_uNm);

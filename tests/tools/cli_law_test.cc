@@ -297,7 +297,7 @@ TEST(CliBench, ProgressLinesWithTheFlag) {
 }
 
 // The quick photo benchmark's summary table: a column without values (the easy photos are
-// PNGs, whose decode time is not measured) printed "nan" on stdout; cli.md allows no NaN.
+// PNGs, whose decode time is not measured) printed "nan" on stdout; docs/spec/cli.md allows no NaN.
 TEST(CliBench, ExtractAccuracySummaryPrintsNoNan) {
   const auto d = Scratch("CliBench.ExtractAccuracy");
   const auto r = RunTextile("bench extract-accuracy --quick -o '" + d.string() + "'",

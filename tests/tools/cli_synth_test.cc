@@ -1,5 +1,5 @@
 // `textile synth-profile` through the real executable: the files it writes, determinism, and
-// how it refuses bad flags and bad materials (cli.md: exit 2, one line naming the flag or
+// how it refuses bad flags and bad materials (docs/spec/cli.md: exit 2, one line naming the flag or
 // file, nothing written).
 
 #include <gtest/gtest.h>
@@ -192,7 +192,8 @@ TEST(CliSynth, BadFlagsExit2NamingTheFlag) {
 }
 
 TEST(CliSynth, PointsAndRotationErrorsNameTheirFlag) {
-  // cli.md: the error names the flag the user typed (not an internal option name or unit).
+  // docs/spec/cli.md: the error names the flag the user typed (not an internal option name or
+  // unit).
   const auto dir = Scratch("cli_synth_bad_points") / "never-created";
   for (const char* args : {"--points 2", "--points -5"}) {
     const auto r = Textile("synth-profile --material " + kFig8 + " --overhang-mm 40 " + args +

@@ -352,7 +352,7 @@ TEST(CliValidate, PhotoFlagsWithoutPhotosGetANote) {
   EXPECT_TRUE(nlohmann::json::parse(p.out)["note"].is_null()) << p.out;
 }
 
-// fitted.json carries the fit report `textile fit` writes (cli.md: b1_sd, b2_sd, c1_sd,
+// fitted.json carries the fit report `textile fit` writes (docs/spec/cli.md: b1_sd, b2_sd, c1_sd,
 // bending_length_mm, flexural_rigidity_uNm, ...), with the same numbers for the same profiles:
 // both run the direct fit with its default options.
 TEST(CliValidate, FittedMaterialCarriesTheFitReport) {

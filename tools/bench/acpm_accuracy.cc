@@ -1,8 +1,8 @@
 // acpm-accuracy: the plain 200 mm strip on the virtual ACPM200, the shell model at increasing
-// resolution against the exact elastica (cantilever.md: the shell's validation), for the paper's
-// three fabrics plus a very soft and a very stiff one. Crossing-length error and side-profile
-// RMS against run time (a Pareto curve), with the elastica's own time as the reference row.
-// Three shell variants: the curvature-tensor bending with one push (first-order convergence),
+// resolution against the exact elastica (docs/spec/cantilever.md: the shell's validation), for the
+// paper's three fabrics plus a very soft and a very stiff one. Crossing-length error and
+// side-profile RMS against run time (a Pareto curve), with the elastica's own time as the reference
+// row. Three shell variants: the curvature-tensor bending with one push (first-order convergence),
 // the same extrapolated from e and e/2 (the default), and the paper's hinges (biased short by
 // their bending-twist coupling, docs/statics.md).
 

@@ -1,9 +1,9 @@
 #ifndef TEXTILE_TOOLS_BENCH_BENCH_H_
 #define TEXTILE_TOOLS_BENCH_BENCH_H_
 
-// The benchmarks of ../shared/spec/benchmarks.md behind `textile bench NAME`. Each one runs its
-// study, returns rows (one JSON object per CSV row, columns as benchmarks.md names them, more
-// welcome), writes a PNG to the output folder and prints a short table on stdout (unless
+// The benchmarks of docs/spec/benchmarks.md behind `textile bench NAME`. Each one runs its
+// study, returns rows (one JSON object per CSV row, columns as docs/spec/benchmarks.md names them,
+// more welcome), writes a PNG to the output folder and prints a short table on stdout (unless
 // --json). Timings are medians of repeats measured in the same run; never used by tests.
 
 #include <functional>
@@ -34,8 +34,9 @@ struct Benchmark {
 
 // Benchmarks register themselves, one file each (tools/bench/<name>.cc), with a namespace-scope
 //   const bool kRegistered = AddBenchmark(40, FitAccuracyBenchmark);
-// `order` follows benchmarks.md: bend-force 10, hinge-curve 15, stability 20, acpm-accuracy 30,
-// fit-accuracy 40, elastica 45, extract-accuracy 50, drape-convergence 60, stress 70.
+// `order` follows docs/spec/benchmarks.md: bend-force 10, hinge-curve 15, stability 20,
+// acpm-accuracy 30, fit-accuracy 40, elastica 45, extract-accuracy 50, drape-convergence 60,
+// stress 70.
 bool AddBenchmark(int order, Benchmark (*make)());
 // All registered benchmarks, in order.
 const std::vector<Benchmark>& Registry();

@@ -1,6 +1,6 @@
 // drape-convergence: the virtual drapemeter's drape coefficient and node count against mesh
-// resolution and solver tolerance, against run time (benchmarks.md), for the paper's Fig. 8
-// fabric {0.1, 0.0892, -0.0092} KES at 200 g/m², plain and with a double lap (C-plain) weft seam.
+// resolution and solver tolerance, against run time (docs/spec/benchmarks.md), for the paper's Fig.
+// 8 fabric {0.1, 0.0892, -0.0092} KES at 200 g/m², plain and with a double lap (C-plain) weft seam.
 // The finest resolution is the reference: DC should settle to < 0.005. Rows with the seam band
 // refined (--seam-refine-mm, Pabst 4.3) measure that shortcut: refined near the seam only
 // against not at all and against a uniform mesh about as fine as the refined band. Rows with a

@@ -1,8 +1,8 @@
-// extract-accuracy (benchmarks.md): rendered photos of the paper's fabrics (render_photo.h) at
-// three difficulty levels and 2 to 50 MP; distance of the extracted profile from the truth in
-// mm, and the extraction's time on one core. The true rig is used, so the error is the
-// extractor's alone (calibration is tested separately). Times are CPU time of this thread with
-// OpenCV single-threaded (the one-core figure, steady on a loaded machine, unlike the wall
+// extract-accuracy (docs/spec/benchmarks.md): rendered photos of the paper's fabrics
+// (render_photo.h) at three difficulty levels and 2 to 50 MP; distance of the extracted profile
+// from the truth in mm, and the extraction's time on one core. The true rig is used, so the error
+// is the extractor's alone (calibration is tested separately). Times are CPU time of this thread
+// with OpenCV single-threaded (the one-core figure, steady on a loaded machine, unlike the wall
 // clock, which is reported too), and the JPEG's decoding is timed apart from the extraction.
 
 #include <time.h>
@@ -196,7 +196,7 @@ Benchmark ExtractAccuracyBenchmark() {
                 return v.empty() ? NAN : *std::max_element(v.begin(), v.end());
               };
               // A column with no value (no photo of this plan decoded, or none extracted) is
-              // "-", not "nan" (cli.md: no NaN in outputs).
+              // "-", not "nan" (docs/spec/cli.md: no NaN in outputs).
               const auto cell = [](double v, int digits) {
                 char c[32];
                 if (std::isfinite(v))

@@ -1,5 +1,5 @@
-// fit-accuracy (benchmarks.md): synthetic profiles from known laws, noise σ = 0 .. 0.5 mm, one to
-// five overhang lengths; error of the recovered moment curve and constants, and of the
+// fit-accuracy (docs/spec/benchmarks.md): synthetic profiles from known laws, noise σ = 0 .. 0.5
+// mm, one to five overhang lengths; error of the recovered moment curve and constants, and of the
 // re-simulated profile, against run time, for Clapp's method and the direct fit on the same data.
 
 #include <chrono>

@@ -1,5 +1,5 @@
-// stress: the static solver at the extremes (benchmarks.md): bending/stretch ratio over six
-// decades, 20-2000 g/m², b1 = b2, κ0 near 0, 50 to 100k triangles, bad meshes. Every run has a
+// stress: the static solver at the extremes (docs/spec/benchmarks.md): bending/stretch ratio over
+// six decades, 20-2000 g/m², b1 = b2, κ0 near 0, 50 to 100k triangles, bad meshes. Every run has a
 // time and iteration cap; the outcome is "converged", "failed-cleanly" (not converged with a
 // reason, or a typed InputError/ComputeError) or "other" (anything else: a non-finite result,
 // an unexpected exception). Only "other" is a bug.

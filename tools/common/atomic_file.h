@@ -3,7 +3,7 @@
 
 // Every file the CLI writes goes through here: the content lands in a temporary file next to
 // the target and is renamed over it only when complete, so a failed run leaves no
-// half-written file and never replaces a good one with garbage (cli.md).
+// half-written file and never replaces a good one with garbage (docs/spec/cli.md).
 //
 //   textile::AtomicFile out("fit.json");        // throws InputError if the folder is unusable
 //   std::ofstream(out.temp_path()) << text;      // or let a library write to temp_path()

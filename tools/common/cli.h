@@ -2,7 +2,7 @@
 #define TEXTILE_TOOLS_COMMON_CLI_H_
 
 // What every subcommand shares: registration, the --json flag, printing, exit codes.
-// Conventions (cli.md): human-readable text on stdout, or one JSON object with --json;
+// Conventions (docs/spec/cli.md): human-readable text on stdout, or one JSON object with --json;
 // errors are one line "error: ..." on stderr with exit 2 (bad input, usage) or 3 (a
 // computation failed). Subcommands throw InputError / ComputeError; main() maps them.
 
@@ -33,10 +33,10 @@ bool IsValidUtf8(const std::string& s);
 // Progress/info line on stderr (never on stdout, which may carry JSON).
 void Info(const std::string& line);
 
-// Progress line on stderr ("Progress for anything over about a second goes to stderr", cli.md),
-// printed only when stderr is a terminal or when `always` is set (a --progress flag), as git
-// does: a script or a test reading stderr sees nothing there but the one `error: ...` line of a
-// failed run. Warnings and notes the user must see go through Info.
+// Progress line on stderr ("Progress for anything over about a second goes to stderr",
+// docs/spec/cli.md), printed only when stderr is a terminal or when `always` is set (a --progress
+// flag), as git does: a script or a test reading stderr sees nothing there but the one `error: ...`
+// line of a failed run. Warnings and notes the user must see go through Info.
 void Progress(const std::string& line, bool always = false);
 // Whether Progress prints: stderr is a terminal, or `always`.
 bool ShowProgress(bool always = false);

@@ -41,7 +41,7 @@ struct PhotoInputOptions {
 
 struct LoadedProfile {
   std::string source;  // the path as given
-  Profile profile;     // frame of cantilever.md [m]; profile.source == source
+  Profile profile;     // frame of docs/spec/cantilever.md [m]; profile.source == source
   bool from_photo = false;
   std::optional<ExtractionSummary> extraction;  // for photos
   cv::Mat photo;  // the grey photo when from_photo and options.keep_photos, else empty

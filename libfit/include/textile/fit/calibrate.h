@@ -1,7 +1,7 @@
 #ifndef TEXTILE_FIT_CALIBRATE_H_
 #define TEXTILE_FIT_CALIBRATE_H_
 
-// Rig calibration from chessboard photos (cantilever.md, "Photo protocol"): a standard
+// Rig calibration from chessboard photos (docs/spec/cantilever.md, "Photo protocol"): a standard
 // chessboard held in the bending plane, photographed by the camera that takes the cantilever
 // photos, gives the image -> plane homography; several photos of the board (in the plane and in
 // other poses) also give the lens distortion.

@@ -17,7 +17,7 @@
 //      φ = atan2(-y, x), the angle below horizontal;
 //   2. least-squares polynomial φ(r) of order 5 (Clapp's choice);
 //   3. along the smooth curve x = r cos φ(r), y = -r sin φ(r): curvature κ, arc length s and
-//      the moment per unit width m(s) = ρ g ∫_s^L (x(s') - x(s)) ds' (cantilever.md);
+//      the moment per unit width m(s) = ρ g ∫_s^L (x(s') - x(s)) ds' (docs/spec/cantilever.md);
 //   4. (κ, m) pairs at evenly spaced arc lengths.
 // The pairs of all profiles are pooled and eq. 1 of Pabst et al. ({b1, b2, c1}) is regressed
 // on them by least squares in M (Ceres), with κ0 ≥ 0 guaranteed by the parametrisation
@@ -128,8 +128,8 @@ struct ClappResult {
 
 // Fits the law of Pabst et al. eq. 1 to cantilever profiles of one strip by Clapp's method.
 // @param profiles       #P ≥ 1 profiles of the same strip (different overhang lengths), in the
-//                       frame of cantilever.md: origin at the edge, x towards the overhang, y up,
-//                       s from the edge, all [m]; each must pass CheckProfile
+//                       frame of docs/spec/cantilever.md: origin at the edge, x towards the
+//                       overhang, y up, s from the edge, all [m]; each must pass CheckProfile
 // @param areal_density  ρ [kg/m²], > 0 (only M/ρ is identifiable from shape)
 // @param options        see ClappOptions
 // Throws InputError for bad options, a bad profile or too few usable points for the

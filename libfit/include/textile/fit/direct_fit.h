@@ -1,8 +1,8 @@
 #ifndef TEXTILE_FIT_DIRECT_FIT_H_
 #define TEXTILE_FIT_DIRECT_FIT_H_
 
-// The direct fit (cantilever.md, "Direct fit"): the constants {b1, b2, c1} of Pabst eq. 1 such
-// that heavy-elastica profiles match one or several measured profiles of the same strip.
+// The direct fit (docs/spec/cantilever.md, "Direct fit"): the constants {b1, b2, c1} of Pabst eq. 1
+// such that heavy-elastica profiles match one or several measured profiles of the same strip.
 //
 //   std::vector<textile::Profile> profiles = {textile::ReadProfileCsv("strip_40.csv"),
 //                                             textile::ReadProfileCsv("strip_60.csv")};
@@ -74,8 +74,8 @@ struct DirectFitSummary {
   double b1_sd = 0.0, b2_sd = 0.0, c1_sd = 0.0;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
 
-  // Observability (cantilever.md): the largest curvature the data reach, and which constants
-  // the data determine. When κ0 ≥ kappa_max the linear branch is never reached: b2 is not
+  // Observability (docs/spec/cantilever.md): the largest curvature the data reach, and which
+  // constants the data determine. When κ0 ≥ kappa_max the linear branch is never reached: b2 is not
   // observed, and the law is reported with κ0 set to kappa_max (the quadratic up to the data's
   // reach, then its last slope), not an invented b2.
   double kappa_max = 0.0;  // [1/m]

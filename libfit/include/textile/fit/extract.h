@@ -1,8 +1,8 @@
 #ifndef TEXTILE_FIT_EXTRACT_H_
 #define TEXTILE_FIT_EXTRACT_H_
 
-// Photo of a cantilevered strip -> its profile in the bending plane (cantilever.md, "Photo
-// protocol" and "Frame"): millimetres, origin at the platform edge or where the strip leaves
+// Photo of a cantilevered strip -> its profile in the bending plane (docs/spec/cantilever.md,
+// "Photo protocol" and "Frame"): millimetres, origin at the platform edge or where the strip leaves
 // the clamp, x towards the overhang, y up, s the arc length from the edge.
 //
 //   cv::Mat photo = textile::ReadPhotoGray("strip.jpg");        // throws InputError
@@ -89,7 +89,7 @@ struct ExtractionSummary {
   std::string message;
   std::string source;  // the photo, for messages
 
-  Profile profile;                    // frame of cantilever.md [m]
+  Profile profile;                    // frame of docs/spec/cantilever.md [m]
   std::string rig_type;               // "platform" or "clamp"
   std::string rig_detail;             // how the origin was found, for people
   std::string polarity;               // "light" or "dark": the strip against the background

@@ -1,8 +1,8 @@
 #ifndef TEXTILE_FIT_PROFILE_H_
 #define TEXTILE_FIT_PROFILE_H_
 
-// A measured cantilever profile in the bending plane (cantilever.md, "Frame"): origin at the
-// platform edge, x towards the overhang, y up (a hanging strip has y < 0), s the arc length
+// A measured cantilever profile in the bending plane (docs/spec/cantilever.md, "Frame"): origin at
+// the platform edge, x towards the overhang, y up (a hanging strip has y < 0), s the arc length
 // from the edge. Files are CSV with the header `s_mm,x_mm,y_mm`; inside, metres.
 //
 //   textile::Profile p = textile::ReadProfileCsv("strip_60mm.profile.csv");

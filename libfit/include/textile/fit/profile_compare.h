@@ -2,8 +2,8 @@
 #define TEXTILE_FIT_PROFILE_COMPARE_H_
 
 // Measured profile against a simulated one: how far apart, in mm, as a technician would judge
-// (cantilever.md, "Closing the loop"). Used by fit reports (for every method alike, so Clapp
-// and the direct fit are graded the same way) and by validation.
+// (docs/spec/cantilever.md, "Closing the loop"). Used by fit reports (for every method alike, so
+// Clapp and the direct fit are graded the same way) and by validation.
 //
 //   textile::ProfileComparison c = textile::CompareWithElastica(law, 0.2, measured, 0.06, 0.0);
 //   // c.rms, c.max [m]: normal distances of the measured points to the simulated curve

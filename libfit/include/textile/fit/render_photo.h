@@ -1,11 +1,11 @@
 #ifndef TEXTILE_FIT_RENDER_PHOTO_H_
 #define TEXTILE_FIT_RENDER_PHOTO_H_
 
-// Synthetic cantilever photos with a known truth (cantilever.md, "Photo protocol"): the exact
-// heavy elastica of a law, drawn as a band of the strip's thickness resting on a platform block,
-// seen by a pinhole camera with a pose (perspective), over a background with a light gradient
-// and a shadow, with the strip's texture, its frayed tip and hairy edges, optics blur, sensor
-// noise and JPEG compression; plus the matching chessboard image held in the bending plane.
+// Synthetic cantilever photos with a known truth (docs/spec/cantilever.md, "Photo protocol"): the
+// exact heavy elastica of a law, drawn as a band of the strip's thickness resting on a platform
+// block, seen by a pinhole camera with a pose (perspective), over a background with a light
+// gradient and a shadow, with the strip's texture, its frayed tip and hairy edges, optics blur,
+// sensor noise and JPEG compression; plus the matching chessboard image held in the bending plane.
 // For the extractor's tests, the calibration's tests, samples/photos and `textile bench
 // extract-accuracy`.
 //
@@ -14,12 +14,13 @@
 //   o.overhang = 0.06;                                     // [m]
 //   textile::RenderedPhoto r = textile::RenderPhoto(law, 0.2, o);   // law [SI], ρ [kg/m²]
 //   textile::image_codecs::Write("strip.png", r.photo);     // or r.encoded (JPEG bytes)
-//   // r.truth: the mid-line in the frame of cantilever.md [m]; r.rig: image -> plane [mm];
+//   // r.truth: the mid-line in the frame of docs/spec/cantilever.md [m]; r.rig: image -> plane
+//   [mm];
 //   // r.board: the chessboard photo; r.board_corners_px: its inner corners' true positions.
 //
-// Plane frame (mm): the frame of cantilever.md, origin at the platform's top/front corner, x
-// towards the overhang, y up, z towards the camera; the strip's near side face lies in z = 0.
-// Pixels are OpenCV's (x right, y down, pixel centres at integers). Deterministic per seed.
+// Plane frame (mm): the frame of docs/spec/cantilever.md, origin at the platform's top/front
+// corner, x towards the overhang, y up, z towards the camera; the strip's near side face lies in z
+// = 0. Pixels are OpenCV's (x right, y down, pixel centres at integers). Deterministic per seed.
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -108,7 +109,7 @@ struct RenderedPhoto {
   std::vector<Eigen::Vector2d> board_corners_mm;  // the same in the board's own frame [mm]
                                                   // (x along a row, y down the rows)
 
-  Profile truth;                    // strip mid-line, frame of cantilever.md [m]; s from the edge
+  Profile truth;  // strip mid-line, frame of docs/spec/cantilever.md [m]; s from the edge
   Profile truth_upper, truth_lower; // the silhouette's boundaries in the plane z = 0 [m]
   std::vector<Eigen::Vector2d> truth_px;  // #N the truth mid-line in the photo [px]
   Eigen::Vector2d origin_px{0, 0};  // the platform edge in the photo [px]

@@ -1,7 +1,7 @@
 #ifndef TEXTILE_FIT_RIG_H_
 #define TEXTILE_FIT_RIG_H_
 
-// How a camera's pixels map to millimetres in the bending plane (cantilever.md, "Photo
+// How a camera's pixels map to millimetres in the bending plane (docs/spec/cantilever.md, "Photo
 // protocol"): either a plain scale (a perpendicular, distortion-free setup) or the homography
 // from a chessboard held in the bending plane, optionally after removing lens distortion.
 //

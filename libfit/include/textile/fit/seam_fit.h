@@ -3,8 +3,8 @@
 
 // The seam influence factor B_f(d) = a2 d² + a1 d + a0 (Pabst et al. 2008, section 4.2,
 // Table 2; d in mm from the seam line) fitted to measured (d, factor) pairs: ACPM200 rays
-// (the virtual one's result JSON, cli.md) or a CSV `d_mm,factor[,sd]`. Weighted linear least
-// squares (GSL gsl_multifit_wlinear) with the parameter covariance; the result is a seam
+// (the virtual one's result JSON, docs/spec/cli.md) or a CSV `d_mm,factor[,sd]`. Weighted linear
+// least squares (GSL gsl_multifit_wlinear) with the parameter covariance; the result is a seam
 // profile (libsim seam.h) of type "fitted" with a `fit` report.
 //
 //   std::vector<textile::SeamSample> data = textile::ReadSeamSamples("acpm-result.json");
@@ -53,8 +53,8 @@ struct SeamSample {
 // non-finite value, d < 0, factor ≤ 0 or sd ≤ 0.
 std::vector<SeamSample> ParseSeamSamplesCsv(const std::string& text, const std::string& source);
 
-// Reads the rays of an ACPM result (cli.md: {"rays": [{"d_mm", "factor", ...}], ...}). Rays
-// without a seam distance (d_mm null: a plain sample) are refused. An optional "factor_sd" per
+// Reads the rays of an ACPM result (docs/spec/cli.md: {"rays": [{"d_mm", "factor", ...}], ...}).
+// Rays without a seam distance (d_mm null: a plain sample) are refused. An optional "factor_sd" per
 // ray is taken as sd. Throws InputError "<source>: rays[i].<field>: <problem>".
 std::vector<SeamSample> SeamSamplesFromAcpmJson(const nlohmann::json& result,
                                                 const std::string& source);

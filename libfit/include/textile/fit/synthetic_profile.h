@@ -13,9 +13,9 @@
 //
 // Order of the distortions (each off by default): sample the exact elastica at N arc lengths
 // (uniform, optionally jittered) -> lift by the vertical offset (the strip rests on the platform,
-// so its mid-line starts at (0, t/2); cantilever.md "Photo protocol") -> rotate about the edge by
-// the rig rotation -> add Gaussian noise to x and y -> optionally recompute s as the cumulative
-// chord length of the distorted points. Deterministic for a given seed.
+// so its mid-line starts at (0, t/2); docs/spec/cantilever.md "Photo protocol") -> rotate about the
+// edge by the rig rotation -> add Gaussian noise to x and y -> optionally recompute s as the
+// cumulative chord length of the distorted points. Deterministic for a given seed.
 
 #include <cstdint>
 #include <string>
@@ -52,7 +52,7 @@ struct SyntheticOptions {
 };
 
 // A synthetic profile of a strip with law `law` [SI], areal density [kg/m²] > 0 and overhang
-// length [m] > 0, in the frame of cantilever.md (origin at the edge, y up, metres).
+// length [m] > 0, in the frame of docs/spec/cantilever.md (origin at the edge, y up, metres).
 // @return #num_points profile; source describes the law, density, length, noise and seed.
 // Throws InputError for bad options or inputs, ComputeError when the elastica does not converge.
 Profile SyntheticProfile(const BendingLaw& law, double areal_density, double overhang,

@@ -2,7 +2,7 @@
 #define TEXTILE_SIM_ACPM_H_
 
 // The virtual ACPM200 bending tester (Pabst et al. 2008, sections 4.1 and 5.1;
-// ../shared/spec/cantilever.md, "Virtual ACPM200"). A sample up to 200 mm wide lies on a
+// docs/spec/cantilever.md, "Virtual ACPM200"). A sample up to 200 mm wide lies on a
 // platform and is pushed over its edge at 12 cm/min; the light barrier is the plane through
 // the edge inclined 41.5° below the horizontal, sampled by 17 rays across the width. Ray i is
 // cut when the sample's front at its width position z_i crosses that plane; the device records
@@ -25,7 +25,7 @@
 //    the push direction). It is plugged in as an AcpmModel (below); this build has none.
 //  - auto: the elastica when it is exact, else the shell model; the result says which and why.
 //
-// Everything here is SI (m, kg, s); the result JSON (cli.md) is in lab units.
+// Everything here is SI (m, kg, s); the result JSON (docs/spec/cli.md) is in lab units.
 
 #include <functional>
 #include <limits>
@@ -65,8 +65,8 @@ struct AcpmResult;
 struct AcpmOptions;
 
 // What a model answers for a scene: per ray, the overhang at which the front crosses the
-// barrier, plus the side profile (mid-line in the bending plane, cantilever.md's frame) at the
-// crossing of one ray.
+// barrier, plus the side profile (mid-line in the bending plane, docs/spec/cantilever.md's frame)
+// at the crossing of one ray.
 struct AcpmCrossings {
   bool converged = false;
   std::string message;            // why not, when not converged
@@ -154,8 +154,8 @@ struct AcpmResult {
 // model fails to converge.
 AcpmResult RunAcpm(const Material& material, const AcpmOptions& options = {});
 
-// cli.md's ACPM result JSON: {"model", "model_reason", "rays": [{"z_mm", "d_mm", "overhang_mm",
-// "bending_length_mm", "rigidity_uNm", "factor", "device_time_s"}], "plain": {...},
+// docs/spec/cli.md's ACPM result JSON: {"model", "model_reason", "rays": [{"z_mm", "d_mm",
+// "overhang_mm", "bending_length_mm", "rigidity_uNm", "factor", "device_time_s"}], "plain": {...},
 // "device_time_s", "seam": {"direction", "at_mm", "profile"}, "side_profile": {...}, ...}.
 // d_mm is null for a plain sample.
 nlohmann::json AcpmResultToJson(const AcpmResult& result, const Material& material,

@@ -11,8 +11,8 @@
 // The scene at overhang L: the sample's overhanging part [0, L] × [0, W] (x along the push, y
 // across the width, z up) plus one cell on the platform, whose vertices are held flat: the
 // platform holds the sample as the elastica's clamp does (the part on the platform stays flat
-// under its own weight, cantilever.md). A tensor-product grid with a constant number of cells
-// stretches with L, so each step is warm-started from the last state; a seam along the push
+// under its own weight, docs/spec/cantilever.md). A tensor-product grid with a constant number of
+// cells stretches with L, so each step is warm-started from the last state; a seam along the push
 // direction lies on a grid line, a seam across it at its distance behind the front. The front
 // edge's height over the 41.5° barrier plane is interpolated at every ray; the push steps
 // until every ray is cut, then each ray's crossing is refined (Illinois regula falsi on the
@@ -75,7 +75,8 @@ AcpmCrossings ShellAcpmCrossings(const Material& material, const AcpmOptions& op
 struct ShellCantilever {
   bool converged = false;
   std::string message;       // why not, when not converged
-  std::vector<double> x, y;  // centre line [m], cantilever.md's frame, from the edge (0, 0)
+  std::vector<double> x,
+      y;  // centre line [m], docs/spec/cantilever.md's frame, from the edge (0, 0)
   int solves = 0;            // static solves, both resolutions
   int vertices = 0;          // of the finest grid
   std::string notes;

@@ -147,9 +147,9 @@ class BendingLaw {
   std::shared_ptr<const Spline> spline_;  // null for a Pabst law; immutable, so shared by copies
 };
 
-// Warp/weft anisotropy (physics.md): a hinge whose edge makes angle φ with the warp direction
-// bends with M(κ) = cos²φ M_warp(κ) + sin²φ M_weft(κ). The blend of two laws is again odd,
-// C1 and strictly increasing; its inverse is found by safeguarded Newton.
+// Warp/weft anisotropy (docs/spec/physics.md): a hinge whose edge makes angle φ with the warp
+// direction bends with M(κ) = cos²φ M_warp(κ) + sin²φ M_weft(κ). The blend of two laws is again
+// odd, C1 and strictly increasing; its inverse is found by safeguarded Newton.
 class BlendedLaw {
  public:
   // phi: angle between the hinge edge and the warp direction [rad].

@@ -3,7 +3,7 @@
 
 // What a cantilever bending tester reports (ASTM D1388, ISO 9073-7, BS 3356, FAST-2, the
 // ACPM200 of Pabst section 4.1), computed from the exact heavy elastica
-// (../shared/spec/cantilever.md, "Classic outputs").
+// (docs/spec/cantilever.md, "Classic outputs").
 //
 //   // Where does the paper's Fig. 8 fabric (200 g/m²) meet the 41.5° barrier?
 //   textile::BendingLaw law = textile::BendingLaw::FromKes(0.1, 0.0892, -0.0092);

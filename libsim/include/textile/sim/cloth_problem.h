@@ -1,9 +1,9 @@
 #ifndef TEXTILE_SIM_CLOTH_PROBLEM_H_
 #define TEXTILE_SIM_CLOTH_PROBLEM_H_
 
-// The total potential of a piece of cloth in a static scene (physics.md, "Static equilibrium";
-// Sensitive Couture eq. 1): membrane + bending + gravity + contact penalty + friction anchor
-// springs, with fixed (or prescribed) vertices. Solvers (static_solver.h) minimise it.
+// The total potential of a piece of cloth in a static scene (docs/spec/physics.md, "Static
+// equilibrium"; Sensitive Couture eq. 1): membrane + bending + gravity + contact penalty + friction
+// anchor springs, with fixed (or prescribed) vertices. Solvers (static_solver.h) minimise it.
 //
 //   textile::TriangleMesh sheet = textile::RegularGridMesh(0.5, 0.5, 30, 30);
 //   textile::ClothProblem problem(sheet, material, {}, textile::ClothOptions{});
@@ -142,7 +142,7 @@ class ClothProblem {
   // Sets the fixed vertices of x to their prescribed positions.
   void ApplyFixed(Vertices* x) const;
   // RMS of the force on free vertices over the RMS of their weights m_i |g| [-]: the
-  // convergence measure of every solver (physics.md: "relative to the weight").
+  // convergence measure of every solver (docs/spec/physics.md: "relative to the weight").
   double RelativeResidual(const Vertices& grad) const;
 
   const TriangleMesh& rest() const { return rest_; }

@@ -1,9 +1,9 @@
 #ifndef TEXTILE_SIM_CONTACT_H_
 #define TEXTILE_SIM_CONTACT_H_
 
-// Supports the cloth rests on: analytic signed-distance shapes (physics.md, "Contact"), with
-// penalty springs on the nodes and Coulomb friction by moving anchor springs (Sensitive Couture
-// section 7, after Hasegawa et al. 2003). No self-contact in this version.
+// Supports the cloth rests on: analytic signed-distance shapes (docs/spec/physics.md, "Contact"),
+// with penalty springs on the nodes and Coulomb friction by moving anchor springs (Sensitive
+// Couture section 7, after Hasegawa et al. 2003). No self-contact in this version.
 //
 //   textile::Support table = textile::Support::Disk({0, 0, 0}, 0.09, 0.005, 0.001);
 //   Eigen::Vector3d n;

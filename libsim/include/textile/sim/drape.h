@@ -2,7 +2,7 @@
 #define TEXTILE_SIM_DRAPE_H_
 
 // The virtual drapemeter (Cusick test; Pabst et al. section 5.2, Fig. 8;
-// ../shared/spec/drapemeter.md): a disk of fabric held on a smaller disk drapes under its own
+// docs/spec/drapemeter.md): a disk of fabric held on a smaller disk drapes under its own
 // weight; the drape coefficient and the folds ("nodes") of its shadow are measured.
 //
 //   textile::DrapeOptions options;                       // 150 mm specimen, 90 mm support, clamped

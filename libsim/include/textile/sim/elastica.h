@@ -2,7 +2,7 @@
 #define TEXTILE_SIM_ELASTICA_H_
 
 // The heavy elastica: a strip clamped flat at a table edge, bending under its own weight with a
-// nonlinear moment-curvature law (../shared/spec/cantilever.md, "Heavy elastica"). It is the
+// nonlinear moment-curvature law (docs/spec/cantilever.md, "Heavy elastica"). It is the
 // reference forward model of the project: the classic cantilever outputs, the Clapp baseline,
 // the direct fit and the validation of the shell model all rest on it.
 //
@@ -14,9 +14,9 @@
 //   if (!p.converged) throw textile::ComputeError(p.message);
 //   // p.x, p.y [m]: 201 points from the edge (0, 0) to the tip (≈ 0.0103, -0.0959).
 //
-// Frame (cantilever.md, "Frame"): origin at the edge, x towards the overhang, y up, so a hanging
-// strip has y < 0; arc length s from the edge (0) to the free tip (L); θ is the angle below the
-// horizontal. Per unit width the bending moment m(s) = ρ g ∫_s^L (x(s') - x(s)) ds' satisfies
+// Frame (docs/spec/cantilever.md, "Frame"): origin at the edge, x towards the overhang, y up, so a
+// hanging strip has y < 0; arc length s from the edge (0) to the free tip (L); θ is the angle below
+// the horizontal. Per unit width the bending moment m(s) = ρ g ∫_s^L (x(s') - x(s)) ds' satisfies
 //
 //   dm/ds = -ρ g (L - s) cos θ,  m(L) = 0,   dθ/ds = κ = M⁻¹(m),  θ(0) = 0,
 //
@@ -39,8 +39,9 @@ namespace textile {
 // (Pabst et al. section 4.2). Both are functions of the distance u = L - s from the free tip
 // [m], so that a seam at a fixed distance from the sample's front stays at that point of the
 // strip whatever the overhang. With S(u) the law becomes M_S(κ) = S(u) M(κ) (the multiplier of
-// eq. 6 on the moment), so κ = M⁻¹(m / S), and the moment balance of cantilever.md becomes
-// dm/ds = -ρ g W(u) cos θ with W(u) = ∫_0^u ρ(u')/ρ du' the weight beyond s in strip lengths.
+// eq. 6 on the moment), so κ = M⁻¹(m / S), and the moment balance of docs/spec/cantilever.md
+// becomes dm/ds = -ρ g W(u) cos θ with W(u) = ∫_0^u ρ(u')/ρ du' the weight beyond s in strip
+// lengths.
 //
 //   // A C-plain seam across the strip, 20 mm from the front (docs/acpm.md):
 //   textile::StripVariation v;

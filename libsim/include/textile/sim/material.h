@@ -1,7 +1,8 @@
 #ifndef TEXTILE_SIM_MATERIAL_H_
 #define TEXTILE_SIM_MATERIAL_H_
 
-// A fabric as the simulators see it, read from and written to the material JSON of cli.md.
+// A fabric as the simulators see it, read from and written to the material JSON of
+// docs/spec/cli.md.
 //
 //   textile::Material m = textile::ReadMaterial("samples/materials/pabst-fig8.json");
 //   textile::BendingLaw law = m.EffectiveLaw();   // β applied; SI inside
@@ -31,11 +32,11 @@ struct Material {
   BendingLaw bending = BendingLaw::FromKes(0.1, 0.1, 0.0);  // warp law (or the only law)
   std::optional<BendingLaw> bending_weft;    // weft law, when anisotropic
   double beta = 1.0;                         // linear bending stiffness factor β (section 3.4)
-  double stretch_stiffness = 1000.0;         // membrane stiffness [N/m] (physics.md default)
+  double stretch_stiffness = 1000.0;  // membrane stiffness [N/m] (docs/spec/physics.md default)
   double poisson = 0.3;                      // Poisson ratio [-]
   // The membrane's stiffness against compression as a fraction of its stretch stiffness [-]
   // (stretch.compression_ratio, kMinCompressionRatio .. 1): 1, the default, is the stabilised
-  // StVK of physics.md, as stiff in compression as in tension (membrane.h).
+  // StVK of docs/spec/physics.md, as stiff in compression as in tension (membrane.h).
   double compression_ratio = 1.0;
   double friction = 0.3;                     // Coulomb coefficient against supports [-]
   nlohmann::json fit;                        // the `fit` report when a fit made this file

@@ -2,7 +2,8 @@
 #define TEXTILE_SIM_MEMBRANE_H_
 
 // In-plane (membrane) elasticity of cloth: constant-strain triangles (CST) with energy, gradient
-// and Hessian side by side. Two models (physics.md, "Membrane"; docs/meshing-and-membrane.md):
+// and Hessian side by side. Two models (docs/spec/physics.md, "Membrane";
+// docs/meshing-and-membrane.md):
 //
 //   kCorotationalLinear  Pabst's linear-elastic CST: Hooke's law on the rotation-free strain
 //                        ε = U - I of the polar decomposition F = R U, so large rotations of a

@@ -35,8 +35,8 @@ struct PatternMeshOptions {
   // Target edge length h away from seams [m].
   double element_size = 0.01;
   // Area refinement factor as a function of the distance d [m] from the nearest seam line; the
-  // seams module plugs in S(d) (physics.md, "Seams"). Empty: no refinement. Must return a finite
-  // number; values below 1 mean no refinement. It should fall to 1 away from the seams: raw
+  // seams module plugs in S(d) (docs/spec/physics.md, "Seams"). Empty: no refinement. Must return a
+  // finite number; values below 1 mean no refinement. It should fall to 1 away from the seams: raw
   // Table 2 polynomials rise again far from the seam, S(d) does not.
   std::function<double(double d_m)> area_factor;
   // area_factor is consulted only for d < refinement_range [m]; elsewhere the factor is 1.

@@ -17,7 +17,7 @@
 //   auto area_factor = textile::SeamAreaFactor({c});   // d [m] -> ⌈B_f⌉, for the mesher
 //
 // Units: the profile works in mm (d, as in the paper's Table 2); geometry is in metres.
-// The readings of the paper that this file fixes are in ../shared/spec/physics.md ("Seams")
+// The readings of the paper that this file fixes are in docs/spec/physics.md ("Seams")
 // and docs/seams.md.
 
 #include <Eigen/Core>
@@ -105,8 +105,8 @@ SeamProfile SeamPreset(const std::string& type);
 // "A-plain", "A-twill", "B-plain", "B-twill", "C-plain", "C-twill".
 std::vector<std::string> SeamPresetNames();
 
-// Seam JSON (cli.md): {"type", "layers", "coefficients_mm": [a2, a1, a0], "range_mm": [lo, hi],
-// "covariance": [[3], [3], [3]], "name", "influence_mm", "fade_mm", "allowance_mm",
+// Seam JSON (docs/spec/cli.md): {"type", "layers", "coefficients_mm": [a2, a1, a0], "range_mm":
+// [lo, hi], "covariance": [[3], [3], [3]], "name", "influence_mm", "fade_mm", "allowance_mm",
 // "multiplier": "factor" | "paper-literal", "rib_factor", "fit": {...}, "notes", "source",
 // "assumptions"}.
 // type, layers and coefficients_mm are required. Throws InputError "<source>: <field>: <problem>".
@@ -143,8 +143,8 @@ std::vector<double> HingeSeamDistances(const TriangleMesh& mesh, const std::vect
 
 // Per-hinge bending multipliers S (#H, ≥ 1), as BendingElements takes them: for each hinge the
 // largest S_i(d_i) over the seams, times the lengthwise term of rib_factor inside a seam's band
-// (max, not product: crossing seams are as stiff as the stiffer one; physics.md fixes no rule).
-// No seams: all ones. Calls CheckSeams.
+// (max, not product: crossing seams are as stiff as the stiffer one; docs/spec/physics.md fixes no
+// rule). No seams: all ones. Calls CheckSeams.
 std::vector<double> HingeSeamMultipliers(const TriangleMesh& mesh, const std::vector<Hinge>& hinges,
                                          const std::vector<Seam>& seams);
 

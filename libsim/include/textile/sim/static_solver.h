@@ -1,8 +1,8 @@
 #ifndef TEXTILE_SIM_STATIC_SOLVER_H_
 #define TEXTILE_SIM_STATIC_SOLVER_H_
 
-// Static equilibrium of a ClothProblem (physics.md, "Static equilibrium"; Sensitive Couture
-// sections 5 and 7): minimise the total potential.
+// Static equilibrium of a ClothProblem (docs/spec/physics.md, "Static equilibrium"; Sensitive
+// Couture sections 5 and 7): minimise the total potential.
 //
 //   textile::SolveOptions options;                       // Newton + CHOLMOD, tolerance 1e-6
 //   textile::SolveSummary s = textile::SolveStatic(&problem, &x, options);

@@ -4,7 +4,7 @@
 // Units at the edges. Everything inside textile is SI (m, kg, N, s, rad); people read and
 // write lab units. The bending law is per unit width: M in N·m/m = N, κ in 1/m, b in N·m,
 // c1 in N·m². KES units (Kawabata KES-FB2): M in gf·cm/cm, κ in 1/cm, b in gf·cm
-// ("gf·cm²/cm"), c1 in gf·cm². See ../shared/spec/physics.md, "Units".
+// ("gf·cm²/cm"), c1 in gf·cm². See docs/spec/physics.md, "Units".
 //
 //   double b1_si = textile::units::KesStiffnessToSi(0.1);   // 9.80665e-6 N·m
 //   double rho = textile::units::GsmToSi(200.0);           // 0.2 kg/m²

@@ -5,26 +5,15 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "csv_text.h"
 #include "textile/sim/error.h"
 #include "textile/sim/units.h"
 
 namespace textile {
 namespace {
 
-std::string Trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t\r\n") - b + 1);
-}
-
-std::vector<std::string> Cells(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string cell;
-  while (std::getline(ss, cell, ',')) out.push_back(Trim(cell));
-  if (!line.empty() && line.back() == ',') out.push_back("");
-  return out;
-}
+using internal::SplitComma;
+using internal::Trim;
 
 // Which columns hold κ and M, and the factors that take them to SI.
 struct Columns {
@@ -60,7 +49,7 @@ MomentCurvePairs ParseMomentCurvatureCsv(const std::string& text, const std::str
     if (line_no == 1 && t.rfind("\xEF\xBB\xBF", 0) == 0) t = t.substr(3);  // byte-order mark
     if (t.empty() || t[0] == '#') continue;
     const std::string where = source + ":" + std::to_string(line_no) + ": ";
-    const std::vector<std::string> cells = Cells(t);
+    const std::vector<std::string> cells = SplitComma(t);
     if (!header_seen) {
       header_seen = true;
       cols = FindColumns(cells);

@@ -7,6 +7,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "csv_text.h"
 #include "textile/sim/error.h"
 
 namespace textile {
@@ -22,20 +23,8 @@ constexpr double kFoldBackM = 1e-3;
 // 80 mm profile as folding back.
 constexpr double kMaxTiltRad = 3.0 * std::numbers::pi / 180.0;
 
-std::string Trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t\r\n") - b + 1);
-}
-
-std::vector<std::string> SplitComma(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream ss(line);
-  std::string cell;
-  while (std::getline(ss, cell, ',')) out.push_back(Trim(cell));
-  if (!line.empty() && line.back() == ',') out.push_back("");
-  return out;
-}
+using internal::SplitComma;
+using internal::Trim;
 
 }  // namespace
 

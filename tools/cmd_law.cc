@@ -125,36 +125,6 @@ double SampleKappa(int i, int n, double kappa_max, bool log_kappa) {
   return kappa_max * std::pow(10.0, -4.0 * (1.0 - static_cast<double>(i) / n));
 }
 
-// The covariance of (b1, b2, c1) [SI] from the fit report a material carries
-// (`fit.covariance_kes`), when every sd of the report is known; else none, with why in *why.
-std::optional<Eigen::Matrix3d> FitCovariance(const Material& m, const std::string& path,
-                                             std::string* why) {
-  const nlohmann::json& f = m.fit;
-  if (!f.is_object() || !f.contains("covariance_kes")) {
-    *why = "no band: the material carries no fit covariance";
-    return std::nullopt;
-  }
-  for (const char* k : {"b1_sd", "b2_sd", "c1_sd"}) {
-    if (!f.contains(k) || !f[k].is_number()) {
-      *why = std::string("no band: ") + k + " is undetermined";
-      return std::nullopt;
-    }
-  }
-  const nlohmann::json& c = f["covariance_kes"];
-  const double to_si[3] = {units::KesStiffnessToSi(1.0), units::KesStiffnessToSi(1.0),
-                           units::KesQuadraticToSi(1.0)};
-  Eigen::Matrix3d cov;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      if (!c.is_array() || c.size() != 3 || !c[i].is_array() || c[i].size() != 3 ||
-          !c[i][j].is_number())
-        throw InputError(path + ": fit.covariance_kes must be a 3×3 array of numbers");
-      cov(i, j) = c[i][j].get<double>() * to_si[i] * to_si[j];
-    }
-  }
-  return cov;
-}
-
 void Plot(const Material& m, const std::string& material_path, double kappa_max,
           const std::vector<MomentCurvePairs>& measured, bool log_kappa, const std::string& path) {
   namespace chart = textile::chart;

@@ -94,4 +94,36 @@ double MomentSigma(const BendingLaw& law, const Eigen::Matrix3d& covariance, dou
   return std::sqrt(std::max(0.0, v.dot(covariance * v)));
 }
 
+std::optional<Eigen::Matrix3d> FitCovariance(const Material& m, const std::string& source,
+                                             std::string* why) {
+  if (m.bending.is_spline() || (m.bending_weft && m.bending_weft->is_spline())) {
+    *why = "no band: a spline law carries its band at its knots (moment_sd)";
+    return std::nullopt;
+  }
+  const nlohmann::json& f = m.fit;
+  if (!f.is_object() || !f.contains("covariance_kes")) {
+    *why = "no band: the material carries no fit covariance";
+    return std::nullopt;
+  }
+  for (const char* k : {"b1_sd", "b2_sd", "c1_sd"}) {
+    if (!f.contains(k) || !f[k].is_number()) {
+      *why = std::string("no band: ") + k + " is undetermined";
+      return std::nullopt;
+    }
+  }
+  const nlohmann::json& c = f["covariance_kes"];
+  const double to_si[3] = {units::KesStiffnessToSi(1.0), units::KesStiffnessToSi(1.0),
+                           units::KesQuadraticToSi(1.0)};
+  Eigen::Matrix3d cov;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      if (!c.is_array() || c.size() != 3 || !c[i].is_array() || c[i].size() != 3 ||
+          !c[i][j].is_number())
+        throw InputError(source + ": fit.covariance_kes must be a 3×3 array of numbers");
+      cov(i, j) = c[i][j].get<double>() * to_si[i] * to_si[j];
+    }
+  }
+  return cov;
+}
+
 }  // namespace textile

@@ -5,6 +5,8 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 
+#include <nlohmann/json.hpp>
+
 #include "textile/sim/error.h"
 #include "textile/sim/units.h"
 
@@ -54,6 +56,27 @@ TEST(MomentCurve, SigmaIsTheLinearPropagationOfTheLawsCovariance) {
     EXPECT_NEAR(MomentSigma(law, c, k), std::sqrt(var), 1e-3 * std::sqrt(var)) << k_cm;
   }
   EXPECT_EQ(MomentSigma(law, Eigen::Matrix3d::Zero(), 50.0), 0.0);
+}
+
+TEST(MomentCurve, FitCovarianceComesFromTheReportWhenEverySdIsKnown) {
+  Material m;
+  m.areal_density = 0.2;
+  m.bending = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+  std::string why;
+  EXPECT_FALSE(FitCovariance(m, "m.json", &why));
+  EXPECT_NE(why.find("no fit covariance"), std::string::npos) << why;
+  m.fit = nlohmann::json::parse(R"({"b1_sd": 0.002, "b2_sd": 0.001, "c1_sd": 0.003,
+      "covariance_kes": [[4e-6, 1e-7, 0], [1e-7, 1e-6, 0], [0, 0, 9e-6]]})");
+  const auto c = FitCovariance(m, "m.json", &why);
+  ASSERT_TRUE(c);
+  EXPECT_NEAR((*c)(0, 0), 4e-6 * std::pow(units::KesStiffnessToSi(1.0), 2), 1e-24);
+  EXPECT_NEAR((*c)(2, 2), 9e-6 * std::pow(units::KesQuadraticToSi(1.0), 2), 1e-30);
+  m.fit["b2_sd"] = nullptr;
+  EXPECT_FALSE(FitCovariance(m, "m.json", &why));
+  EXPECT_NE(why.find("b2_sd"), std::string::npos) << why;
+  m.fit["b2_sd"] = 0.001;
+  m.fit["covariance_kes"] = nlohmann::json::array({1, 2, 3});
+  EXPECT_THROW(FitCovariance(m, "m.json", &why), InputError);
 }
 
 }  // namespace

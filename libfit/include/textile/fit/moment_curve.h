@@ -8,12 +8,14 @@
 //   // peer.kappa [1/m], peer.moment [N]
 //   double sd = textile::MomentSigma(law, covariance, 10.0);  // 1-σ of M(10 /m) [N]
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "textile/sim/bending_law.h"
+#include "textile/sim/material.h"
 
 namespace textile {
 
@@ -38,6 +40,13 @@ MomentCurvePairs ReadMomentCurvatureCsv(const std::string& path);
 // (BendingLaw::MomentGradient). Linear propagation: the band of the law's own uncertainty, not
 // of laws the model cannot represent.
 double MomentSigma(const BendingLaw& law, const Eigen::Matrix3d& covariance, double kappa);
+
+// The covariance of (b1, b2, c1) [SI] that a fitted material's report carries
+// (`fit.covariance_kes`, textile fit), when every sd of the report is known and the law is eq. 1;
+// else none, with why in *why ("no band: b2_sd is undetermined"). Throws InputError naming
+// `source` for a covariance that is not a 3×3 array of numbers.
+std::optional<Eigen::Matrix3d> FitCovariance(const Material& material, const std::string& source,
+                                             std::string* why);
 
 }  // namespace textile
 

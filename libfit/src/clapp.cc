@@ -140,34 +140,46 @@ double ClappProfileFit::Phi(double r) const {
   return p;
 }
 
-ClappProfileFit FitClappProfile(const Profile& profile, double areal_density,
-                                const ClappOptions& options, std::vector<ClappPoint>* points) {
-  CheckOptions(options);
-  CheckDensity(areal_density);
-  CheckProfile(profile);
-  const int order = options.polynomial_order;
+namespace {
 
-  // 1. Polar coordinates about the edge; φ is the angle below horizontal.
-  std::vector<double> r, phi;
+// Step 1: the digitised points in polar coordinates about the edge, φ the angle below
+// horizontal; points nearer the edge than options.min_radius are left out.
+struct PolarPoints {
+  std::vector<double> r, phi;  // #n distances [m] and angles [rad]
+};
+
+PolarPoints PolarPointsAboutEdge(const Profile& profile, const ClappOptions& options) {
+  const int order = options.polynomial_order;
+  PolarPoints polar;
   for (size_t i = 0; i < profile.size(); ++i) {
     const double ri = std::hypot(profile.x[i], profile.y[i]);
     if (ri > 0.0 && ri >= options.min_radius) {
-      r.push_back(ri);
-      phi.push_back(std::atan2(-profile.y[i], profile.x[i]));
+      polar.r.push_back(ri);
+      polar.phi.push_back(std::atan2(-profile.y[i], profile.x[i]));
     }
   }
-  const int n = static_cast<int>(r.size());
+  const int n = static_cast<int>(polar.r.size());
   if (n < order + 1) {
     throw InputError(profile.source + ": only " + std::to_string(n) +
                      " points away from the edge; Clapp's polynomial of order " +
                      std::to_string(order) + " needs at least " + std::to_string(order + 1));
   }
-  // The smooth curve runs from the edge to the tip, the last digitised point.
+  return polar;
+}
+
+// Step 2: the least-squares polynomial φ(r) from the edge to the tip, the last digitised
+// point, with its residuals. Throws InputError for a tip at the edge or too few distinct r.
+ClappProfileFit FitPolarPolynomial(const Profile& profile, const PolarPoints& polar,
+                                   const ClappOptions& options) {
+  const int order = options.polynomial_order;
+  const std::vector<double>& r = polar.r;
+  const std::vector<double>& phi = polar.phi;
+  const int n = static_cast<int>(r.size());
   const double r_tip = std::hypot(profile.x.back(), profile.y.back());
   if (!(r_tip > 0.0)) throw InputError(profile.source + ": the tip lies at the edge");
 
-  // 2. Least-squares polynomial φ(r) in t = r / r_tip ∈ (0, ~1]: the scaled Vandermonde
-  // matrix is well conditioned (~1e4 for order 5) and QR never forms the normal equations.
+  // In t = r / r_tip ∈ (0, ~1]: the scaled Vandermonde matrix is well conditioned (~1e4 for
+  // order 5) and QR never forms the normal equations.
   Eigen::MatrixXd vandermonde(n, order + 1);
   Eigen::VectorXd rhs(n);
   for (int i = 0; i < n; ++i) {
@@ -193,22 +205,34 @@ ClappProfileFit FitClappProfile(const Profile& profile, double areal_density,
   double sum_sq = 0.0;
   for (int i = 0; i < n; ++i) sum_sq += Sq(r[i] * (phi[i] - fit.Phi(r[i])));
   fit.residual_rms = std::sqrt(sum_sq / n);
+  return fit;
+}
 
-  // 3. Arc length and first moment of the curve, cumulative at panel ends.
-  const PolarCurve curve(fit.coefficients, r_tip);
-  std::vector<double> panel_r(kPanels + 1), panel_s(kPanels + 1, 0.0), panel_xs(kPanels + 1, 0.0);
-  for (int k = 0; k <= kPanels; ++k) panel_r[k] = r_tip * k / kPanels;
+// Step 3: arc length and first moment of the curve, cumulative at the ends of kPanels panels.
+struct CurvePanels {
+  std::vector<double> r, s, xs;  // #kPanels + 1: r [m], ∫ ds [m], ∫ x ds [m²] from the edge
+};
+
+CurvePanels IntegrateCurve(const PolarCurve& curve, double r_tip) {
+  CurvePanels panels{std::vector<double>(kPanels + 1), std::vector<double>(kPanels + 1, 0.0),
+                     std::vector<double>(kPanels + 1, 0.0)};
+  for (int k = 0; k <= kPanels; ++k) panels.r[k] = r_tip * k / kPanels;
   for (int k = 0; k < kPanels; ++k) {
     double ds, dxs;
-    curve.Integrate(panel_r[k], panel_r[k + 1], &ds, &dxs);
-    panel_s[k + 1] = panel_s[k] + ds;
-    panel_xs[k + 1] = panel_xs[k] + dxs;
+    curve.Integrate(panels.r[k], panels.r[k + 1], &ds, &dxs);
+    panels.s[k + 1] = panels.s[k] + ds;
+    panels.xs[k + 1] = panels.xs[k] + dxs;
   }
-  const double length = panel_s.back(), first_moment = panel_xs.back();
-  fit.curve_length = length;
-  fit.kappa_at_edge = curve.At(0.0).kappa;
+  return panels;
+}
 
-  // 4. (κ, m) at evenly spaced arc lengths; m(s) = ρ g [∫_s^L x ds' - x(s) (L - s)].
+// Step 4: (κ, m) at evenly spaced arc lengths; m(s) = ρ g [∫_s^L x ds' - x(s) (L - s)].
+void PairsAlongCurve(const PolarCurve& curve, const CurvePanels& panels, double areal_density,
+                     const ClappOptions& options, std::vector<ClappPoint>* points) {
+  const std::vector<double>& panel_r = panels.r;
+  const std::vector<double>& panel_s = panels.s;
+  const std::vector<double>& panel_xs = panels.xs;
+  const double length = panel_s.back(), first_moment = panel_xs.back();
   const double weight = areal_density * units::kGravity;  // per unit area [N/m²]
   const int count = options.points_per_profile;
   const double s_end = (1.0 - options.tip_exclusion) * length;
@@ -236,6 +260,22 @@ ClappProfileFit FitClappProfile(const Profile& profile, double areal_density,
     const double moment = weight * ((first_moment - xs_j) - p.x * (length - s_j));
     if (points != nullptr) points->push_back({p.kappa, moment, s_j, 0});
   }
+}
+
+}  // namespace
+
+ClappProfileFit FitClappProfile(const Profile& profile, double areal_density,
+                                const ClappOptions& options, std::vector<ClappPoint>* points) {
+  CheckOptions(options);
+  CheckDensity(areal_density);
+  CheckProfile(profile);
+  const PolarPoints polar = PolarPointsAboutEdge(profile, options);
+  ClappProfileFit fit = FitPolarPolynomial(profile, polar, options);
+  const PolarCurve curve(fit.coefficients, fit.r_scale);
+  const CurvePanels panels = IntegrateCurve(curve, fit.r_scale);
+  fit.curve_length = panels.s.back();
+  fit.kappa_at_edge = curve.At(0.0).kappa;
+  PairsAlongCurve(curve, panels, areal_density, options, points);
   return fit;
 }
 

@@ -515,7 +515,7 @@ void BuildProblem(DirectFitState& s) {
 }
 
 // Bounds: b1, b2 within a factor 100 of the start and inside the textile range that material
-// files accept (1e-5 .. 1e3 gf·cm), κ0 within a factor 1000 of the curvature scale. Without
+// files accept (1e-5 .. 1e5 gf·cm), κ0 within a factor 1000 of the curvature scale. Without
 // them, data that no law explains (mixed strips) drive b2 towards 0, a plastic hinge. False,
 // with the message, when the start lies outside any textile.
 bool BoundLaw(DirectFitState& s) {

@@ -52,7 +52,7 @@ void Run(const FitSeamArgs& a) {
   seam["source"] = a.input;
   WriteFileAtomically(a.out, seam.dump(2) + "\n");
   if (fit.poor) Info("warning: " + a.input + ": poor fit: " + fit.poor_reason);
-  for (const std::string& note : fit.notes) Info("note: " + a.input + ": " + note);
+  for (const Note& note : fit.notes) Info("note: " + a.input + ": " + note.text);
 
   if (a.json) {
     PrintJson({{"input", a.input}, {"output", a.out}, {"seam", seam}});

@@ -16,6 +16,7 @@
 #include <tuple>
 
 #include "cost_functions/profile_model.h"
+#include "direct_fit_stages.h"
 #include "textile/fit/clapp.h"
 #include "law_parameters.h"
 #include "textile/sim/error.h"
@@ -294,266 +295,97 @@ std::string LastIterateSummary(const std::vector<std::unique_ptr<ProfileModel>>&
   return s.str();
 }
 
-DirectFitSummary FitDirectFrom(const std::vector<Profile>& profiles, double areal_density,
-                               const DirectFitOptions& options, const LawStart& start) {
-  const auto t0 = std::chrono::steady_clock::now();
-  std::array<double, 3> law_p = start.p;
-  const double b0 = start.b_centre;
-  std::vector<double> lengths;
-  for (const Profile& p : profiles) lengths.push_back(NoiseFreeLength(p));
-  std::array<double, 2> rig = {options.fit_offset ? 0.0 : options.offset, 0.0};
+}  // namespace
 
-  ceres::Problem::Options problem_options;
-  problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
-  problem_options.loss_function_ownership = ceres::TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
-  std::vector<std::unique_ptr<ProfileModel>> models;
-  for (size_t i = 0; i < profiles.size(); ++i) {
-    const int samples =
-        std::max(options.curve_samples,
-                 std::min(2001, static_cast<int>(std::ceil(lengths[i] / kMaxSampleSpacing)) + 1));
-    models.push_back(
-        std::make_unique<ProfileModel>(profiles[i], areal_density, samples, options.elastica_tol));
-    ProfileModel* m = models.back().get();
-    for (int j = 0; j < m->num_points(); ++j) {
-      ceres::LossFunction* loss =
-          options.robust_scale > 0.0 ? new ceres::CauchyLoss(options.robust_scale * 1e3) : nullptr;
-      problem.AddResidualBlock(new internal::PointResidual(m, j), loss, law_p.data(), &lengths[i],
-                               rig.data());
-    }
-    problem.AddResidualBlock(new internal::TipResidual(m), nullptr, law_p.data(), &lengths[i],
-                             rig.data());
-    problem.SetParameterLowerBound(&lengths[i], 0, 0.2 * lengths[i]);
-    problem.SetParameterUpperBound(&lengths[i], 0, 2.0 * lengths[i]);
-  }
-  // Bounds: b1, b2 within a factor 100 of the start and inside the textile range that material
-  // files accept (1e-5 .. 1e3 gf·cm), κ0 within a factor 1000 of the curvature scale. Without
-  // them, data that no law explains (mixed strips) drive b2 towards 0, a plastic hinge.
-  const double lo_b = std::log(std::max(b0 / 100.0, units::KesStiffnessToSi(range::kMinStiffnessKes)));
-  const double hi_b = std::log(std::min(b0 * 100.0, units::KesStiffnessToSi(range::kMaxStiffnessKes)));
-  if (!(lo_b < hi_b)) {
-    DirectFitSummary out;
-    std::ostringstream m;
-    m.precision(3);
-    m << "the profiles' shape asks for a bending stiffness of about " << units::SiStiffnessToKes(b0)
-      << " gf·cm, outside any textile (1e-5 .. 1e5 gf·cm): is --gsm right, is y up?";
-    out.message = m.str();
-    return out;
-  }
-  for (int k = 0; k < 2; ++k) {
-    law_p[k] = std::clamp(law_p[k], lo_b, hi_b);
-    problem.SetParameterLowerBound(law_p.data(), k, lo_b);
-    problem.SetParameterUpperBound(law_p.data(), k, hi_b);
-  }
-  problem.SetParameterLowerBound(law_p.data(), 2, law_p[2] - std::log(1000.0));
-  problem.SetParameterUpperBound(law_p.data(), 2, law_p[2] + std::log(1000.0));
-  // A weak prior towards a linear law with κ0 at the data's curvature scale: it settles the
-  // directions the data leave free (b1 = b2 makes κ0 free; κ0 beyond the data makes b2 free)
-  // and is negligible elsewhere (1e-2 mm per unit of ln, against hundreds of points whose
-  // residuals move millimetres per unit of ln).
-  auto* prior = new LawPrior(kPriorWeight, law_p[2]);
-  problem.AddResidualBlock(prior, nullptr, law_p.data());
-  if (!options.fit_offset && !options.fit_rotation) {
-    problem.SetParameterBlockConstant(rig.data());
-  } else if (!options.fit_offset || !options.fit_rotation) {
-    problem.SetManifold(rig.data(), new ceres::SubsetManifold(2, {options.fit_offset ? 1 : 0}));
-  }
+namespace internal {
 
-  ceres::Solver::Options solver_options;
-  solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = options.max_iterations;
-  solver_options.max_solver_time_in_seconds = options.max_seconds;
-  // The model's own numerical floor (elastica tolerance, foot-point projection) makes the cost
-  // repeatable to ~1e-8 relative; asking for less only buys rejected steps.
-  solver_options.function_tolerance = 1e-7;
-  solver_options.parameter_tolerance = 1e-10;
-  solver_options.gradient_tolerance = 1e-14;
-  const bool debug = std::getenv("TEXTILE_DEBUG_FIT") != nullptr;
-  solver_options.logging_type = debug ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
-  solver_options.minimizer_progress_to_stdout = debug;
-  ceres::Solver::Summary solver_summary;
-  ceres::Solve(solver_options, &problem, &solver_summary);
-  // Data more or less precise than the prior's σ = 0.1 mm: again, with the prior scaled to
-  // their rms (from the first solve's result, a few iterations).
-  if (solver_summary.IsSolutionUsable() &&
-      solver_summary.termination_type != ceres::NO_CONVERGENCE) {
-    double sum2 = 0.0;
-    int n = 0;
-    bool ok = true;
-    for (size_t i = 0; i < models.size() && ok; ++i) {
-      ok = models[i]->Update(law_p.data(), &lengths[i], rig.data(), false);
-      for (int j = 0; ok && j < models[i]->num_points(); ++j, ++n)
-        sum2 += models[i]->residual(j) * models[i]->residual(j);  // [mm²]
-    }
-    const double w = std::max(kPriorFloor, kPriorPerRms * std::sqrt(sum2 / std::max(1, n)));
-    if (ok && std::abs(std::log(w / prior->weight())) > std::log(1.25)) {
-      prior->set_weight(w);
-      const int first_iterations = static_cast<int>(solver_summary.iterations.size());
-      const double first_seconds = solver_summary.total_time_in_seconds;
-      solver_options.max_num_iterations = std::max(1, options.max_iterations - first_iterations);
-      solver_options.max_solver_time_in_seconds =
-          std::max(1e-3, options.max_seconds - first_seconds);
-      const auto first_law = law_p;
-      const auto first_lengths = lengths;
-      const auto first_rig = rig;
-      ceres::Solver::Summary second;
-      ceres::Solve(solver_options, &problem, &second);
-      if (second.IsSolutionUsable() && second.termination_type != ceres::NO_CONVERGENCE) {
-        second.iterations.insert(second.iterations.begin(), solver_summary.iterations.begin(),
-                                 solver_summary.iterations.end());
-        solver_summary = second;
-      } else {
-        // A refinement that does not settle (profiles no law fits, which the check below
-        // names) keeps the first solve's result.
-        law_p = first_law, lengths = first_lengths, rig = first_rig;
-        prior->set_weight(kPriorWeight);
-      }
-    }
-  }
+std::optional<std::array<double, 2>> LogStiffnessBounds(double b_centre) {
+  const double lo_b =
+      std::log(std::max(b_centre / 100.0, units::KesStiffnessToSi(range::kMinStiffnessKes)));
+  const double hi_b =
+      std::log(std::min(b_centre * 100.0, units::KesStiffnessToSi(range::kMaxStiffnessKes)));
+  if (!(lo_b < hi_b)) return std::nullopt;
+  return std::array<double, 2>{lo_b, hi_b};
+}
 
-  DirectFitSummary out;
-  out.iterations = static_cast<int>(solver_summary.iterations.size());
-  const auto finish = [&] {
-    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return out;
-  };
-  if (!solver_summary.IsSolutionUsable() ||
-      solver_summary.termination_type == ceres::NO_CONVERGENCE) {
-    out.message = "the fit did not converge (" + solver_summary.message + ")" +
-                  LastIterateSummary(models, law_p, lengths, rig);
-    return finish();
-  }
-  // Final state, with jacobians, for reports and the covariance.
-  for (size_t i = 0; i < models.size(); ++i) {
-    if (!models[i]->Update(law_p.data(), &lengths[i], rig.data(), true)) {
-      out.message = "the elastica failed at the fitted constants";
-      return finish();
-    }
-  }
-  BendingLaw law = internal::LawFromParameters(law_p.data());
+std::optional<double> RescaledPriorWeight(double rms_mm, double current_weight) {
+  const double w = std::max(kPriorFloor, kPriorPerRms * rms_mm);
+  if (std::abs(std::log(w / current_weight)) > std::log(1.25)) return w;
+  return std::nullopt;
+}
 
-  // Residual statistics per profile (normal distances only).
-  double sum2 = 0.0;
-  int count = 0;
-  std::vector<double> rms_each;
-  for (size_t i = 0; i < models.size(); ++i) {
-    const ProfileModel& m = *models[i];
-    ProfileFitReport r;
-    r.source = profiles[i].source;
-    r.overhang = lengths[i];
-    r.data_length = profiles[i].s.back();
-    double s2 = 0.0;
-    for (int j = 0; j < m.num_points(); ++j) {
-      const double d = m.residual(j) * 1e-3;
-      s2 += d * d;
-      r.max = std::max(r.max, std::abs(d));
-    }
-    sum2 += s2;
-    count += m.num_points();
-    r.rms = std::sqrt(s2 / m.num_points());
-    r.clamp_curvature = m.solution().clamp_curvature;
-    out.kappa_max = std::max(out.kappa_max, r.clamp_curvature);
-    rms_each.push_back(r.rms);
-    out.profiles.push_back(r);
-  }
-  out.rms = std::sqrt(sum2 / count);
-  double scatter2 = 0.0;
-  for (const Profile& p : profiles) scatter2 += std::pow(ProfilePointScatter(p), 2);
-  const double scatter = std::sqrt(scatter2 / profiles.size());
-  out.cost = solver_summary.final_cost;
-  out.offset = rig[0];
-  out.rotation = rig[1];
-
+void RefuseMixedStrips(const std::vector<Profile>& profiles, const DirectFitSummary& fit,
+                       double outlier_profile_rms,
+                       const std::function<double(const Profile&)>& rms_alone) {
   // One law for several profiles that fits badly, while each profile alone fits well, means
   // the profiles are not of one strip (or one is a bad extraction): refuse rather than average.
-  if (profiles.size() >= 2 && out.rms > options.outlier_profile_rms) {
-    const size_t worst = std::max_element(rms_each.begin(), rms_each.end()) - rms_each.begin();
-    std::vector<double> alone;
-    for (const Profile& p : profiles) {
-      const DirectFitSummary single = FitDirect({p}, areal_density, options);
-      alone.push_back(single.converged ? single.rms : std::numeric_limits<double>::infinity());
-    }
-    if (*std::max_element(alone.begin(), alone.end()) < out.rms / 3.0) {
-      throw InputError(profiles[worst].source + ": the profiles do not fit one law (rms " +
-                       Mm(out.rms) + " together, at most " +
-                       Mm(*std::max_element(alone.begin(), alone.end())) +
-                       " each alone): profiles of different strips, or a bad extraction?");
-    }
+  if (profiles.size() < 2 || !(fit.rms > outlier_profile_rms)) return;
+  const auto worse = [](const ProfileFitReport& a, const ProfileFitReport& b) {
+    return a.rms < b.rms;
+  };
+  const size_t worst =
+      std::max_element(fit.profiles.begin(), fit.profiles.end(), worse) - fit.profiles.begin();
+  std::vector<double> alone;
+  for (const Profile& p : profiles) alone.push_back(rms_alone(p));
+  const double worst_alone = *std::max_element(alone.begin(), alone.end());
+  if (worst_alone < fit.rms / 3.0) {
+    throw InputError(profiles[worst].source + ": the profiles do not fit one law (rms " +
+                     Mm(fit.rms) + " together, at most " + Mm(worst_alone) +
+                     " each alone): profiles of different strips, or a bad extraction?");
   }
+}
 
+std::string PinnedBoundMessage(const std::array<double, 3>& law_p,
+                               const std::array<double, 2>& lower,
+                               const std::array<double, 2>& upper) {
   // A law pinned to a stiffness bound is not a fit: the data do not bend (or bend without
   // limit) within the textile range.
   for (int k = 0; k < 2; ++k) {
-    const double lo = problem.GetParameterLowerBound(law_p.data(), k);
-    const double hi = problem.GetParameterUpperBound(law_p.data(), k);
-    if (law_p[k] - lo < 1e-6 || hi - law_p[k] < 1e-6) {
+    if (law_p[k] - lower[k] < 1e-6 || upper[k] - law_p[k] < 1e-6) {
       std::ostringstream m;
       m.precision(3);
       m << "the fit ran into the bound b" << k + 1 << " = "
         << units::SiStiffnessToKes(std::exp(law_p[k]))
         << " gf·cm: the profiles do not determine a textile law (almost no bending, or not a "
            "cantilever shape)";
-      out.message = m.str();
-      return finish();
+      return m.str();
     }
   }
-  // Covariance: (JᵀJ)⁺ σ̂² over all free parameters, from the unrobustified Jacobian, with
-  // σ̂² = Σr² / (N - n). Pseudo-inverse, so that an undetermined direction (b1 = b2 makes κ0
-  // free; κ0 beyond the data makes b2 free) shows up as an infinite variance, not a crash.
-  {
-    std::vector<double*> blocks = {law_p.data(), rig.data()};
-    for (double& L : lengths) blocks.push_back(&L);
-    const int n_res = count + 2 * static_cast<int>(models.size());
-    const int n_par = 3 + 2 + static_cast<int>(lengths.size());
-    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(n_res, n_par);
-    int row = 0;
-    std::vector<int> free_cols = {0, 1, 2};
-    if (options.fit_offset) free_cols.push_back(3);
-    if (options.fit_rotation) free_cols.push_back(4);
-    for (size_t i = 0; i < models.size(); ++i) {
-      free_cols.push_back(5 + static_cast<int>(i));
-      const auto put = [&](const std::array<double, 6>& g) {
-        for (int k = 0; k < 3; ++k) J(row, k) = g[k];
-        J(row, 3) = g[4];
-        J(row, 4) = g[5];
-        J(row, 5 + static_cast<int>(i)) = g[3];
-        ++row;
-      };
-      for (int j = 0; j < models[i]->num_points(); ++j) put(models[i]->gradient(j));
-      put(models[i]->tip_gradient()[0]);
-      put(models[i]->tip_gradient()[1]);
-    }
-    Eigen::MatrixXd Jf(n_res, free_cols.size());
-    for (size_t k = 0; k < free_cols.size(); ++k) Jf.col(k) = J.col(free_cols[k]);
-    const int dof = std::max(1, n_res - static_cast<int>(free_cols.size()));
-    out.num_residuals = n_res;
-    out.num_free_parameters = static_cast<int>(free_cols.size());
-    const double sigma2 = sum2 * 1e6 / dof;  // [mm²]: residuals are in mm
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(Jf, Eigen::ComputeThinV);
-    const auto& sv = svd.singularValues();
-    const double cutoff = 1e-8 * sv(0);
-    Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(free_cols.size(), free_cols.size());
-    Eigen::VectorXd null_weight = Eigen::VectorXd::Zero(free_cols.size());
-    for (int k = 0; k < sv.size(); ++k) {
-      const Eigen::VectorXd v = svd.matrixV().col(k);
-      if (sv(k) > cutoff)
-        cov += v * v.transpose() / (sv(k) * sv(k));
-      else
-        null_weight += v.cwiseAbs2();
-    }
-    cov *= sigma2;
-    const Eigen::Matrix3d cov_p = cov.topLeftCorner<3, 3>();
-    const double b1 = law.b1(), b2 = law.b2(), k0 = std::exp(law_p[2]), c1 = law.c1();
-    Eigen::Matrix3d D;  // ∂(b1, b2, c1)/∂(ln b1, ln b2, ln κ0)
-    D << b1, 0, 0, 0, b2, 0, -b1 / (2 * k0), b2 / (2 * k0), -c1;
-    out.covariance = D * cov_p * D.transpose();
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    out.b1_sd = null_weight(0) > 0.5 ? nan : std::sqrt(out.covariance(0, 0));
-    out.b2_sd = null_weight(1) > 0.5 ? nan : std::sqrt(out.covariance(1, 1));
-    out.c1_sd = null_weight(2) > 0.5 && c1 != 0.0 ? nan : std::sqrt(out.covariance(2, 2));
-  }
+  return "";
+}
 
-  // Observability (docs/spec/cantilever.md): which constants the data determine.
+void CovarianceFromJacobian(const Eigen::MatrixXd& free_jacobian, double sigma2,
+                            const BendingLaw& law, double log_kappa0, DirectFitSummary* fit) {
+  // Pseudo-inverse, so that an undetermined direction (b1 = b2 makes κ0 free; κ0 beyond the
+  // data makes b2 free) shows up as an infinite variance, not a crash.
+  const Eigen::Index n = free_jacobian.cols();
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(free_jacobian, Eigen::ComputeThinV);
+  const auto& sv = svd.singularValues();
+  const double cutoff = 1e-8 * sv(0);
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(n, n);
+  Eigen::VectorXd null_weight = Eigen::VectorXd::Zero(n);
+  for (int k = 0; k < sv.size(); ++k) {
+    const Eigen::VectorXd v = svd.matrixV().col(k);
+    if (sv(k) > cutoff)
+      cov += v * v.transpose() / (sv(k) * sv(k));
+    else
+      null_weight += v.cwiseAbs2();
+  }
+  cov *= sigma2;
+  const Eigen::Matrix3d cov_p = cov.topLeftCorner<3, 3>();
+  const double b1 = law.b1(), b2 = law.b2(), k0 = std::exp(log_kappa0), c1 = law.c1();
+  Eigen::Matrix3d D;  // ∂(b1, b2, c1)/∂(ln b1, ln b2, ln κ0)
+  D << b1, 0, 0, 0, b2, 0, -b1 / (2 * k0), b2 / (2 * k0), -c1;
+  fit->covariance = D * cov_p * D.transpose();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  fit->b1_sd = null_weight(0) > 0.5 ? nan : std::sqrt(fit->covariance(0, 0));
+  fit->b2_sd = null_weight(1) > 0.5 ? nan : std::sqrt(fit->covariance(1, 1));
+  fit->c1_sd = null_weight(2) > 0.5 && c1 != 0.0 ? nan : std::sqrt(fit->covariance(2, 2));
+}
+
+void ObserveConstants(BendingLaw* law_io, DirectFitSummary* fit) {
+  BendingLaw& law = *law_io;
+  DirectFitSummary& out = *fit;
   const double k0 = law.kappa0();
   const auto undetermined = [](double sd, double v) {
     return !std::isfinite(sd) || sd > kUndeterminedRelSd * std::abs(v);
@@ -603,13 +435,306 @@ DirectFitSummary FitDirectFrom(const std::vector<Profile>& profiles, double area
   }
   obs << "The moment curve M(κ) is determined for 0 ≤ κ ≤ " << kmax_cm << " /cm.";
   out.observability = obs.str();
-  out.law = law;
+}
+
+}  // namespace internal
+
+namespace {
+
+// What one solve of the direct fit (FitDirectFrom) works on, stage by stage.
+struct DirectFitState {
+  DirectFitState(const std::vector<Profile>& profiles, double areal_density,
+                 const DirectFitOptions& options, const LawStart& start)
+      : profiles(profiles),
+        areal_density(areal_density),
+        options(options),
+        start(start),
+        t0(std::chrono::steady_clock::now()),
+        law_p(start.p),
+        problem(OwningProblemOptions()) {}
+
+  static ceres::Problem::Options OwningProblemOptions() {
+    ceres::Problem::Options o;
+    o.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+    o.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+    return o;
+  }
+
+  const std::vector<Profile>& profiles;
+  double areal_density;  // [kg/m²]
+  const DirectFitOptions& options;
+  const LawStart& start;
+  std::chrono::steady_clock::time_point t0;
+  // The unknowns: the law p = (ln b1, ln b2, ln κ0), each profile's overhang [m], the rig
+  // (offset [m], rotation [rad]).
+  std::array<double, 3> law_p;
+  std::vector<double> lengths;
+  std::array<double, 2> rig{};
+  ceres::Problem problem;
+  std::vector<std::unique_ptr<ProfileModel>> models;  // one per profile, residuals in mm
+  LawPrior* prior = nullptr;                          // owned by problem
+  ceres::Solver::Options solver_options;
+  ceres::Solver::Summary solver_summary;
+  std::optional<BendingLaw> law;  // at the solution
+  double sum2 = 0.0;              // Σ of the points' squared normal distances [m²]
+  int count = 0;                  // points over all profiles
+  double scatter = 0.0;           // the points' pooled scatter [m]
+  DirectFitSummary out;
+};
+
+// The summary as it stands, with the time spent.
+DirectFitSummary Finish(DirectFitState& s) {
+  s.out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - s.t0).count();
+  return s.out;
+}
+
+// Models of the profiles and their residuals: each point's normal distance under the robust
+// loss and the tip's position; each overhang within [0.2, 2] of its noise-free length.
+void BuildProblem(DirectFitState& s) {
+  const DirectFitOptions& options = s.options;
+  for (const Profile& p : s.profiles) s.lengths.push_back(NoiseFreeLength(p));
+  s.rig = {options.fit_offset ? 0.0 : options.offset, 0.0};
+  for (size_t i = 0; i < s.profiles.size(); ++i) {
+    const int samples =
+        std::max(options.curve_samples,
+                 std::min(2001, static_cast<int>(std::ceil(s.lengths[i] / kMaxSampleSpacing)) + 1));
+    s.models.push_back(std::make_unique<ProfileModel>(s.profiles[i], s.areal_density, samples,
+                                                      options.elastica_tol));
+    ProfileModel* m = s.models.back().get();
+    for (int j = 0; j < m->num_points(); ++j) {
+      ceres::LossFunction* loss =
+          options.robust_scale > 0.0 ? new ceres::CauchyLoss(options.robust_scale * 1e3) : nullptr;
+      s.problem.AddResidualBlock(new internal::PointResidual(m, j), loss, s.law_p.data(),
+                                 &s.lengths[i], s.rig.data());
+    }
+    s.problem.AddResidualBlock(new internal::TipResidual(m), nullptr, s.law_p.data(), &s.lengths[i],
+                               s.rig.data());
+    s.problem.SetParameterLowerBound(&s.lengths[i], 0, 0.2 * s.lengths[i]);
+    s.problem.SetParameterUpperBound(&s.lengths[i], 0, 2.0 * s.lengths[i]);
+  }
+}
+
+// Bounds: b1, b2 within a factor 100 of the start and inside the textile range that material
+// files accept (1e-5 .. 1e5 gf·cm), κ0 within a factor 1000 of the curvature scale. Without
+// them, data that no law explains (mixed strips) drive b2 towards 0, a plastic hinge. False,
+// with the message, when the start lies outside any textile.
+bool BoundLaw(DirectFitState& s) {
+  const std::optional<std::array<double, 2>> bounds =
+      internal::LogStiffnessBounds(s.start.b_centre);
+  if (!bounds) {
+    std::ostringstream m;
+    m.precision(3);
+    m << "the profiles' shape asks for a bending stiffness of about "
+      << units::SiStiffnessToKes(s.start.b_centre)
+      << " gf·cm, outside any textile (1e-5 .. 1e5 gf·cm): is --gsm right, is y up?";
+    s.out.message = m.str();
+    return false;
+  }
+  const auto [lo_b, hi_b] = *bounds;
+  for (int k = 0; k < 2; ++k) {
+    s.law_p[k] = std::clamp(s.law_p[k], lo_b, hi_b);
+    s.problem.SetParameterLowerBound(s.law_p.data(), k, lo_b);
+    s.problem.SetParameterUpperBound(s.law_p.data(), k, hi_b);
+  }
+  s.problem.SetParameterLowerBound(s.law_p.data(), 2, s.law_p[2] - std::log(1000.0));
+  s.problem.SetParameterUpperBound(s.law_p.data(), 2, s.law_p[2] + std::log(1000.0));
+  return true;
+}
+
+// A weak prior towards a linear law with κ0 at the data's curvature scale: it settles the
+// directions the data leave free (b1 = b2 makes κ0 free; κ0 beyond the data makes b2 free)
+// and is negligible elsewhere (1e-2 mm per unit of ln, against hundreds of points whose
+// residuals move millimetres per unit of ln). The rig's fixed parts are held constant.
+void AddPriorAndRig(DirectFitState& s) {
+  s.prior = new LawPrior(kPriorWeight, s.law_p[2]);
+  s.problem.AddResidualBlock(s.prior, nullptr, s.law_p.data());
+  const DirectFitOptions& options = s.options;
+  if (!options.fit_offset && !options.fit_rotation) {
+    s.problem.SetParameterBlockConstant(s.rig.data());
+  } else if (!options.fit_offset || !options.fit_rotation) {
+    s.problem.SetManifold(s.rig.data(), new ceres::SubsetManifold(2, {options.fit_offset ? 1 : 0}));
+  }
+}
+
+void Solve(DirectFitState& s) {
+  const DirectFitOptions& options = s.options;
+  ceres::Solver::Options& solver_options = s.solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.max_solver_time_in_seconds = options.max_seconds;
+  // The model's own numerical floor (elastica tolerance, foot-point projection) makes the cost
+  // repeatable to ~1e-8 relative; asking for less only buys rejected steps.
+  solver_options.function_tolerance = 1e-7;
+  solver_options.parameter_tolerance = 1e-10;
+  solver_options.gradient_tolerance = 1e-14;
+  const bool debug = std::getenv("TEXTILE_DEBUG_FIT") != nullptr;
+  solver_options.logging_type = debug ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+  solver_options.minimizer_progress_to_stdout = debug;
+  ceres::Solve(solver_options, &s.problem, &s.solver_summary);
+}
+
+bool Settled(const ceres::Solver::Summary& summary) {
+  return summary.IsSolutionUsable() && summary.termination_type != ceres::NO_CONVERGENCE;
+}
+
+// Data more or less precise than the prior's σ = 0.1 mm: again, with the prior scaled to
+// their rms (from the first solve's result, a few iterations).
+void SolveWithRescaledPrior(DirectFitState& s) {
+  if (!Settled(s.solver_summary)) return;
+  double sum2 = 0.0;
+  int n = 0;
+  bool ok = true;
+  for (size_t i = 0; i < s.models.size() && ok; ++i) {
+    ok = s.models[i]->Update(s.law_p.data(), &s.lengths[i], s.rig.data(), false);
+    for (int j = 0; ok && j < s.models[i]->num_points(); ++j, ++n)
+      sum2 += s.models[i]->residual(j) * s.models[i]->residual(j);  // [mm²]
+  }
+  const std::optional<double> w =
+      internal::RescaledPriorWeight(std::sqrt(sum2 / std::max(1, n)), s.prior->weight());
+  if (!ok || !w) return;
+  s.prior->set_weight(*w);
+  const DirectFitOptions& options = s.options;
+  const int first_iterations = static_cast<int>(s.solver_summary.iterations.size());
+  const double first_seconds = s.solver_summary.total_time_in_seconds;
+  s.solver_options.max_num_iterations = std::max(1, options.max_iterations - first_iterations);
+  s.solver_options.max_solver_time_in_seconds = std::max(1e-3, options.max_seconds - first_seconds);
+  const auto first_law = s.law_p;
+  const auto first_lengths = s.lengths;
+  const auto first_rig = s.rig;
+  ceres::Solver::Summary second;
+  ceres::Solve(s.solver_options, &s.problem, &second);
+  if (Settled(second)) {
+    second.iterations.insert(second.iterations.begin(), s.solver_summary.iterations.begin(),
+                             s.solver_summary.iterations.end());
+    s.solver_summary = second;
+  } else {
+    // A refinement that does not settle (profiles no law fits, which the check below
+    // names) keeps the first solve's result.
+    s.law_p = first_law, s.lengths = first_lengths, s.rig = first_rig;
+    s.prior->set_weight(kPriorWeight);
+  }
+}
+
+// The solver's verdict, and the models at the solution with their jacobians (for reports and
+// the covariance). False, with the message, when it did not converge.
+bool ReachSolution(DirectFitState& s) {
+  s.out.iterations = static_cast<int>(s.solver_summary.iterations.size());
+  if (!Settled(s.solver_summary)) {
+    s.out.message = "the fit did not converge (" + s.solver_summary.message + ")" +
+                    LastIterateSummary(s.models, s.law_p, s.lengths, s.rig);
+    return false;
+  }
+  for (size_t i = 0; i < s.models.size(); ++i) {
+    if (!s.models[i]->Update(s.law_p.data(), &s.lengths[i], s.rig.data(), true)) {
+      s.out.message = "the elastica failed at the fitted constants";
+      return false;
+    }
+  }
+  s.law = internal::LawFromParameters(s.law_p.data());
+  return true;
+}
+
+// Residual statistics per profile (normal distances only), the largest curvature, the rig.
+void MeasureProfiles(DirectFitState& s) {
+  DirectFitSummary& out = s.out;
+  for (size_t i = 0; i < s.models.size(); ++i) {
+    const ProfileModel& m = *s.models[i];
+    ProfileFitReport r;
+    r.source = s.profiles[i].source;
+    r.overhang = s.lengths[i];
+    r.data_length = s.profiles[i].s.back();
+    double s2 = 0.0;
+    for (int j = 0; j < m.num_points(); ++j) {
+      const double d = m.residual(j) * 1e-3;
+      s2 += d * d;
+      r.max = std::max(r.max, std::abs(d));
+    }
+    s.sum2 += s2;
+    s.count += m.num_points();
+    r.rms = std::sqrt(s2 / m.num_points());
+    r.clamp_curvature = m.solution().clamp_curvature;
+    out.kappa_max = std::max(out.kappa_max, r.clamp_curvature);
+    out.profiles.push_back(r);
+  }
+  out.rms = std::sqrt(s.sum2 / s.count);
+  double scatter2 = 0.0;
+  for (const Profile& p : s.profiles) scatter2 += std::pow(ProfilePointScatter(p), 2);
+  s.scatter = std::sqrt(scatter2 / s.profiles.size());
+  out.cost = s.solver_summary.final_cost;
+  out.offset = s.rig[0];
+  out.rotation = s.rig[1];
+}
+
+// False, with the message, when b1 or b2 ended on a bound.
+bool CheckNotPinned(DirectFitState& s) {
+  std::array<double, 2> lower{}, upper{};
+  for (int k = 0; k < 2; ++k) {
+    lower[k] = s.problem.GetParameterLowerBound(s.law_p.data(), k);
+    upper[k] = s.problem.GetParameterUpperBound(s.law_p.data(), k);
+  }
+  s.out.message = internal::PinnedBoundMessage(s.law_p, lower, upper);
+  return s.out.message.empty();
+}
+
+// Covariance: (JᵀJ)⁺ σ̂² over all free parameters, from the unrobustified Jacobian, with
+// σ̂² = Σr² / (N - n). Columns of J: ln b1, ln b2, ln κ0, offset, rotation, the overhangs.
+void EstimateCovariance(DirectFitState& s) {
+  const DirectFitOptions& options = s.options;
+  const int n_res = s.count + 2 * static_cast<int>(s.models.size());
+  const int n_par = 3 + 2 + static_cast<int>(s.lengths.size());
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(n_res, n_par);
+  int row = 0;
+  std::vector<int> free_cols = {0, 1, 2};
+  if (options.fit_offset) free_cols.push_back(3);
+  if (options.fit_rotation) free_cols.push_back(4);
+  for (size_t i = 0; i < s.models.size(); ++i) {
+    free_cols.push_back(5 + static_cast<int>(i));
+    const auto put = [&](const std::array<double, 6>& g) {
+      for (int k = 0; k < 3; ++k) J(row, k) = g[k];
+      J(row, 3) = g[4];
+      J(row, 4) = g[5];
+      J(row, 5 + static_cast<int>(i)) = g[3];
+      ++row;
+    };
+    for (int j = 0; j < s.models[i]->num_points(); ++j) put(s.models[i]->gradient(j));
+    put(s.models[i]->tip_gradient()[0]);
+    put(s.models[i]->tip_gradient()[1]);
+  }
+  Eigen::MatrixXd Jf(n_res, free_cols.size());
+  for (size_t k = 0; k < free_cols.size(); ++k) Jf.col(k) = J.col(free_cols[k]);
+  const int dof = std::max(1, n_res - static_cast<int>(free_cols.size()));
+  s.out.num_residuals = n_res;
+  s.out.num_free_parameters = static_cast<int>(free_cols.size());
+  const double sigma2 = s.sum2 * 1e6 / dof;  // [mm²]: residuals are in mm
+  internal::CovarianceFromJacobian(Jf, sigma2, *s.law, s.law_p[2], &s.out);
+}
+
+DirectFitSummary FitDirectFrom(const std::vector<Profile>& profiles, double areal_density,
+                               const DirectFitOptions& options, const LawStart& start) {
+  DirectFitState s(profiles, areal_density, options, start);
+  BuildProblem(s);
+  if (!BoundLaw(s)) return s.out;  // no time taken: nothing was solved
+  AddPriorAndRig(s);
+  Solve(s);
+  SolveWithRescaledPrior(s);
+  if (!ReachSolution(s)) return Finish(s);
+  MeasureProfiles(s);
+  internal::RefuseMixedStrips(profiles, s.out, options.outlier_profile_rms, [&](const Profile& p) {
+    const DirectFitSummary single = FitDirect({p}, areal_density, options);
+    return single.converged ? single.rms : std::numeric_limits<double>::infinity();
+  });
+  if (!CheckNotPinned(s)) return Finish(s);
+  EstimateCovariance(s);
+  // Observability (docs/spec/cantilever.md): which constants the data determine.
+  internal::ObserveConstants(&*s.law, &s.out);
+  DirectFitSummary& out = s.out;
+  out.law = s.law;
   out.converged = true;
-  out.message = "converged (" + solver_summary.message + ")";
+  out.message = "converged (" + s.solver_summary.message + ")";
   out.start = start.name;
-  out.point_scatter = scatter;
-  if (LacksFit(out)) out.fit_pattern = DescribeMisfit(profiles, models, out);
-  return finish();
+  out.point_scatter = s.scatter;
+  if (LacksFit(out)) out.fit_pattern = DescribeMisfit(profiles, s.models, out);
+  return Finish(s);
 }
 
 }  // namespace

@@ -13,20 +13,15 @@
 #include <set>
 #include <sstream>
 
+#include "seam_fit_stages.h"
 #include "textile/sim/error.h"
 #include "textile/sim/json_text.h"
+#include "textile/sim/number_text.h"
 
 namespace textile {
 namespace {
 
 constexpr int kParams = 3;  // a2, a1, a0
-
-std::string Num(double v, int precision = 6) {
-  std::ostringstream s;
-  s.precision(precision);
-  s << v;
-  return s.str();
-}
 
 std::string Trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t\r");
@@ -53,27 +48,27 @@ void CheckSample(const SeamSample& p, const std::string& where) {
       (!std::isnan(p.sd) && !std::isfinite(p.sd)))
     throw InputError(where + ": values must be finite numbers");
   if (p.d_mm < 0.0)
-    throw InputError(where + ": d_mm = " + Num(p.d_mm) +
+    throw InputError(where + ": d_mm = " + NumberText(p.d_mm) +
                      " is negative (distance from the seam line)");
   // A seam's influence spans centimetres (the ACPM sample's half-width is 100 mm); far larger
   // distances are a unit mix-up, and 1e200 mm overflowed the least squares to NaN coefficients.
   if (p.d_mm > kMaxSeamDistanceMm)
-    throw InputError(where + ": d_mm = " + Num(p.d_mm) + " is beyond " + Num(kMaxSeamDistanceMm) +
-                     " mm from the seam line (d in mm, not µm?)");
+    throw InputError(where + ": d_mm = " + NumberText(p.d_mm) + " is beyond " +
+                     NumberText(kMaxSeamDistanceMm) + " mm from the seam line (d in mm, not µm?)");
   if (!(p.factor >= 1e-6 && p.factor <= kMaxSeamFactor))
-    throw InputError(where + ": factor = " + Num(p.factor) + " must be in [1e-6, " +
-                     Num(kMaxSeamFactor) +
+    throw InputError(where + ": factor = " + NumberText(p.factor) + " must be in [1e-6, " +
+                     NumberText(kMaxSeamFactor) +
                      "] (stiffness relative to the plain fabric; more is likely a unit mix-up)");
   if (!std::isnan(p.sd) && !(p.sd > 0.0))
-    throw InputError(where + ": sd = " + Num(p.sd) + " must be > 0");
+    throw InputError(where + ": sd = " + NumberText(p.sd) + " must be > 0");
   // The weights are 1/sd²: below 1e-9 of the factor they overflow the least squares (sd 1e-300
   // gave NaN coefficients); no measurement of a stiffness ratio is that exact.
   if (!std::isnan(p.sd) && p.sd < 1e-9 * p.factor)
-    throw InputError(where + ": sd = " + Num(p.sd) + " is below 1e-9 of the factor " +
-                     Num(p.factor));
+    throw InputError(where + ": sd = " + NumberText(p.sd) + " is below 1e-9 of the factor " +
+                     NumberText(p.factor));
   if (!std::isnan(p.sd) && p.sd > 1e6 * p.factor)  // weights underflowed: B_f = 0
-    throw InputError(where + ": sd = " + Num(p.sd) + " is over 1e6 times the factor " +
-                     Num(p.factor));
+    throw InputError(where + ": sd = " + NumberText(p.sd) + " is over 1e6 times the factor " +
+                     NumberText(p.factor));
 }
 
 // Excel's "CSV UTF-8" (and some editors) start the file with a UTF-8 byte-order mark.
@@ -254,15 +249,17 @@ bool SeamFitOptions::Check(std::string* why) const {
   return s.str().empty();
 }
 
-SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,
-                             const SeamFitOptions& options) {
-  if (std::string why; !options.Check(&why)) throw InputError("seam fit options: " + why);
+namespace internal {
+
+void CheckSeamData(SeamFitState* state) {
+  const std::vector<SeamSample>& samples = state->samples;
+  if (std::string why; !state->options.Check(&why)) throw InputError("seam fit options: " + why);
   const int n = static_cast<int>(samples.size());
   if (n < kParams)
     throw InputError(std::to_string(n) + " point(s): the quadratic B_f(d) has 3 coefficients, " +
                      "at least 3 points are needed");
   int with_sd = 0;
-  std::set<double> distinct;
+  std::set<double>& distinct = state->distinct;
   for (int i = 0; i < n; ++i) {
     CheckSample(samples[i], "point " + std::to_string(i + 1));
     with_sd += std::isnan(samples[i].sd) ? 0 : 1;
@@ -282,19 +279,25 @@ SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,
       samples.begin(), samples.end(),
       [](const SeamSample& l, const SeamSample& r) { return l.factor < r.factor; });
   if (highest->factor < 1.0)
-    throw InputError("every factor is below 1 (" + Num(lowest->factor, 4) + " to " +
-                     Num(highest->factor, 4) +
+    throw InputError("every factor is below 1 (" + NumberText(lowest->factor, 4) + " to " +
+                     NumberText(highest->factor, 4) +
                      "): a seam would make the fabric softer, and S = max(1, B_f) would be 1 "
                      "everywhere; is the ratio inverted (plain / seamed)? Its inverse is " +
-                     Num(1.0 / highest->factor, 4) + " to " + Num(1.0 / lowest->factor, 4));
+                     NumberText(1.0 / highest->factor, 4) + " to " +
+                     NumberText(1.0 / lowest->factor, 4));
 
-  SeamFitSummary fit;
+  SeamFitSummary& fit = state->fit;
   fit.num_points = n;
   fit.distinct_distances = static_cast<int>(distinct.size());
   fit.dof = n - kParams;
   fit.weighted = with_sd == n;
   fit.range_mm = {*distinct.begin(), *distinct.rbegin()};
+}
 
+void SolveSeamQuadratic(SeamFitState* state) {
+  const std::vector<SeamSample>& samples = state->samples;
+  SeamFitSummary& fit = state->fit;
+  const int n = static_cast<int>(samples.size());
   // Design matrix rows (d², d, 1), weights 1/sd² (or 1); d in mm as in Table 2.
   std::unique_ptr<gsl_matrix, GslMatrixDeleter> x(gsl_matrix_alloc(n, kParams));
   std::unique_ptr<gsl_matrix, GslMatrixDeleter> cov(gsl_matrix_alloc(kParams, kParams));
@@ -335,7 +338,12 @@ SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,
     fit.covariance.setZero();
   }
   fit.covariance = 0.5 * (fit.covariance + fit.covariance.transpose()).eval();
+}
 
+void MeasureSeamResiduals(SeamFitState* state) {
+  const std::vector<SeamSample>& samples = state->samples;
+  SeamFitSummary& fit = state->fit;
+  const int n = static_cast<int>(samples.size());
   double ss_res = 0.0, ss_tot = 0.0, mean = 0.0;
   for (const auto& p : samples) mean += p.factor / n;
   for (const auto& p : samples) {
@@ -346,6 +354,7 @@ SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,
     ss_tot += (p.factor - mean) * (p.factor - mean);
     fit.max_residual = std::max(fit.max_residual, std::abs(r));
   }
+  state->mean_factor = mean;
   fit.rms = std::sqrt(ss_res / n);
   fit.rms_relative = fit.rms / mean;  // mean > 0: every factor is
   // Factors that do not vary leave no variance to explain: the fit is perfect when it
@@ -354,27 +363,37 @@ SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,
   fit.r2 = ss_tot > round_off    ? 1.0 - ss_res / ss_tot
            : ss_res <= round_off ? 1.0
                                  : std::numeric_limits<double>::quiet_NaN();
+}
 
+void JudgeSeamFit(SeamFitState* state) {
+  const SeamFitOptions& options = state->options;
+  SeamFitSummary& fit = state->fit;
   if (fit.weighted && fit.dof > 0 && fit.chi2_probability < options.poor_probability) {
     fit.poor = true;
     fit.poor_reason =
-        "residuals too large for the stated sd: chi2/dof = " + Num(chi2 / fit.dof, 4) +
-        ", Q(chi2, " + std::to_string(fit.dof) + ") = " + Num(fit.chi2_probability, 3) + " < " +
-        Num(options.poor_probability);
+        "residuals too large for the stated sd: chi2/dof = " + NumberText(fit.chi2 / fit.dof, 4) +
+        ", Q(chi2, " + std::to_string(fit.dof) + ") = " + NumberText(fit.chi2_probability, 3) +
+        " < " + NumberText(options.poor_probability);
   } else if (!fit.weighted && fit.dof > 0 && !(fit.r2 >= options.poor_r2) &&
              fit.rms_relative > options.poor_relative_rms) {
     // r² alone judges a flat profile by its round-off: with no variance to explain, residuals
     // of 0.001 on factors of 2 gave r² = 0.11. A fit is poor when it misses the trend (low r²)
     // by residuals that matter against the factors themselves.
     fit.poor = true;
-    fit.poor_reason = "the quadratic explains only " +
-                      (std::isnan(fit.r2) ? std::string("none") : Num(100.0 * fit.r2, 3) + " %") +
-                      " of the factor's variance (r2 < " + Num(options.poor_r2) +
-                      ") and its rms residual " + Num(fit.rms, 3) + " is " +
-                      Num(100.0 * fit.rms_relative, 3) + " % of the mean factor " + Num(mean, 4) +
-                      " (> " + Num(100.0 * options.poor_relative_rms) + " %)";
+    fit.poor_reason =
+        "the quadratic explains only " +
+        (std::isnan(fit.r2) ? std::string("none") : NumberText(100.0 * fit.r2, 3) + " %") +
+        " of the factor's variance (r2 < " + NumberText(options.poor_r2) +
+        ") and its rms residual " + NumberText(fit.rms, 3) + " is " +
+        NumberText(100.0 * fit.rms_relative, 3) + " % of the mean factor " +
+        NumberText(state->mean_factor, 4) + " (> " + NumberText(100.0 * options.poor_relative_rms) +
+        " %)";
   }
+}
 
+void StartSeamProfile(SeamFitState* state) {
+  const SeamFitOptions& options = state->options;
+  SeamFitSummary& fit = state->fit;
   SeamProfile& p = fit.profile;
   p.type = "fitted";
   p.name = options.name;
@@ -385,68 +404,109 @@ SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,
   if (fit.covariance_known) p.covariance = fit.covariance;
   // The influence range: where the data are, unless given. Beyond d_max only the value and
   // slope of B_f at d_max enter (the fade, seam.h), so the default extrapolates nothing.
-  const double hi = fit.range_mm[1];
   fit.influence_from_data = std::isnan(options.influence_mm);
-  fit.influence_mm = fit.influence_from_data ? std::max(1.0, hi) : options.influence_mm;
+  fit.influence_mm =
+      fit.influence_from_data ? std::max(1.0, fit.range_mm[1]) : options.influence_mm;
   p.influence_mm = fit.influence_mm;
+}
+
+void CheckExtrapolation(SeamFitState* state) {
+  SeamFitSummary& fit = state->fit;
+  const double hi = fit.range_mm[1];
+  if (!(fit.influence_mm > hi)) return;
   const auto& a = fit.coefficients_mm;
-  if (fit.influence_mm > hi) {
-    const Rise rise = RiseOn(a, hi, fit.influence_mm);
-    if (rise.amount > options.rise_tolerance) {
-      std::string advice = "leave the influence range to the data (" + Num(hi, 4) + " mm)";
-      if (rise.from > hi) advice += " or end it by " + Num(rise.from, 4) + " mm";
-      throw InputError("influence range " + Num(fit.influence_mm) +
-                       " mm reaches beyond the data (d up to " + Num(hi, 4) +
-                       " mm), and there the fitted B_f rises from " +
-                       Num(Quadratic(a, rise.from), 4) + " at " + Num(rise.from, 4) + " mm to " +
-                       Num(Quadratic(a, rise.to), 4) + " at " + Num(rise.to, 4) +
-                       " mm: a seam stiffer away from its line is the polynomial extrapolated, "
-                       "not measured; " +
-                       advice);
-    }
-    if (!fit.influence_from_data)
-      fit.notes.push_back("the influence range " + Num(fit.influence_mm) +
-                          " mm reaches beyond the data (d up to " + Num(hi, 4) +
-                          " mm): S extrapolates the fit there, B_f " + Num(Quadratic(a, hi), 4) +
-                          " -> " + Num(Quadratic(a, fit.influence_mm), 4));
+  const Rise rise = RiseOn(a, hi, fit.influence_mm);
+  if (rise.amount > state->options.rise_tolerance) {
+    std::string advice = "leave the influence range to the data (" + NumberText(hi, 4) + " mm)";
+    if (rise.from > hi) advice += " or end it by " + NumberText(rise.from, 4) + " mm";
+    throw InputError("influence range " + NumberText(fit.influence_mm) +
+                     " mm reaches beyond the data (d up to " + NumberText(hi, 4) +
+                     " mm), and there the fitted B_f rises from " +
+                     NumberText(Quadratic(a, rise.from), 4) + " at " + NumberText(rise.from, 4) +
+                     " mm to " + NumberText(Quadratic(a, rise.to), 4) + " at " +
+                     NumberText(rise.to, 4) +
+                     " mm: a seam stiffer away from its line is the polynomial extrapolated, "
+                     "not measured; " +
+                     advice);
   }
+  if (!fit.influence_from_data)
+    fit.notes.push_back(
+        {"influence_beyond_data", "the influence range " + NumberText(fit.influence_mm) +
+                                      " mm reaches beyond the data (d up to " + NumberText(hi, 4) +
+                                      " mm): S extrapolates the fit there, B_f " +
+                                      NumberText(Quadratic(a, hi), 4) + " -> " +
+                                      NumberText(Quadratic(a, fit.influence_mm), 4)});
+}
+
+void CheckSeamProfile(const SeamFitState& state) {
+  const SeamProfile& p = state.fit.profile;
   if (std::string why; !p.Check(&why))
-    throw ComputeError("fitted B_f(d) = " + Num(p.coefficients_mm[0]) + " d² + " +
-                       Num(p.coefficients_mm[1]) + " d + " + Num(p.coefficients_mm[2]) +
+    throw ComputeError("fitted B_f(d) = " + NumberText(p.coefficients_mm[0]) + " d² + " +
+                       NumberText(p.coefficients_mm[1]) + " d + " +
+                       NumberText(p.coefficients_mm[2]) +
                        " cannot serve as a seam profile: " + why);
-  if (fit.influence_mm < hi) {
-    // S fades to 1 from d_max on: say how far it then lies from the points it leaves out.
-    int beyond = 0;
-    const SeamSample* worst = nullptr;
-    for (const auto& s : samples) {
-      if (s.d_mm <= fit.influence_mm) continue;
-      ++beyond;
-      if (worst == nullptr || std::abs(s.factor - p.Multiplier(s.d_mm)) >
-                                  std::abs(worst->factor - p.Multiplier(worst->d_mm)))
-        worst = &s;
-    }
-    fit.notes.push_back("the influence range " + Num(fit.influence_mm) +
-                        " mm ends inside the data (d up to " + Num(hi, 4) +
-                        " mm): S fades to 1 by " + Num(fit.influence_mm + p.fade_mm) + " mm; at " +
-                        std::to_string(beyond) +
-                        " point(s) beyond it S departs from the measured factor by up to " +
-                        Num(std::abs(worst->factor - p.Multiplier(worst->d_mm)), 3) +
-                        " (S = " + Num(p.Multiplier(worst->d_mm), 4) + " where the data say " +
-                        Num(worst->factor, 4) + " at " + Num(worst->d_mm, 4) + " mm)");
+}
+
+void NoteInfluenceInsideData(SeamFitState* state) {
+  SeamFitSummary& fit = state->fit;
+  const SeamProfile& p = fit.profile;
+  const double hi = fit.range_mm[1];
+  if (!(fit.influence_mm < hi)) return;
+  // S fades to 1 from d_max on: say how far it then lies from the points it leaves out.
+  int beyond = 0;
+  const SeamSample* worst = nullptr;
+  for (const auto& s : state->samples) {
+    if (s.d_mm <= fit.influence_mm) continue;
+    ++beyond;
+    if (worst == nullptr || std::abs(s.factor - p.Multiplier(s.d_mm)) >
+                                std::abs(worst->factor - p.Multiplier(worst->d_mm)))
+      worst = &s;
   }
+  fit.notes.push_back(
+      {"influence_inside_data",
+       "the influence range " + NumberText(fit.influence_mm) +
+           " mm ends inside the data (d up to " + NumberText(hi, 4) + " mm): S fades to 1 by " +
+           NumberText(fit.influence_mm + p.fade_mm) + " mm; at " + std::to_string(beyond) +
+           " point(s) beyond it S departs from the measured factor by up to " +
+           NumberText(std::abs(worst->factor - p.Multiplier(worst->d_mm)), 3) +
+           " (S = " + NumberText(p.Multiplier(worst->d_mm), 4) + " where the data say " +
+           NumberText(worst->factor, 4) + " at " + NumberText(worst->d_mm, 4) + " mm)"});
+}
+
+void NoteFadeOvershoot(SeamFitState* state) {
+  SeamFitSummary& fit = state->fit;
+  const SeamProfile& p = fit.profile;
+  const auto& a = fit.coefficients_mm;
   // The fade starts with B_f's slope at d_max: a fit that still rises there overshoots.
   double peak = p.Multiplier(fit.influence_mm), peak_at = fit.influence_mm;
   for (int k = 1; k <= 200; ++k) {
     const double d = fit.influence_mm + p.fade_mm * k / 200.0;
     if (p.Multiplier(d) > peak) peak = p.Multiplier(d), peak_at = d;
   }
-  if (peak > p.Multiplier(fit.influence_mm) + options.rise_tolerance)
-    fit.notes.push_back("B_f still rises at d_max = " + Num(fit.influence_mm, 4) + " mm (slope " +
-                        Num(2.0 * a[0] * fit.influence_mm + a[1], 3) +
-                        " /mm); the fade to 1, which starts with that slope, peaks at S = " +
-                        Num(peak, 4) + " at " + Num(peak_at, 4) + " mm");
-  p.fit = fit.Report();
-  return fit;
+  if (peak > p.Multiplier(fit.influence_mm) + state->options.rise_tolerance)
+    fit.notes.push_back(
+        {"fade_overshoot", "B_f still rises at d_max = " + NumberText(fit.influence_mm, 4) +
+                               " mm (slope " + NumberText(2.0 * a[0] * fit.influence_mm + a[1], 3) +
+                               " /mm); the fade to 1, which starts with that slope, peaks at S = " +
+                               NumberText(peak, 4) + " at " + NumberText(peak_at, 4) + " mm"});
+}
+
+}  // namespace internal
+
+SeamFitSummary FitSeamFactor(const std::vector<SeamSample>& samples,
+                             const SeamFitOptions& options) {
+  internal::SeamFitState state(samples, options);
+  internal::CheckSeamData(&state);
+  internal::SolveSeamQuadratic(&state);
+  internal::MeasureSeamResiduals(&state);
+  internal::JudgeSeamFit(&state);
+  internal::StartSeamProfile(&state);
+  internal::CheckExtrapolation(&state);
+  internal::CheckSeamProfile(state);
+  internal::NoteInfluenceInsideData(&state);
+  internal::NoteFadeOvershoot(&state);
+  state.fit.profile.fit = state.fit.Report();
+  return std::move(state.fit);
 }
 
 nlohmann::json SeamFitSummary::Report() const {
@@ -454,6 +514,9 @@ nlohmann::json SeamFitSummary::Report() const {
   nlohmann::json sd = nlohmann::json::array();
   for (int k = 0; k < kParams; ++k)
     sd.push_back(covariance_known ? nlohmann::json(std::sqrt(covariance(k, k))) : nlohmann::json());
+  // The notes' texts, as the seam file has always carried them.
+  nlohmann::json note_texts = nlohmann::json::array();
+  for (const Note& note : notes) note_texts.push_back(note.text);
   return {{"method", "gsl_multifit_wlinear"},
           {"weighted", weighted},
           {"points", num_points},
@@ -473,24 +536,26 @@ nlohmann::json SeamFitSummary::Report() const {
           {"poor_reason", poor_reason},
           {"influence_mm", influence_mm},
           {"influence_from", influence_from_data ? "data" : "option"},
-          {"notes", notes}};
+          {"notes", note_texts}};
 }
 
 std::string SeamFitSummary::BriefReport() const {
   std::ostringstream s;
   s.precision(4);
   const char* names[3] = {"a2", "a1", "a0"};
-  s << "B_f(d) = " << Num(coefficients_mm[0], 5) << " d² + " << Num(coefficients_mm[1], 5)
-    << " d + " << Num(coefficients_mm[2], 5) << " (d in mm);";
+  s << "B_f(d) = " << NumberText(coefficients_mm[0], 5) << " d² + "
+    << NumberText(coefficients_mm[1], 5) << " d + " << NumberText(coefficients_mm[2], 5)
+    << " (d in mm);";
   for (int k = 0; k < kParams; ++k) {
     s << " " << names[k] << " ± "
-      << (covariance_known ? Num(std::sqrt(covariance(k, k)), 3) : std::string("?"));
+      << (covariance_known ? NumberText(std::sqrt(covariance(k, k)), 3) : std::string("?"));
     if (k < kParams - 1) s << ",";
   }
   s << " (1-σ" << (weighted ? ", from the given sd" : ", from the scatter") << "); " << num_points
-    << " points, d in [" << Num(range_mm[0], 4) << ", " << Num(range_mm[1], 4) << "] mm, rms "
-    << Num(rms, 3) << ", r² " << (std::isfinite(r2) ? Num(r2, 5) : std::string("n/a"));
-  if (weighted && dof > 0) s << ", chi²/dof " << Num(chi2 / dof, 3);
+    << " points, d in [" << NumberText(range_mm[0], 4) << ", " << NumberText(range_mm[1], 4)
+    << "] mm, rms " << NumberText(rms, 3) << ", r² "
+    << (std::isfinite(r2) ? NumberText(r2, 5) : std::string("n/a"));
+  if (weighted && dof > 0) s << ", chi²/dof " << NumberText(chi2 / dof, 3);
   if (poor) s << "; POOR FIT: " << poor_reason;
   return s.str();
 }

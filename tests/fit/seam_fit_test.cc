@@ -286,7 +286,7 @@ TEST(SeamFitInfluence, DefaultsToTheDataAndNeverRisesBeyondThem) {
   const SeamFitSummary fit = FitSeamFactor(FallingTo30());
   EXPECT_TRUE(fit.influence_from_data);
   EXPECT_DOUBLE_EQ(fit.profile.influence_mm, 30.0);
-  EXPECT_TRUE(fit.notes.empty()) << fit.notes.front();
+  EXPECT_TRUE(fit.notes.empty()) << JoinNoteTexts(fit.notes, "; ");
   // Beyond the data S only falls, from B_f(30) to 1 at the end of the fade (0.01 mm sweep).
   const SeamProfile& p = fit.profile;
   double previous = p.Multiplier(30.0);
@@ -316,8 +316,9 @@ TEST(SeamFitInfluence, AGivenRangeBeyondTheDataWhereTheFitRisesIsRefused) {
   const SeamFitSummary fit = FitSeamFactor(FallingTo30(), o);
   EXPECT_FALSE(fit.influence_from_data);
   ASSERT_EQ(fit.notes.size(), 1u);
-  EXPECT_NE(fit.notes[0].find("reaches beyond the data (d up to 30 mm)"), std::string::npos)
-      << fit.notes[0];
+  EXPECT_EQ(fit.notes[0].code, "influence_beyond_data");
+  EXPECT_NE(fit.notes[0].text.find("reaches beyond the data (d up to 30 mm)"), std::string::npos)
+      << fit.notes[0].text;
   // A rise within rise_tolerance (round-off of a flat fit) is no reason to refuse.
   o.influence_mm = 43.0;
   EXPECT_NO_THROW(FitSeamFactor(FallingTo30(), o));
@@ -331,13 +332,14 @@ TEST(SeamFitInfluence, AGivenRangeInsideTheDataSaysWhatItCuts) {
   const SeamFitSummary fit = FitSeamFactor(data, o);
   EXPECT_EQ(fit.profile.Multiplier(30.0), 1.0);  // the data say 1.8
   ASSERT_EQ(fit.notes.size(), 1u);
-  EXPECT_NE(fit.notes[0].find("ends inside the data (d up to 40 mm)"), std::string::npos)
-      << fit.notes[0];
-  EXPECT_NE(fit.notes[0].find("3 point(s) beyond it"), std::string::npos) << fit.notes[0];
-  EXPECT_NE(fit.notes[0].find("by up to 0.8 (S = 1 where the data say 1.8 at 30 mm)"),
+  EXPECT_EQ(fit.notes[0].code, "influence_inside_data");
+  EXPECT_NE(fit.notes[0].text.find("ends inside the data (d up to 40 mm)"), std::string::npos)
+      << fit.notes[0].text;
+  EXPECT_NE(fit.notes[0].text.find("3 point(s) beyond it"), std::string::npos) << fit.notes[0].text;
+  EXPECT_NE(fit.notes[0].text.find("by up to 0.8 (S = 1 where the data say 1.8 at 30 mm)"),
             std::string::npos)
-      << fit.notes[0];
-  EXPECT_EQ(fit.Report()["notes"].size(), 1u);
+      << fit.notes[0].text;
+  EXPECT_EQ(fit.Report()["notes"], nlohmann::json::array({fit.notes[0].text}));
 }
 
 TEST(SeamFitInfluence, AFadeThatOvershootsAFitRisingAtTheEndOfTheDataIsNoted) {
@@ -345,7 +347,9 @@ TEST(SeamFitInfluence, AFadeThatOvershootsAFitRisingAtTheEndOfTheDataIsNoted) {
   // slope and first climbs.
   const SeamFitSummary fit = FitSeamFactor({{0, 3.0}, {20, 2.0}, {40, 1.8}, {60, 2.2}});
   ASSERT_EQ(fit.notes.size(), 1u);
-  EXPECT_NE(fit.notes[0].find("still rises at d_max = 60 mm"), std::string::npos) << fit.notes[0];
+  EXPECT_EQ(fit.notes[0].code, "fade_overshoot");
+  EXPECT_NE(fit.notes[0].text.find("still rises at d_max = 60 mm"), std::string::npos)
+      << fit.notes[0].text;
 }
 
 // Factors of 2 ± 0.001 (a flat profile, as the shell ACPM gives an along seam) leave almost no

@@ -37,6 +37,7 @@
 #include <string>
 #include <vector>
 
+#include "textile/sim/note.h"
 #include "textile/sim/seam.h"
 
 namespace textile {
@@ -110,9 +111,10 @@ struct SeamFitSummary {
   std::string poor_reason;  // why, when poor
   double influence_mm = 0.0;         // d_max written [mm]
   bool influence_from_data = false;  // d_max is the largest d fitted (not given)
-  // What the user should know about the written S(d) (d_max inside or beyond the data, the
-  // fade overshooting a fit that rises at the end of the data), one sentence each.
-  std::vector<std::string> notes;
+  // What the user should know about the written S(d), one sentence each, with its code:
+  // "influence_beyond_data" (an explicit d_max beyond the data), "influence_inside_data" (d_max
+  // cuts data off), "fade_overshoot" (the fade overshoots a fit that rises at d_max).
+  std::vector<Note> notes;
 
   SeamProfile profile;  // type "fitted", ready for SeamProfileToJson (fit report included)
 

@@ -301,9 +301,9 @@ void Run(const FitArgs& a) {
       extracted << "extracted " << in.source << ": " << r.rig_type << " rig, " << r.polarity
                 << " strip, L = " << Num(r.length_mm, 4) << " mm, tip (" << Num(r.tip_mm.x(), 4)
                 << ", " << Num(r.tip_mm.y(), 4) << ") mm, " << r.profile.size() << " points\n";
-      for (const auto& w : r.warnings) extracted << "  warning: " << w << "\n";
+      for (const auto& w : r.warnings) extracted << "  warning: " << w.text << "\n";
     }
-    for (const auto& w : r.warnings) photo_warnings += "; " + in.source + ": " + w;
+    for (const auto& w : r.warnings) photo_warnings += "; " + in.source + ": " + w.text;
   }
   Outcome o;
   try {

@@ -25,7 +25,11 @@ using extract_internal::Median;
 using extract_internal::PlatformFit;
 using extract_internal::ResampleByArc;
 using extract_internal::SampleGray;
+using extract_internal::Section;
+using extract_internal::SectionSet;
 using extract_internal::SmoothPolyline;
+using extract_internal::Strip;
+using extract_internal::Sweep;
 using extract_internal::Vec2;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -110,17 +114,7 @@ cv::Point Farthest(const cv::Mat& dist, const cv::Rect& box, float* value) {
   return best;
 }
 
-// The two ends of a band-like mask (a double sweep of geodesic distances) and its length.
-struct Sweep {
-  cv::Rect box;  // bounding box of the mask
-  cv::Point a, b;
-  cv::Mat dist_a, dist_b;  // box-sized (GeodesicDistance)
-  double length = 0.0;
-  // Distance from end a (or b) of image pixel (x, y), which must lie in the box.
-  float DistA(int x, int y) const { return dist_a.at<float>(y - box.y, x - box.x); }
-  float DistB(int x, int y) const { return dist_b.at<float>(y - box.y, x - box.x); }
-};
-
+// The ends of a band-like mask and its geodesic length (Sweep).
 Sweep DoubleSweep(const cv::Mat& mask) {
   Sweep s;
   s.box = cv::boundingRect(mask);
@@ -163,15 +157,6 @@ double HatThreshold(const cv::Mat& hat) {
   const double otsu = cv::threshold(hat, unused, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
   return std::max({otsu, med + 6.0 * spread, med + 3.0});
 }
-
-// A strip candidate on the reduced image.
-struct Strip {
-  int polarity = 0;        // +1 lighter than the background, -1 darker
-  cv::Mat mask;            // CV_8U, reduced-image size
-  double score = 0.0;      // length x mean contrast
-  double length = 0.0;     // geodesic length [reduced px]
-  double thickness = 0.0;  // area / length [reduced px]
-};
 
 void CollectStrips(const cv::Mat& hat, int polarity, std::vector<Strip>* out) {
   const double min_length = kMinLengthFraction * std::hypot(hat.cols, hat.rows);
@@ -557,34 +542,6 @@ void CutAtSharpTurn(std::vector<Vec2>* line, double base, bool check_growth,
 
 // ---------------------------------------------------------------- full-resolution sections
 
-struct Section {
-  double n_lo = kNaN, n_up = kNaN;    // boundaries along the normal [px] (n_up on the top side)
-  double peak = 0.0;                  // contrast at the core [grey levels]
-  double bg = 0.0;                    // background level (mean of both sides)
-  bool present = false;               // the strip is there (clear contrast at the core)
-  bool valid = false;                 // ... and both boundaries were measured
-  bool lo_ok = false, up_ok = false;  // each boundary measured and not an outlier
-  double solid = 0.0;                 // longest run above half the peak contrast [px]: the
-                                      // strip's body, where loose fibres give only short runs
-  double solid_mid = kNaN;            // centre of that run along the normal [px]: a steadier
-                                      // guide than the mid-line when a faint face comes and goes
-  double width() const { return n_up - n_lo; }
-  // Whether the line to trace is known here.
-  bool Usable(TraceLine line) const {
-    return line == TraceLine::kUpper ? up_ok : line == TraceLine::kLower ? lo_ok : lo_ok && up_ok;
-  }
-};
-
-// Cross-sections of the strip at stations along a guide line.
-struct SectionSet {
-  std::vector<Vec2> p, t, n;  // station [px], unit tangent (root -> tip), unit normal (top side)
-  std::vector<Section> s;
-  double noise = 0.0;     // σ of the smoothed background [grey levels]
-  double contrast = 0.0;  // median peak contrast of valid sections
-  double width = 0.0;     // median width of valid sections [px]
-  int rejected = 0;       // sections dropped as outliers
-};
-
 // Sub-sample edge position: the first local maximum of the inward derivative of the contrast
 // c, from `start` (just outside the silhouette) towards `core`, that is at least `min_slope`
 // per sample; parabola through the maximum. Falls back to `fallback` when there is none.
@@ -605,28 +562,35 @@ double RefineEdge(const std::vector<double>& c, int start, int core, double min_
   return fallback;
 }
 
-SectionSet AnalyseSections(const cv::Mat& gray, const std::vector<Vec2>& line, int direction,
-                           int polarity, double half_width, double core_half_width) {
-  SectionSet set;
+// Stations along `line`: tangents over ±3 points (root -> tip) and normals on the top side.
+void PlaceStations(const std::vector<Vec2>& line, int direction, SectionSet* set) {
   const int m = static_cast<int>(line.size());
-  set.p = line;
-  set.t.resize(m);
-  set.n.resize(m);
-  set.s.resize(m);
+  set->p = line;
+  set->t.resize(m);
+  set->n.resize(m);
+  set->s.resize(m);
   for (int i = 0; i < m; ++i) {
     Vec2 d = line[std::min(i + 3, m - 1)] - line[std::max(i - 3, 0)];
     if (d.norm() < 1e-9) d = Vec2(direction, 0.0);
-    set.t[i] = d.normalized();
-    set.n[i] = direction * Vec2(set.t[i].y(), -set.t[i].x());
+    set->t[i] = d.normalized();
+    set->n[i] = direction * Vec2(set->t[i].y(), -set->t[i].x());
   }
-  const int half = static_cast<int>(std::lround(half_width / kAcrossStep));
+}
+
+// Grey levels across the strip at every station, 2 half + 1 samples kAcrossStep apart centred
+// on it: *raw (#M × cols, CV_32F) and *inside (CV_8U, 1 where the sample lies in the photo;
+// outside ones take the nearest border's value).
+void SampleAcross(const cv::Mat& gray, const SectionSet& set, int half, cv::Mat* raw,
+                  cv::Mat* inside) {
+  const int m = static_cast<int>(set.p.size());
   const int cols = 2 * half + 1;
-  cv::Mat raw(m, cols, CV_32F), inside(m, cols, CV_8U);
+  raw->create(m, cols, CV_32F);
+  inside->create(m, cols, CV_8U);
   const double x_max = gray.cols - 1.0, y_max = gray.rows - 1.0;
   for (int i = 0; i < m; ++i) {
-    float* out = raw.ptr<float>(i);
-    uchar* in_row = inside.ptr<uchar>(i);
-    const Vec2 q0 = line[i] - half * kAcrossStep * set.n[i], dq = kAcrossStep * set.n[i];
+    float* out = raw->ptr<float>(i);
+    uchar* in_row = inside->ptr<uchar>(i);
+    const Vec2 q0 = set.p[i] - half * kAcrossStep * set.n[i], dq = kAcrossStep * set.n[i];
     const Vec2 q1 = q0 + (cols - 1) * dq;
     // A section wholly inside the photo (the usual case) is sampled without per-sample checks.
     const bool all_in = std::min(q0.x(), q1.x()) >= 0.0 && std::max(q0.x(), q1.x()) <= x_max &&
@@ -651,70 +615,112 @@ SectionSet AnalyseSections(const cv::Mat& gray, const std::vector<Vec2>& line, i
       out[j] = static_cast<float>(v);
     }
   }
+}
+
+// Background on each side of every section: the median of its outer `margin` samples of the
+// smoothed profiles `u`. Returns the background noise σ (robust, from every fourth section).
+double BackgroundLevels(const cv::Mat& u, int margin, std::vector<double>* bg_lo,
+                        std::vector<double>* bg_up) {
+  const int m = u.rows, cols = u.cols;
+  std::vector<double> deviations;
+  bg_lo->resize(m);
+  bg_up->resize(m);
+  for (int i = 0; i < m; ++i) {
+    const float* row = u.ptr<float>(i);
+    std::vector<double> lo(row, row + margin), up(row + cols - margin, row + cols);
+    (*bg_lo)[i] = Median(lo);
+    (*bg_up)[i] = Median(up);
+    if (i % 4 == 0) {
+      for (double v : lo) deviations.push_back(std::abs(v - (*bg_lo)[i]));
+      for (double v : up) deviations.push_back(std::abs(v - (*bg_up)[i]));
+    }
+  }
+  return std::max(0.2, 1.4826 * Median(deviations));
+}
+
+// How one section's samples are read: the window's geometry and the background.
+struct SectionWindow {
+  int half = 0, margin = 0, core_reach = 0;  // [samples]
+  double bg_lo = 0.0, bg_up = 0.0;           // background on each side [grey levels]
+  double noise = 0.0;                        // [grey levels]
+  int polarity = 0;
+};
+
+// One section from its smoothed samples `row` (cols = 2 half + 1) and which of them lie in the
+// photo: the contrast against the background interpolated between both sides (*c, scratch of
+// cols), its core, solid run and the two boundaries.
+void MeasureSection(const float* row, const uchar* inside, const SectionWindow& w,
+                    std::vector<double>* contrast, Section* sec) {
+  std::vector<double>& c = *contrast;
+  const int half = w.half, cols = 2 * half + 1, margin = w.margin;
+  const double jl = (margin - 1) / 2.0, ju = cols - 1 - (margin - 1) / 2.0;
+  for (int j = 0; j < cols; ++j) {
+    const double bg = w.bg_lo + (w.bg_up - w.bg_lo) * (j - jl) / (ju - jl);
+    c[j] = w.polarity * (row[j] - bg);
+  }
+  sec->bg = 0.5 * (w.bg_lo + w.bg_up);
+  if (!inside[half]) return;
+  int core = half;
+  for (int j = half - w.core_reach; j <= half + w.core_reach; ++j) {
+    if (j > 0 && j < cols - 1 && c[j] > c[core]) core = j;
+  }
+  sec->peak = c[core];
+  if (sec->peak < 4.0 * w.noise) return;
+  sec->present = true;
+  {
+    int lo = core, hi = core;
+    while (lo > 0 && c[lo - 1] > 0.5 * sec->peak) --lo;
+    while (hi < cols - 1 && c[hi + 1] > 0.5 * sec->peak) ++hi;
+    sec->solid = (hi - lo + 1) * kAcrossStep;
+    sec->solid_mid = (0.5 * (lo + hi) - half) * kAcrossStep;
+  }
+  const double threshold = std::max(kSilhouetteFraction * sec->peak, 4.0 * w.noise);
+  int a = core, b = core;
+  while (a > 0 && c[a - 1] > threshold) --a;
+  while (b < cols - 1 && c[b + 1] > threshold) ++b;
+  // The silhouette must end inside the window with background on both sides.
+  if (a <= margin || b >= cols - 1 - margin) return;
+  if (std::abs(w.bg_up - w.bg_lo) > 0.5 * sec->peak) return;
+  bool all_inside = true;
+  for (int j = std::max(0, a - 4); j <= std::min(cols - 1, b + 4); ++j)
+    all_inside &= inside[j] != 0;
+  if (!all_inside) return;
+  const double cross_lo = (a - 1) + (threshold - c[a - 1]) / (c[a] - c[a - 1]);
+  const double cross_up = (b + 1) - (threshold - c[b + 1]) / (c[b] - c[b + 1]);
+  const double min_slope = threshold * kAcrossStep / 4.0;
+  const double e_lo = RefineEdge(c, a - 1, core, min_slope, cross_lo);
+  const double e_up = RefineEdge(c, b + 1, core, min_slope, cross_up);
+  sec->n_lo = (e_lo - half) * kAcrossStep;
+  sec->n_up = (e_up - half) * kAcrossStep;
+  sec->valid = sec->lo_ok = sec->up_ok = sec->n_up > sec->n_lo;
+}
+
+// Cross-sections at every point of `line` [px of `gray`], half_width either side [px]; the
+// core (the contrast's peak) is looked for within core_half_width of the line [px].
+SectionSet AnalyseSections(const cv::Mat& gray, const std::vector<Vec2>& line, int direction,
+                           int polarity, double half_width, double core_half_width) {
+  SectionSet set;
+  PlaceStations(line, direction, &set);
+  SectionWindow w;
+  w.half = static_cast<int>(std::lround(half_width / kAcrossStep));
+  const int cols = 2 * w.half + 1;
+  cv::Mat raw, inside;
+  SampleAcross(gray, set, w.half, &raw, &inside);
   // Noise is smoothed across (σ = 1 px) and along (σ = 1.5 stations) the strip; both are far
   // below the scale of the strip's shape.
   cv::Mat u;
   cv::GaussianBlur(raw, u, cv::Size(0, 0), 1.0 / kAcrossStep, 1.5, cv::BORDER_REPLICATE);
-
-  const int margin = std::max(4, static_cast<int>(std::lround(0.12 * cols)));
-  std::vector<double> deviations;
-  std::vector<double> bg_lo(m), bg_up(m);
-  for (int i = 0; i < m; ++i) {
-    const float* row = u.ptr<float>(i);
-    std::vector<double> lo(row, row + margin), up(row + cols - margin, row + cols);
-    bg_lo[i] = Median(lo);
-    bg_up[i] = Median(up);
-    if (i % 4 == 0) {
-      for (double v : lo) deviations.push_back(std::abs(v - bg_lo[i]));
-      for (double v : up) deviations.push_back(std::abs(v - bg_up[i]));
-    }
-  }
-  set.noise = std::max(0.2, 1.4826 * Median(deviations));
-  const double jl = (margin - 1) / 2.0, ju = cols - 1 - (margin - 1) / 2.0;
-  const int core_reach = std::max(2, static_cast<int>(std::lround(core_half_width / kAcrossStep)));
+  w.margin = std::max(4, static_cast<int>(std::lround(0.12 * cols)));
+  std::vector<double> bg_lo, bg_up;
+  set.noise = BackgroundLevels(u, w.margin, &bg_lo, &bg_up);
+  w.noise = set.noise;
+  w.polarity = polarity;
+  w.core_reach = std::max(2, static_cast<int>(std::lround(core_half_width / kAcrossStep)));
   std::vector<double> c(cols);
-  for (int i = 0; i < m; ++i) {
-    Section& sec = set.s[i];
-    const float* row = u.ptr<float>(i);
-    for (int j = 0; j < cols; ++j) {
-      const double bg = bg_lo[i] + (bg_up[i] - bg_lo[i]) * (j - jl) / (ju - jl);
-      c[j] = polarity * (row[j] - bg);
-    }
-    sec.bg = 0.5 * (bg_lo[i] + bg_up[i]);
-    if (!inside.at<uchar>(i, half)) continue;
-    int core = half;
-    for (int j = half - core_reach; j <= half + core_reach; ++j) {
-      if (j > 0 && j < cols - 1 && c[j] > c[core]) core = j;
-    }
-    sec.peak = c[core];
-    if (sec.peak < 4.0 * set.noise) continue;
-    sec.present = true;
-    {
-      int lo = core, hi = core;
-      while (lo > 0 && c[lo - 1] > 0.5 * sec.peak) --lo;
-      while (hi < cols - 1 && c[hi + 1] > 0.5 * sec.peak) ++hi;
-      sec.solid = (hi - lo + 1) * kAcrossStep;
-      sec.solid_mid = (0.5 * (lo + hi) - half) * kAcrossStep;
-    }
-    const double threshold = std::max(kSilhouetteFraction * sec.peak, 4.0 * set.noise);
-    int a = core, b = core;
-    while (a > 0 && c[a - 1] > threshold) --a;
-    while (b < cols - 1 && c[b + 1] > threshold) ++b;
-    // The silhouette must end inside the window with background on both sides.
-    if (a <= margin || b >= cols - 1 - margin) continue;
-    if (std::abs(bg_up[i] - bg_lo[i]) > 0.5 * sec.peak) continue;
-    bool all_inside = true;
-    for (int j = std::max(0, a - 4); j <= std::min(cols - 1, b + 4); ++j)
-      all_inside &= inside.at<uchar>(i, j) != 0;
-    if (!all_inside) continue;
-    const double cross_lo = (a - 1) + (threshold - c[a - 1]) / (c[a] - c[a - 1]);
-    const double cross_up = (b + 1) - (threshold - c[b + 1]) / (c[b] - c[b + 1]);
-    const double min_slope = threshold * kAcrossStep / 4.0;
-    const double e_lo = RefineEdge(c, a - 1, core, min_slope, cross_lo);
-    const double e_up = RefineEdge(c, b + 1, core, min_slope, cross_up);
-    sec.n_lo = (e_lo - half) * kAcrossStep;
-    sec.n_up = (e_up - half) * kAcrossStep;
-    sec.valid = sec.lo_ok = sec.up_ok = sec.n_up > sec.n_lo;
+  for (int i = 0; i < static_cast<int>(line.size()); ++i) {
+    w.bg_lo = bg_lo[i];
+    w.bg_up = bg_up[i];
+    MeasureSection(u.ptr<float>(i), inside.ptr<uchar>(i), w, &c, &set.s[i]);
   }
   return set;
 }
@@ -1181,13 +1187,20 @@ std::string ExtractionSummary::BriefReport() const {
   s << "  " << profile.size() << " points, L = " << Fmt(length_mm, 2) << " mm, tip (x, y) = ("
     << Fmt(tip_mm.x(), 2) << ", " << Fmt(tip_mm.y(), 2) << ") mm, " << Fmt(mm_per_px, 5)
     << " mm/px, silhouette " << Fmt(width_px, 1) << " px wide";
-  for (const auto& w : warnings) s << "\n  warning: " << w;
+  for (const Note& w : warnings) s << "\n  warning: " << w.text;
   return s.str();
 }
 
-ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const ExtractOptions& options,
-                                 const std::string& source) {
-  const fit_internal::Deadline deadline(options.max_seconds);  // checked below: options.Check
+std::vector<std::string> ExtractionSummary::WarningTexts() const {
+  std::vector<std::string> texts;
+  for (const Note& w : warnings) texts.push_back(w.text);
+  return texts;
+}
+
+namespace extract_internal {
+
+void CheckExtractInputs(const cv::Mat& gray, const Rig& rig, const ExtractOptions& options,
+                        const std::string& source) {
   if (gray.empty() || gray.type() != CV_8UC1) {
     throw InputError(source + ": expected an 8-bit grey image");
   }
@@ -1201,518 +1214,589 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
                      std::to_string(W) + "x" + std::to_string(H) + " px)");
   }
   rig.CheckForImage(W, H, source);
+}
 
-  ExtractionSummary r;
-  r.source = source;
-  r.trace = options.trace == TraceLine::kUpper   ? "upper"
-            : options.trace == TraceLine::kLower ? "lower"
-                                                 : "mid";
-  // A photo that fails once the detection image exists is first checked for being a
-  // calibration board, so that the error names the mix-up rather than the stage it broke (the
-  // check costs nothing on photos that extract, and cannot refuse one).
-  const cv::Mat* detection_image = nullptr;
-  const auto fail = [&](const std::string& message) {
-    r.success = false;
-    r.message = detection_image && extract_internal::LooksLikeCalibrationBoard(*detection_image)
-                    ? "this looks like a calibration board (a chessboard), not a strip: give "
-                      "board photos to textile calibrate, which writes the rig file for --rig"
-                    : message;
-    r.seconds = deadline.Elapsed();
-    return r;
-  };
-  // The time cap (ExtractOptions::max_seconds), read between stages; each stage is a bounded
-  // pass over the photo, so the cap bounds a run to the cap plus one stage.
-  const auto past_cap = [&](const char* stage) {
-    const std::optional<std::string> why = deadline.Reached(stage);
-    if (!why) return false;
-    r.profile = Profile{};
-    r.success = false;
-    r.message = *why + "; no profile";
-    r.seconds = deadline.Elapsed();
-    return true;
-  };
-
-  // ---- 1. Find the strip on a reduced image.
-  if (past_cap("before the strip was looked for")) return r;
-  const double scale = std::min(1.0, options.detect_side_px / double(std::max(W, H)));
+void ReduceImages(ExtractState* s) {
+  const int W = s->gray.cols, H = s->gray.rows;
+  s->scale = std::min(1.0, s->options.detect_side_px / double(std::max(W, H)));
   // Large photos get an intermediate level too, reduced by an integer factor to about 2000 px
   // (a box average, the fast case of cv::INTER_AREA; the photo's last f - 1 rows and columns
   // are left out): the first, wide tracking pass runs on it, and the detection image is
   // reduced from it rather than from the photo.
-  const int mid_factor = std::max(1, std::max(W, H) / 2000);
-  cv::Mat mid;
-  if (mid_factor > 1) {
-    const int mw = W / mid_factor, mh = H / mid_factor;
-    cv::resize(gray(cv::Rect(0, 0, mw * mid_factor, mh * mid_factor)), mid, cv::Size(mw, mh), 0,
-               0, cv::INTER_AREA);
+  s->mid_factor = std::max(1, std::max(W, H) / 2000);
+  const int f = s->mid_factor;
+  if (f > 1) {
+    const int mw = W / f, mh = H / f;
+    cv::resize(s->gray(cv::Rect(0, 0, mw * f, mh * f)), s->mid, cv::Size(mw, mh), 0, 0,
+               cv::INTER_AREA);
   }
-  cv::Mat small;
-  if (scale < 1.0 && mid_factor > 1) {
-    const cv::Size size(static_cast<int>(std::lround(W * scale)),
-                        static_cast<int>(std::lround(H * scale)));
-    cv::resize(mid, small, size, 0, 0, cv::INTER_AREA);
-  } else if (scale < 1.0) {
-    cv::resize(gray, small, cv::Size(), scale, scale, cv::INTER_AREA);
+  if (s->scale < 1.0 && f > 1) {
+    const cv::Size size(static_cast<int>(std::lround(W * s->scale)),
+                        static_cast<int>(std::lround(H * s->scale)));
+    cv::resize(s->mid, s->small, size, 0, 0, cv::INTER_AREA);
+  } else if (s->scale < 1.0) {
+    cv::resize(s->gray, s->small, cv::Size(), s->scale, s->scale, cv::INTER_AREA);
   } else {
-    small = gray;
+    s->small = s->gray;
   }
-  const auto full = [&](const Vec2& p) {
-    return Vec2((p.x() + 0.5) / scale - 0.5, (p.y() + 0.5) / scale - 0.5);
-  };
-  detection_image = &small;
+}
+
+namespace {
+
+// A reduced-image point in full-resolution pixels.
+Vec2 FullFromSmall(const ExtractState& s, const Vec2& p) {
+  return Vec2((p.x() + 0.5) / s.scale - 0.5, (p.y() + 0.5) / s.scale - 0.5);
+}
+
+// "(x,y)-(x,y) px": the two ends of a reduced-image band, at full resolution.
+std::string EndsText(const ExtractState& s, const cv::Mat& mask) {
+  const Sweep e = DoubleSweep(mask);
+  const Vec2 a = FullFromSmall(s, Vec2(e.a.x, e.a.y)), b = FullFromSmall(s, Vec2(e.b.x, e.b.y));
+  return "(" + Fmt(a.x(), 0) + "," + Fmt(a.y(), 0) + ")-(" + Fmt(b.x(), 0) + "," + Fmt(b.y(), 0) +
+         ") px";
+}
+
+// A second strip, as long and clear as the chosen one, apart from it: the photo shows two
+// cantilevers and nothing says which one to measure, unless --edge-px does (then the strip
+// nearer to it is taken).
+StageFailure ResolveSecondStrip(ExtractState* s, const std::vector<Strip>& strips) {
+  const std::optional<size_t> k = SecondStrip(strips, s->strip);
+  if (!k) return std::nullopt;
+  const Strip& other = strips[*k];
+  if (Vec2 at; OverhangsOnBothSides(s->small, s->strip, other, &at)) {
+    return DrapedMessage(FullFromSmall(*s, at));
+  }
+  const ExtractOptions& options = s->options;
+  if (!options.edge_px) {
+    return "two strips in the photo, one from " + EndsText(*s, s->strip.mask) +
+           ", the other from " + EndsText(*s, other.mask) +
+           "; photograph one at a time, or give --edge-px X,Y at the held end of the one to "
+           "measure";
+  }
+  const double scale = s->scale;
+  const cv::Point e(static_cast<int>(std::lround((options.edge_px->x() + 0.5) * scale - 0.5)),
+                    static_cast<int>(std::lround((options.edge_px->y() + 0.5) * scale - 0.5)));
+  if (DistanceToMask(other.mask, e) < DistanceToMask(s->strip.mask, e)) {
+    s->strip = other;
+    s->own_blocks = PrepareStrip(s->strip.polarity > 0 ? s->light : s->dark, &s->strip);
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+StageFailure FindStrip(ExtractState* s) {
   // Background flattening: hats with a kernel far wider than any strip but smaller than the
   // light's gradients and broad shadows; a light and a dark strip show in one of the two.
+  const cv::Mat& small = s->small;
   const int kernel = std::max(15, static_cast<int>(std::max(small.cols, small.rows) / 10)) | 1;
   const cv::Mat se = cv::getStructuringElement(cv::MORPH_RECT, {kernel, kernel});
-  cv::Mat light, dark;
-  cv::morphologyEx(small, light, cv::MORPH_TOPHAT, se);
-  cv::morphologyEx(small, dark, cv::MORPH_BLACKHAT, se);
+  cv::morphologyEx(small, s->light, cv::MORPH_TOPHAT, se);
+  cv::morphologyEx(small, s->dark, cv::MORPH_BLACKHAT, se);
   std::vector<Strip> strips;
-  CollectStrips(light, +1, &strips);
-  CollectStrips(dark, -1, &strips);
-  if (strips.empty()) {
-    return fail("no strip found: nothing long and thin contrasts with the background");
-  }
+  CollectStrips(s->light, +1, &strips);
+  CollectStrips(s->dark, -1, &strips);
+  if (strips.empty()) return "no strip found: nothing long and thin contrasts with the background";
   std::sort(strips.begin(), strips.end(),
             [](const Strip& a, const Strip& b) { return a.score > b.score; });
-  Strip strip = strips.front();
+  s->strip = strips.front();
   for (size_t k = 1; k < strips.size(); ++k) {
-    if (strips[k].polarity != strip.polarity && strips[k].score > 0.5 * strip.score) {
-      r.warnings.push_back("a " + std::string(strip.polarity > 0 ? "dark" : "light") +
-                           " band almost as prominent as the strip was ignored");
+    if (strips[k].polarity != s->strip.polarity && strips[k].score > 0.5 * s->strip.score) {
+      s->summary.warnings.push_back({"other_polarity_band_ignored",
+                                     "a " + std::string(s->strip.polarity > 0 ? "dark" : "light") +
+                                         " band almost as prominent as the strip was ignored"});
       break;
     }
   }
-  const cv::Mat& chosen_hat = strip.polarity > 0 ? light : dark;
-  std::vector<Block> own_blocks = PrepareStrip(chosen_hat, &strip);
-  // A second strip, as long and clear as this one, apart from it: the photo shows two
-  // cantilevers and nothing says which one to measure, unless --edge-px does.
-  if (const std::optional<size_t> k = SecondStrip(strips, strip)) {
-    const auto ends = [&](const cv::Mat& mask) {
-      const Sweep e = DoubleSweep(mask);
-      const Vec2 a = full(Vec2(e.a.x, e.a.y)), b = full(Vec2(e.b.x, e.b.y));
-      return "(" + Fmt(a.x(), 0) + "," + Fmt(a.y(), 0) + ")-(" + Fmt(b.x(), 0) + "," +
-             Fmt(b.y(), 0) + ") px";
-    };
-    if (Vec2 at; OverhangsOnBothSides(small, strip, strips[*k], &at)) {
-      return fail(DrapedMessage(full(at)));
-    }
-    if (!options.edge_px) {
-      return fail("two strips in the photo, one from " + ends(strip.mask) + ", the other from " +
-                  ends(strips[*k].mask) +
-                  "; photograph one at a time, or give --edge-px X,Y at the held end of the "
-                  "one to measure");
-    }
-    const cv::Point e(static_cast<int>(std::lround((options.edge_px->x() + 0.5) * scale - 0.5)),
-                      static_cast<int>(std::lround((options.edge_px->y() + 0.5) * scale - 0.5)));
-    if (DistanceToMask(strips[*k].mask, e) < DistanceToMask(strip.mask, e)) {
-      strip = strips[*k];
-      own_blocks = PrepareStrip(strip.polarity > 0 ? light : dark, &strip);
-    }
-  }
-  r.polarity = strip.polarity > 0 ? "light" : "dark";
-  const Sweep sweep = DoubleSweep(strip.mask);
-  const double t_small = std::max(1.0, cv::countNonZero(strip.mask) / std::max(1.0, sweep.length));
-  cv::Mat strip_zone;
-  cv::dilate(strip.mask, strip_zone,
-             cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * static_cast<int>(t_small) + 3,
-                                                           2 * static_cast<int>(t_small) + 3}));
-  for (const Block& b : own_blocks) strip_zone |= b.mask;
-  std::vector<Block> blocks = extract_internal::FindBlocks(small, strip_zone, t_small);
-  for (Block& b : own_blocks) blocks.push_back(std::move(b));
+  s->own_blocks = PrepareStrip(s->strip.polarity > 0 ? s->light : s->dark, &s->strip);
+  return ResolveSecondStrip(s, strips);
+}
 
-  // ---- 2. Which end is held? The held end leaves the left or right border, or a block;
-  // a free end that touches any border is a tip cut off by the image.
-  const double end_radius = std::max(2.0, 1.5 * t_small);
-  const int at_a = BordersNear(strip.mask, sweep.dist_a, sweep.box, end_radius);
-  const int at_b = BordersNear(strip.mask, sweep.dist_b, sweep.box, end_radius);
+void FindStripBlocks(ExtractState* s) {
+  s->summary.polarity = s->strip.polarity > 0 ? "light" : "dark";
+  s->sweep = DoubleSweep(s->strip.mask);
+  s->t_small = std::max(1.0, cv::countNonZero(s->strip.mask) / std::max(1.0, s->sweep.length));
+  const int side = 2 * static_cast<int>(s->t_small) + 3;
+  cv::dilate(s->strip.mask, s->strip_zone,
+             cv::getStructuringElement(cv::MORPH_ELLIPSE, {side, side}));
+  for (const Block& b : s->own_blocks) s->strip_zone |= b.mask;
+  s->blocks = FindBlocks(s->small, s->strip_zone, s->t_small);
+  for (Block& b : s->own_blocks) s->blocks.push_back(std::move(b));
+  s->own_blocks.clear();
+}
+
+StageFailure FindHeldEnd(ExtractState* s) {
+  // The held end leaves the left or right border, or a block; a free end that touches any
+  // border is a tip cut off by the image.
+  const Sweep& sweep = s->sweep;
+  s->end_radius = std::max(2.0, 1.5 * s->t_small);
+  const int at_a = BordersNear(s->strip.mask, sweep.dist_a, sweep.box, s->end_radius);
+  const int at_b = BordersNear(s->strip.mask, sweep.dist_b, sweep.box, s->end_radius);
   const int sides = kLeft | kRight;
-  bool root_is_a;
-  std::string root_how;
-  if (options.edge_px) {
+  if (s->options.edge_px) {
     // The held end is the one at a side border if only one is (a free tip there would be cut
     // off), else the one nearer the edge given. Not simply the nearer one: a short strip
     // lying far along a platform from the border has its tip nearer the platform's corner
     // (pabst-fig8_L040mm.jpg was refused as a tip cut off by the border).
-    const Vec2 e = *options.edge_px;
+    const Vec2 e = *s->options.edge_px;
     if (static_cast<bool>(at_a & sides) != static_cast<bool>(at_b & sides)) {
-      root_is_a = (at_a & sides) != 0;
+      s->root_is_a = (at_a & sides) != 0;
     } else {
-      root_is_a = (full(Vec2(sweep.a.x, sweep.a.y)) - e).norm() <=
-                  (full(Vec2(sweep.b.x, sweep.b.y)) - e).norm();
+      s->root_is_a = (FullFromSmall(*s, Vec2(sweep.a.x, sweep.a.y)) - e).norm() <=
+                     (FullFromSmall(*s, Vec2(sweep.b.x, sweep.b.y)) - e).norm();
     }
-    root_how = "edge";
+    s->root_how = "edge";
   } else if ((at_a & sides) && !(at_b & sides)) {
-    root_is_a = true;
-    root_how = "border";
+    s->root_is_a = true;
+    s->root_how = "border";
   } else if ((at_b & sides) && !(at_a & sides)) {
-    root_is_a = false;
-    root_how = "border";
+    s->root_is_a = false;
+    s->root_how = "border";
   } else if ((at_a & sides) && (at_b & sides)) {
-    return fail("the free tip is cut off by the image border (the strip crosses the whole photo)" +
-                std::string(kWholeStripInView));
+    return "the free tip is cut off by the image border (the strip crosses the whole photo)" +
+           std::string(kWholeStripInView);
   } else if (at_a != kNoBorder || at_b != kNoBorder) {
-    root_is_a = at_a == kNoBorder;  // the end at the top/bottom border is the cut tip
-    root_how = "block";
+    s->root_is_a = at_a == kNoBorder;  // the end at the top/bottom border is the cut tip
+    s->root_how = "block";
   } else {
-    const double da = DistanceToBlocks(blocks, sweep.a), db = DistanceToBlocks(blocks, sweep.b);
-    if (std::min(da, db) <= 3.0 * t_small + 5.0) {
-      root_is_a = da <= db;
-      root_how = "block";
+    const double da = DistanceToBlocks(s->blocks, sweep.a);
+    const double db = DistanceToBlocks(s->blocks, sweep.b);
+    if (std::min(da, db) <= 3.0 * s->t_small + 5.0) {
+      s->root_is_a = da <= db;
+      s->root_how = "block";
     } else {
       // Nothing holds either end in view: the held end of a hanging strip is the higher one.
-      root_is_a = sweep.a.y <= sweep.b.y;
-      root_how = "guess";
-      r.warnings.push_back(
-          "no clamp, platform or border holds the strip; took its higher end as the held end");
+      s->root_is_a = sweep.a.y <= sweep.b.y;
+      s->root_how = "guess";
+      s->summary.warnings.push_back(
+          {"held_end_guessed",
+           "no clamp, platform or border holds the strip; took its higher end as the held end"});
     }
   }
-  const cv::Point root_end = root_is_a ? sweep.a : sweep.b;
-  const int root_borders = root_is_a ? at_a : at_b;
-  const int tip_borders = root_is_a ? at_b : at_a;
+  s->root_borders = s->root_is_a ? at_a : at_b;
+  const int tip_borders = s->root_is_a ? at_b : at_a;
   if (tip_borders != kNoBorder) {
-    return fail(std::string("the free tip is cut off by the image border (") +
-                BorderName(tip_borders) + ")" + kWholeStripInView);
+    return std::string("the free tip is cut off by the image border (") + BorderName(tip_borders) +
+           ")" + kWholeStripInView;
   }
+  return std::nullopt;
+}
 
-  // ---- 3. Coarse centre line from the held end, at full resolution.
+StageFailure TraceCoarseLine(ExtractState* s) {
+  const cv::Mat& small = s->small;
+  const bool at_side = s->root_how == "border" && (s->root_borders & (kLeft | kRight));
   std::vector<cv::Point> seeds;
-  if (root_how == "border" && (root_borders & sides)) {
-    const int x_border = (root_borders & kLeft) ? 0 : small.cols - 1;
+  if (at_side) {
+    const int x_border = (s->root_borders & kLeft) ? 0 : small.cols - 1;
     for (int y = 0; y < small.rows; ++y) {
-      if (strip.mask.at<uchar>(y, x_border) &&
-          (root_is_a ? sweep.DistA(x_border, y) : sweep.DistB(x_border, y)) <=
-              end_radius + 2.0 * t_small) {
+      if (s->strip.mask.at<uchar>(y, x_border) &&
+          (s->root_is_a ? s->sweep.DistA(x_border, y) : s->sweep.DistB(x_border, y)) <=
+              s->end_radius + 2.0 * s->t_small) {
         seeds.emplace_back(x_border, y);
       }
     }
   }
-  if (seeds.empty()) seeds.push_back(root_end);
+  if (seeds.empty()) seeds.push_back(s->root_is_a ? s->sweep.a : s->sweep.b);
   std::vector<double> widths_small;
-  std::vector<Vec2> coarse = LevelSetCentreline(strip.mask, seeds, &widths_small);
-  if (coarse.size() < 5) return fail("no strip found: the detected band is too short");
-  if (Vec2 peak; extract_internal::DrapedOverBlock(coarse, blocks, t_small, &peak)) {
-    const Vec2 p = full(peak);
-    return fail(DrapedMessage(p));
+  std::vector<Vec2> coarse = LevelSetCentreline(s->strip.mask, seeds, &widths_small);
+  if (coarse.size() < 5) return "no strip found: the detected band is too short";
+  if (Vec2 peak; DrapedOverBlock(coarse, s->blocks, s->t_small, &peak)) {
+    return DrapedMessage(FullFromSmall(*s, peak));
   }
-  for (Vec2& p : coarse) p = full(p);
-  coarse = SmoothPolyline(coarse, std::max(2.0, 0.5 * t_small));
+  for (Vec2& p : coarse) p = FullFromSmall(*s, p);
+  coarse = SmoothPolyline(coarse, std::max(2.0, 0.5 * s->t_small));
   coarse = ResampleByArc(coarse, 1.0);
-  const double t_full = t_small / scale;
-  CutAtSharpTurn(&coarse, std::max(10.0, 2.0 * t_full), /*check_growth=*/false,
+  s->t_full = s->t_small / s->scale;
+  CutAtSharpTurn(&coarse, std::max(10.0, 2.0 * s->t_full), /*check_growth=*/false,
                  /*from_fraction=*/0.6);
-
-  int direction;
-  if (root_how == "border" && (root_borders & sides)) {
-    direction = (root_borders & kLeft) ? +1 : -1;
+  if (at_side) {
+    s->direction = (s->root_borders & kLeft) ? +1 : -1;
   } else {
-    direction = coarse.back().x() >= coarse.front().x() ? +1 : -1;
+    s->direction = coarse.back().x() >= coarse.front().x() ? +1 : -1;
   }
-  r.direction = direction > 0 ? "right" : "left";
+  s->coarse = std::move(coarse);
+  s->summary.direction = s->direction > 0 ? "right" : "left";
+  return std::nullopt;
+}
 
-  // ---- 4. Platform or clamp?
-  if (past_cap("after the strip's centre line was found")) return r;
+namespace {
+
+// The platform under the held end: the block nearest to the held end of the coarse line (a
+// strip lying on a platform that contrasts with it starts on the platform, else at its
+// corner), or one found by its front face. Sets *why to why none was found.
+PlatformFit FindPlatform(ExtractState* s, std::string* why) {
+  const cv::Mat& small = s->small;
+  const Vec2& front = s->coarse.front();
+  const cv::Point held(std::clamp(static_cast<int>(std::lround((front.x() + 0.5) * s->scale - 0.5)),
+                                  0, small.cols - 1),
+                       std::clamp(static_cast<int>(std::lround((front.y() + 0.5) * s->scale - 0.5)),
+                                  0, small.rows - 1));
+  double best_d = 1e300;
+  int best_k = -1;
+  for (size_t k = 0; k < s->blocks.size(); ++k) {
+    const double d = DistanceToBlocks({s->blocks[k]}, held);
+    if (d < best_d) {
+      best_d = d;
+      best_k = static_cast<int>(k);
+    }
+  }
   PlatformFit platform;
-  std::string platform_why = "no block under the strip's held end";
-  if (options.rig != RigKind::kClamp) {
-    // The platform is the block nearest to the held end of the line (a strip lying on a
-    // platform that contrasts with it starts on the platform, else at its corner).
-    const cv::Point held(
-        std::clamp(static_cast<int>(std::lround((coarse.front().x() + 0.5) * scale - 0.5)), 0,
-                   small.cols - 1),
-        std::clamp(static_cast<int>(std::lround((coarse.front().y() + 0.5) * scale - 0.5)), 0,
-                   small.rows - 1));
-    double best_d = 1e300;
-    int best_k = -1;
-    for (size_t k = 0; k < blocks.size(); ++k) {
-      const double d = DistanceToBlocks({blocks[k]}, held);
-      if (d < best_d) {
-        best_d = d;
-        best_k = static_cast<int>(k);
+  if (best_k >= 0 && best_d <= 3.0 * s->t_small + 5.0) {
+    platform =
+        FitPlatform(s->gray, s->blocks[best_k], s->scale, s->direction, s->coarse, s->t_full);
+    if (!platform.found) *why = platform.why_not;
+  } else if (s->root_how == "border" || s->root_how == "guess") {
+    // No region stands out under the held end, and the strip comes in from the border (a
+    // clamp out of view?) or from nowhere: a platform whose faces the light makes as light
+    // as the background in places, or whose top merges with the strip, still shows its
+    // front face as a long straight edge.
+    if (auto block = FindBlockByFrontEdge(small, s->strip_zone, s->coarse, s->scale, s->direction,
+                                          s->t_small)) {
+      platform = FitPlatform(s->gray, *block, s->scale, s->direction, s->coarse, s->t_full);
+      if (!platform.found) *why = platform.why_not;
+      s->blocks.push_back(std::move(*block));
+      if (platform.found && s->root_how == "guess") {
+        std::erase_if(s->summary.warnings,
+                      [](const Note& w) { return w.code == "held_end_guessed"; });
       }
     }
-    if (best_k >= 0 && best_d <= 3.0 * t_small + 5.0) {
-      platform =
-          extract_internal::FitPlatform(gray, blocks[best_k], scale, direction, coarse, t_full);
-      if (!platform.found) platform_why = platform.why_not;
-    } else if (root_how == "border" || root_how == "guess") {
-      // No region stands out under the held end, and the strip comes in from the border (a
-      // clamp out of view?) or from nowhere: a platform whose faces the light makes as light
-      // as the background in places, or whose top merges with the strip, still shows its
-      // front face as a long straight edge.
-      if (auto block = extract_internal::FindBlockByFrontEdge(small, strip_zone, coarse, scale,
-                                                              direction, t_small)) {
-        platform = extract_internal::FitPlatform(gray, *block, scale, direction, coarse, t_full);
-        if (!platform.found) platform_why = platform.why_not;
-        blocks.push_back(std::move(*block));
-        if (platform.found && root_how == "guess") {
-          std::erase_if(r.warnings, [](const std::string& w) {
-            return w.starts_with("no clamp, platform or border holds the strip");
-          });
-        }
+  }
+  return platform;
+}
+
+// The blocks' outlines at full resolution, for the overlay.
+void RecordBlockOutlines(ExtractState* s) {
+  for (const Block& b : s->blocks) {
+    std::vector<std::vector<cv::Point>> contours;
+    cv::findContours(b.mask.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+    for (auto& contour : contours) {
+      for (cv::Point& q : contour) {
+        const Vec2 f = FullFromSmall(*s, Vec2(q.x, q.y));
+        q = cv::Point(static_cast<int>(std::lround(f.x())), static_cast<int>(std::lround(f.y())));
       }
+      s->summary.blocks_px.push_back(std::move(contour));
     }
-    if (options.rig == RigKind::kPlatform && !platform.found) {
-      return fail("platform not found: " + platform_why);
+  }
+}
+
+}  // namespace
+
+StageFailure FindRig(ExtractState* s) {
+  if (s->options.rig != RigKind::kClamp) {
+    std::string why = "no block under the strip's held end";
+    s->platform = FindPlatform(s, &why);
+    if (s->options.rig == RigKind::kPlatform && !s->platform.found) {
+      return "platform not found: " + why;
     }
     // The strip lies on a block that could not be measured as a platform. Taken for a clamp
     // instead, the origin would be put where the strip leaves the image border (extrapolated)
     // or where its held end lies on the block, either far behind the platform's edge, and the
     // profile would be wrong with no sign of it: refuse.
-    if (!platform.found && platform.under_strip &&
-        (root_how == "border" || root_how == "block")) {
-      return fail("the strip lies on a block that looks like a platform, but " + platform_why +
-                  "; give the platform's edge with --edge-px X,Y (and --level-deg if the camera "
-                  "is rolled), or --rig-type clamp if the block is a clamp");
+    if (!s->platform.found && s->platform.under_strip &&
+        (s->root_how == "border" || s->root_how == "block")) {
+      return "the strip lies on a block that looks like a platform, but " + why +
+             "; give the platform's edge with --edge-px X,Y (and --level-deg if the camera is "
+             "rolled), or --rig-type clamp if the block is a clamp";
     }
   }
-  for (const Block& b : blocks) {
-    std::vector<std::vector<cv::Point>> contours;
-    cv::findContours(b.mask.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
-    for (auto& contour : contours) {
-      for (cv::Point& q : contour) {
-        const Vec2 f = full(Vec2(q.x, q.y));
-        q = cv::Point(static_cast<int>(std::lround(f.x())), static_cast<int>(std::lround(f.y())));
-      }
-      r.blocks_px.push_back(std::move(contour));
-    }
-  }
+  RecordBlockOutlines(s);
+  return std::nullopt;
+}
 
-  // ---- 5. Cross-sections at full resolution, along the strip.
-  const double root_ext = root_how == "border" ? 3.0 * t_full + 10.0 : 2.0 * t_full + 10.0;
+namespace {
+
+std::string TraceName(TraceLine line) {
+  return line == TraceLine::kUpper ? "upper" : line == TraceLine::kLower ? "lower" : "mid";
+}
+
+// The traced line must be measured along enough of the strip: its gaps are bridged by
+// interpolation, but a line measured nowhere (the upper edge of a very thick strip) has
+// nothing to bridge, and one measured on a few sections would follow the guide, not the
+// strip. A quarter of the stations at least; on the real photos a third of the sections
+// lose their upper edge to fibres, which leaves two thirds.
+StageFailure CheckTraceMeasured(const ExtractState& s) {
+  const auto usable = [&](TraceLine line) {
+    int n = 0;
+    for (int i = s.measured_from; i <= s.last; ++i) n += s.set.s[i].Usable(line);
+    return n;
+  };
+  const int stations = s.last - s.measured_from + 1;
+  const auto enough = [&](int n) { return n >= 10 && 4 * n >= stations; };
+  const TraceLine trace = s.options.trace;
+  const int have = usable(trace);
+  if (enough(have)) return std::nullopt;
+  const auto what = [&](TraceLine line) {
+    return line == TraceLine::kMid ? std::string("mid-line (both edges)")
+                                   : TraceName(line) + " edge";
+  };
+  std::string m = "the strip's " + what(trace) + " is measured on only " + std::to_string(have) +
+                  " of its " + std::to_string(stations) +
+                  " cross-sections (a quarter needed: a very thick strip, a faint or frayed "
+                  "edge?)";
+  std::string others;
+  for (TraceLine line : {TraceLine::kLower, TraceLine::kUpper, TraceLine::kMid}) {
+    if (line == trace) continue;
+    const int n = usable(line);
+    if (enough(n)) {
+      others += (others.empty() ? "" : ", ") + ("--trace " + TraceName(line)) + " (" +
+                std::to_string(n) + ")";
+    }
+  }
+  if (!others.empty()) m += "; measured enough: " + others;
+  return m;
+}
+
+}  // namespace
+
+StageFailure MeasureSections(ExtractState* s) {
+  const double t_full = s->t_full;
+  const double root_ext = s->root_how == "border" ? 3.0 * t_full + 10.0 : 2.0 * t_full + 10.0;
   // The first pass runs on the intermediate level if the strip is at least 4 px thick there.
-  const int first_f = mid_factor > 1 && t_full >= 4.0 * mid_factor ? mid_factor : 1;
+  const int first_f = s->mid_factor > 1 && t_full >= 4.0 * s->mid_factor ? s->mid_factor : 1;
   bool tracked;
-  SectionSet set = TrackStrip(gray, mid, first_f, coarse, direction, strip.polarity, t_full,
-                              root_ext, options.edge_px, &tracked);
+  s->set = TrackStrip(s->gray, s->mid, first_f, s->coarse, s->direction, s->strip.polarity, t_full,
+                      root_ext, s->options.edge_px, &tracked);
   if (!tracked) {
-    set = TrackStrip(gray, mid, 1, coarse, direction, strip.polarity, t_full, root_ext,
-                     options.edge_px, &tracked);
+    s->set = TrackStrip(s->gray, s->mid, 1, s->coarse, s->direction, s->strip.polarity, t_full,
+                        root_ext, s->options.edge_px, &tracked);
   }
-  double w_end = 0.0;
-  int measured_from = 0;
-  const std::pair<int, int> run = TrimmedRun(set, options.trace, &w_end, &measured_from);
-  if (run.second - run.first < 10) return fail("no strip found: its edges could not be measured");
-  // The traced line must be measured along enough of the strip: its gaps are bridged by
-  // interpolation, but a line measured nowhere (the upper edge of a very thick strip) has
-  // nothing to bridge, and one measured on a few sections would follow the guide, not the
-  // strip. A quarter of the stations at least; on the real photos a third of the sections
-  // lose their upper edge to fibres, which leaves two thirds.
-  {
-    const auto usable = [&](TraceLine line) {
-      int n = 0;
-      for (int i = measured_from; i <= run.second; ++i) n += set.s[i].Usable(line);
-      return n;
-    };
-    const int stations = run.second - measured_from + 1;
-    const auto enough = [&](int n) { return n >= 10 && 4 * n >= stations; };
-    const int have = usable(options.trace);
-    if (!enough(have)) {
-      const auto name = [](TraceLine line) {
-        return std::string(line == TraceLine::kUpper   ? "upper"
-                           : line == TraceLine::kLower ? "lower"
-                                                       : "mid");
-      };
-      const auto what = [&](TraceLine line) {
-        return line == TraceLine::kMid ? std::string("mid-line (both edges)")
-                                       : name(line) + " edge";
-      };
-      std::string m = "the strip's " + what(options.trace) + " is measured on only " +
-                      std::to_string(have) + " of its " + std::to_string(stations) +
-                      " cross-sections (a quarter needed: a very thick strip, a faint or frayed "
-                      "edge?)";
-      std::string others;
-      for (TraceLine line : {TraceLine::kLower, TraceLine::kUpper, TraceLine::kMid}) {
-        if (line == options.trace) continue;
-        const int n = usable(line);
-        if (enough(n)) {
-          others += (others.empty() ? "" : ", ") + ("--trace " + name(line)) + " (" +
-                    std::to_string(n) + ")";
-        }
-      }
-      if (!others.empty()) m += "; measured enough: " + others;
-      return fail(m);
-    }
-  }
-  r.contrast = set.contrast;
-  r.noise = set.noise;
-  r.width_px = set.width;
-  int first = run.first, last = run.second;
+  const std::pair<int, int> run =
+      TrimmedRun(s->set, s->options.trace, &s->w_end, &s->measured_from);
+  s->first = run.first;
+  s->last = run.second;
+  if (run.second - run.first < 10) return "no strip found: its edges could not be measured";
+  if (StageFailure why = CheckTraceMeasured(*s)) return why;
+  s->summary.contrast = s->set.contrast;
+  s->summary.noise = s->set.noise;
+  s->summary.width_px = s->set.width;
+  return std::nullopt;
+}
 
-  if (past_cap("after the cross-sections were measured")) return r;
-  // ---- 6. The tip. Sections within ¾ of a width of the end straddle the end face, so the
-  // line is continued straight from the stretch before them, to where the contrast along the
-  // strip's middle falls to half (a frayed end was already trimmed to where sections collapse
-  // to fibre width).
-  const int cut = std::min(static_cast<int>(0.75 * w_end), (last - first) / 4);
-  const int end_i = last - cut;
+void TraceMeasuredLine(ExtractState* s) {
+  // Sections within ¾ of a width of the end straddle the end face: the line stops before them
+  // (FindTipEnd continues it).
+  const SectionSet& set = s->set;
+  const int first = s->first, last = s->last;
+  const int cut = std::min(static_cast<int>(0.75 * s->w_end), (last - first) / 4);
+  s->end_i = last - cut;
   // The traced offsets: a running median over half a core width removes what the outlier test
   // let through (a fibre crossing a few sections), a Gaussian of half the profile's sample
   // spacing (at least 2 px) the remaining noise before resampling.
-  std::vector<double> offsets = FilledOffsets(set, first, end_i, options.trace);
+  std::vector<double> offsets = FilledOffsets(set, first, s->end_i, s->options.trace);
   {
     std::vector<double> cores;
-    for (int i = first; i <= end_i; ++i)
+    for (int i = first; i <= s->end_i; ++i)
       if (set.s[i].present) cores.push_back(set.s[i].solid);
     const int reach = std::max(2, static_cast<int>(0.5 * Median(cores)));
     offsets = RunningQuantile(offsets, std::vector<char>(offsets.size(), 1), reach);
   }
-  const std::vector<double> mids = FilledOffsets(set, first, end_i, TraceLine::kMid);
-  std::vector<Vec2> trace;
-  for (int i = first; i <= end_i; ++i) trace.push_back(set.p[i] + offsets[i - first] * set.n[i]);
-  const double step_px = options.step_mm / rig.MmPerPxAt(trace.front());
+  std::vector<Vec2>& trace = s->trace;
+  trace.clear();
+  for (int i = first; i <= s->end_i; ++i) trace.push_back(set.p[i] + offsets[i - first] * set.n[i]);
+  const double step_px = s->options.step_mm / s->rig.MmPerPxAt(trace.front());
   trace = SmoothPolyline(trace, std::clamp(0.5 * step_px, 2.0, 10.0));
   for (int i = first; i <= last; ++i) {
-    if (set.s[i].up_ok) r.upper_px.push_back(set.p[i] + set.s[i].n_up * set.n[i]);
-    if (set.s[i].lo_ok) r.lower_px.push_back(set.p[i] + set.s[i].n_lo * set.n[i]);
+    if (set.s[i].up_ok) s->summary.upper_px.push_back(set.p[i] + set.s[i].n_up * set.n[i]);
+    if (set.s[i].lo_ok) s->summary.lower_px.push_back(set.p[i] + set.s[i].n_lo * set.n[i]);
   }
-  {
-    const int k = std::min<int>(static_cast<int>(trace.size()) - 1,
-                                std::max(10, static_cast<int>(2.0 * w_end)));
-    const Vec2 tangent = (trace.back() - trace[trace.size() - 1 - k]).normalized();
-    const Vec2 normal = direction * Vec2(tangent.y(), -tangent.x());
-    const Vec2 centre = set.p[end_i] + mids.back() * set.n[end_i];
-    TipStatus status;
-    std::vector<double> peaks;
-    for (int i = end_i; i >= first && peaks.size() < 20; --i)
-      if (set.s[i].valid) peaks.push_back(set.s[i].peak);
-    const double peak = peaks.empty() ? set.contrast : Median(peaks);
-    const double t_tip = FindTip(gray, centre, tangent, normal, w_end, set.s[end_i].bg, peak,
-                                 strip.polarity, &status);
-    if (status == TipStatus::kNoEnd) {
-      r.warnings.push_back(
-          "the tip's end is unclear (the strip's contrast does not fall off); took the last "
-          "measured section");
-    }
-    const Vec2 end = trace.back();
-    while (trace.size() > 2 && (trace.back() - end).dot(tangent) > t_tip) trace.pop_back();
-    const Vec2 tip = end + t_tip * tangent;
-    trace.push_back(tip);
-    r.tip_px = tip;
-    const double clearance =
-        std::min({tip.x() + 0.5, W - 0.5 - tip.x(), tip.y() + 0.5, H - 0.5 - tip.y()});
-    if (status == TipStatus::kLeftImage || clearance < 0.5 * w_end + 2.0) {
-      r.trace_px = trace;
-      return fail("the free tip is cut off by the image border (or lies within " +
-                  Fmt(0.5 * w_end + 2.0, 0) + " px of it)" + kWholeStripInView);
-    }
-  }
+}
 
-  // ---- 7. Origin and horizontal.
-  if (options.edge_px) {
-    // The edge is where the strip leaves its support: on the traced line (a clamp) or a
-    // thickness under it (a platform's corner), on the coarse centre line (which also runs
-    // over the part lying on a platform, back to where the strip was first seen), or on the
-    // traced line's straight continuation back from where the sections start. Farther than a
-    // few strip widths from all of these it is a mistake (reduced-image pixels, x and y
-    // swapped, another photo's edge) that would move the whole profile: refused.
-    const Vec2 e = *options.edge_px;
-    // Distance from e to a polyline [px]; *arc: the arc length from its start to the nearest
-    // point [px].
-    const auto distance_to = [&](const std::vector<Vec2>& line, double* arc) {
-      double best = (e - line.front()).norm(), run = 0.0;
-      *arc = 0.0;
-      for (size_t k = 1; k < line.size(); ++k) {
-        const Vec2 d = line[k] - line[k - 1];
-        const double f =
-            std::clamp((e - line[k - 1]).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
-        const double miss = (e - line[k - 1] - f * d).norm();
-        if (miss < best) best = miss, *arc = run + f * d.norm();
-        run += d.norm();
-      }
-      return best;
-    };
-    double along = 0.0, unused = 0.0;
-    double miss = std::min(distance_to(trace, &along), distance_to(coarse, &unused));
-    const Vec2 back = (trace.front() - trace[std::min<size_t>(10, trace.size() - 1)]).normalized();
-    const double behind = (e - trace.front()).dot(back);
-    if (behind > 0.0) miss = std::min(miss, (e - trace.front() - behind * back).norm());
-    const double limit = kEdgeFarWidths * set.width + kEdgeFarPx;
-    if (!(miss <= limit)) {
-      throw InputError("--edge-px " + Fmt(e.x(), 1) + "," + Fmt(e.y(), 1) + " lies " +
-                       Fmt(miss, 0) + " px from the strip in " + source + " (more than " +
-                       Fmt(kEdgeFarWidths, 0) + " strip widths + " + Fmt(kEdgeFarPx, 0) +
-                       " px = " + Fmt(limit, 0) + " px; its held end is at " +
-                       Fmt(trace.front().x(), 0) + "," + Fmt(trace.front().y(), 0) +
-                       "): the edge is where the strip leaves the platform or clamp, in "
-                       "full-resolution pixels (x right, y down)");
-    }
-    // An edge well along the measured strip cuts off what lies before it: right if the strip
-    // lies on a platform found in the photo up to there (straight: the shipped interlining
-    // photos show 62 mm of it on the platform), wrong if that part already bends (an edge 100 mm
-    // along a 251 mm strip hanging from a clamp gave L = 151 mm with no word). Bending: the part's
-    // sagitta from its chord over a strip width and 2 % of the part (at least 2 px): 3.9 px over
-    // 410 px on the interlining's platform, 42 px over 900 px on that clamp photo.
-    double sagitta = 0.0;
-    if (along > limit) {
-      double run = 0.0;
-      size_t end = 1;
-      while (end + 1 < trace.size() && run < along)
-        run += (trace[end] - trace[end - 1]).norm(), ++end;
-      const Vec2 a = trace.front(), chord = trace[end - 1] - a;
-      const double n = chord.norm();
-      for (size_t k = 0; k < end && n > 0.0; ++k) {
-        const Vec2 d = trace[k] - a;
-        sagitta = std::max(sagitta, std::abs(d.x() * chord.y() - d.y() * chord.x()) / n);
-      }
-    }
-    if (along > limit && (!platform.found || sagitta > std::max({2.0, set.width, 0.02 * along}))) {
-      r.warnings.push_back("--edge-px lies " + Fmt(along * rig.MmPerPxAt(e), 1) + " mm (" +
-                           Fmt(along, 0) + " px) along the strip from its held end at " +
-                           Fmt(trace.front().x(), 0) + "," + Fmt(trace.front().y(), 0) +
-                           ": the profile leaves that part out; the edge is where the strip "
-                           "leaves the platform or clamp");
+StageFailure FindTipEnd(ExtractState* s) {
+  // The line is continued straight from the stretch before the end face, to where the
+  // contrast along the strip's middle falls to half (a frayed end was already trimmed to where
+  // sections collapse to fibre width).
+  const SectionSet& set = s->set;
+  std::vector<Vec2>& trace = s->trace;
+  const int end_i = s->end_i;
+  const std::vector<double> mids = FilledOffsets(set, s->first, end_i, TraceLine::kMid);
+  const int k = std::min<int>(static_cast<int>(trace.size()) - 1,
+                              std::max(10, static_cast<int>(2.0 * s->w_end)));
+  const Vec2 tangent = (trace.back() - trace[trace.size() - 1 - k]).normalized();
+  const Vec2 normal = s->direction * Vec2(tangent.y(), -tangent.x());
+  const Vec2 centre = set.p[end_i] + mids.back() * set.n[end_i];
+  TipStatus status;
+  std::vector<double> peaks;
+  for (int i = end_i; i >= s->first && peaks.size() < 20; --i)
+    if (set.s[i].valid) peaks.push_back(set.s[i].peak);
+  const double peak = peaks.empty() ? set.contrast : Median(peaks);
+  const double t_tip = FindTip(s->gray, centre, tangent, normal, s->w_end, set.s[end_i].bg, peak,
+                               s->strip.polarity, &status);
+  if (status == TipStatus::kNoEnd) {
+    s->summary.warnings.push_back(
+        {"tip_end_unclear",
+         "the tip's end is unclear (the strip's contrast does not fall off); took the last "
+         "measured section"});
+  }
+  const Vec2 end = trace.back();
+  while (trace.size() > 2 && (trace.back() - end).dot(tangent) > t_tip) trace.pop_back();
+  const Vec2 tip = end + t_tip * tangent;
+  trace.push_back(tip);
+  s->summary.tip_px = tip;
+  const int W = s->gray.cols, H = s->gray.rows;
+  const double clearance =
+      std::min({tip.x() + 0.5, W - 0.5 - tip.x(), tip.y() + 0.5, H - 0.5 - tip.y()});
+  if (status == TipStatus::kLeftImage || clearance < 0.5 * s->w_end + 2.0) {
+    s->summary.trace_px = trace;
+    return "the free tip is cut off by the image border (or lies within " +
+           Fmt(0.5 * s->w_end + 2.0, 0) + " px of it)" + kWholeStripInView;
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+// Distance from e to a polyline [px]; *arc: the arc length from its start to the nearest
+// point [px].
+double DistanceToPolyline(const Vec2& e, const std::vector<Vec2>& line, double* arc) {
+  double best = (e - line.front()).norm(), run = 0.0;
+  *arc = 0.0;
+  for (size_t k = 1; k < line.size(); ++k) {
+    const Vec2 d = line[k] - line[k - 1];
+    const double f =
+        std::clamp((e - line[k - 1]).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
+    const double miss = (e - line[k - 1] - f * d).norm();
+    if (miss < best) best = miss, *arc = run + f * d.norm();
+    run += d.norm();
+  }
+  return best;
+}
+
+// The largest distance of `line`'s points up to arc length `along` from the chord over them
+// [px].
+double SagittaUpTo(const std::vector<Vec2>& line, double along) {
+  double sagitta = 0.0, run = 0.0;
+  size_t end = 1;
+  while (end + 1 < line.size() && run < along) run += (line[end] - line[end - 1]).norm(), ++end;
+  const Vec2 a = line.front(), chord = line[end - 1] - a;
+  const double n = chord.norm();
+  for (size_t k = 0; k < end && n > 0.0; ++k) {
+    const Vec2 d = line[k] - a;
+    sagitta = std::max(sagitta, std::abs(d.x() * chord.y() - d.y() * chord.x()) / n);
+  }
+  return sagitta;
+}
+
+}  // namespace
+
+void CheckEdgeGiven(const ExtractState& s, std::vector<Note>* warnings) {
+  if (!s.options.edge_px) return;
+  // The edge is where the strip leaves its support: on the traced line (a clamp) or a
+  // thickness under it (a platform's corner), on the coarse centre line (which also runs
+  // over the part lying on a platform, back to where the strip was first seen), or on the
+  // traced line's straight continuation back from where the sections start. Farther than a
+  // few strip widths from all of these it is a mistake (reduced-image pixels, x and y
+  // swapped, another photo's edge) that would move the whole profile: refused.
+  const Vec2 e = *s.options.edge_px;
+  const std::vector<Vec2>& trace = s.trace;
+  double along = 0.0, unused = 0.0;
+  double miss =
+      std::min(DistanceToPolyline(e, trace, &along), DistanceToPolyline(e, s.coarse, &unused));
+  const Vec2 back = (trace.front() - trace[std::min<size_t>(10, trace.size() - 1)]).normalized();
+  const double behind = (e - trace.front()).dot(back);
+  if (behind > 0.0) miss = std::min(miss, (e - trace.front() - behind * back).norm());
+  const double limit = kEdgeFarWidths * s.set.width + kEdgeFarPx;
+  if (!(miss <= limit)) {
+    throw InputError("--edge-px " + Fmt(e.x(), 1) + "," + Fmt(e.y(), 1) + " lies " + Fmt(miss, 0) +
+                     " px from the strip in " + s.summary.source + " (more than " +
+                     Fmt(kEdgeFarWidths, 0) + " strip widths + " + Fmt(kEdgeFarPx, 0) +
+                     " px = " + Fmt(limit, 0) + " px; its held end is at " +
+                     Fmt(trace.front().x(), 0) + "," + Fmt(trace.front().y(), 0) +
+                     "): the edge is where the strip leaves the platform or clamp, in "
+                     "full-resolution pixels (x right, y down)");
+  }
+  // An edge well along the measured strip cuts off what lies before it: right if the strip
+  // lies on a platform found in the photo up to there (straight: the shipped interlining
+  // photos show 62 mm of it on the platform), wrong if that part already bends (an edge 100 mm
+  // along a 251 mm strip hanging from a clamp gave L = 151 mm with no word). Bending: the part's
+  // sagitta from its chord over a strip width and 2 % of the part (at least 2 px): 3.9 px over
+  // 410 px on the interlining's platform, 42 px over 900 px on that clamp photo.
+  const double sagitta = along > limit ? SagittaUpTo(trace, along) : 0.0;
+  if (along > limit &&
+      (!s.platform.found || sagitta > std::max({2.0, s.set.width, 0.02 * along}))) {
+    warnings->push_back(
+        {"edge_px_along_strip",
+         "--edge-px lies " + Fmt(along * s.rig.MmPerPxAt(e), 1) + " mm (" + Fmt(along, 0) +
+             " px) along the strip from its held end at " + Fmt(trace.front().x(), 0) + "," +
+             Fmt(trace.front().y(), 0) +
+             ": the profile leaves that part out; the edge is where the strip leaves the "
+             "platform or clamp"});
+  }
+}
+
+namespace {
+
+// A clamp rig whose strip leaves the image border: the origin is where the traced line's first
+// stretch, extended, meets that border.
+StageFailure PlaceOriginAtBorder(ExtractState* s) {
+  ExtractionSummary& r = s->summary;
+  const char* side = s->direction > 0 ? "left" : "right";
+  r.rig_detail = std::string("strip leaves the ") + side + " image border";
+  // Say so when a block at that border is in view: most likely the clamp itself.
+  for (const Block& b : s->blocks) {
+    if (s->direction > 0 ? b.box.x == 0 : b.box.br().x == s->small.cols) {
+      r.rig_detail += std::string("; a ") + (b.sign < 0 ? "dark" : "light") +
+                      " block at that border (the clamp?)";
+      break;
     }
   }
-  double level = options.level_deg ? *options.level_deg * kDeg : 0.0;
-  if (platform.found) {
+  const std::vector<Vec2>& trace = s->trace;
+  const int k = std::min<int>(static_cast<int>(trace.size()) - 1,
+                              std::max(10, static_cast<int>(s->set.width)));
+  const Vec2 d = (trace[k] - trace[0]).normalized();
+  const double x_border = s->direction > 0 ? -0.5 : s->gray.cols - 0.5;
+  if (std::abs(d.x()) < 0.2) return "the strip leaves the image border too steeply to find where";
+  const double gap = (x_border - trace[0].x()) / d.x();
+  if (-gap > std::max(3.0 * s->set.width, 20.0)) {
+    r.warnings.push_back(
+        {"border_gap_extrapolated", "the strip's edges are measured only from " + Fmt(-gap, 0) +
+                                        " px after the image border (extrapolated)"});
+  }
+  r.origin_px = trace[0] + gap * d;
+  return std::nullopt;
+}
+
+}  // namespace
+
+StageFailure PlaceOrigin(ExtractState* s) {
+  ExtractionSummary& r = s->summary;
+  const ExtractOptions& options = s->options;
+  s->level = options.level_deg ? *options.level_deg * kDeg : 0.0;
+  if (s->platform.found) {
+    const PlatformFit& platform = s->platform;
     r.rig_type = "platform";
     r.rig_detail = "edge at the platform's top/front corner";
-    if (!options.level_deg) level = platform.top_angle;
+    if (!options.level_deg) s->level = platform.top_angle;
     r.platform_px = {platform.top_far, platform.corner, platform.front_low};
     r.origin_px = platform.corner;
   } else {
     r.rig_type = "clamp";
-    if (root_how == "border") {
-      const char* side = direction > 0 ? "left" : "right";
-      r.rig_detail = std::string("strip leaves the ") + side + " image border";
-      // Say so when a block at that border is in view: most likely the clamp itself.
-      for (const Block& b : blocks) {
-        if (direction > 0 ? b.box.x == 0 : b.box.br().x == small.cols) {
-          r.rig_detail += std::string("; a ") + (b.sign < 0 ? "dark" : "light") +
-                          " block at that border (the clamp?)";
-          break;
-        }
-      }
-      // Extend the first stretch of the traced line to the border.
-      const int k = std::min<int>(static_cast<int>(trace.size()) - 1,
-                                  std::max(10, static_cast<int>(set.width)));
-      const Vec2 d = (trace[k] - trace[0]).normalized();
-      const double x_border = direction > 0 ? -0.5 : W - 0.5;
-      if (std::abs(d.x()) < 0.2)
-        return fail("the strip leaves the image border too steeply to find where");
-      const double gap = (x_border - trace[0].x()) / d.x();
-      if (-gap > std::max(3.0 * set.width, 20.0)) {
-        r.warnings.push_back("the strip's edges are measured only from " + Fmt(-gap, 0) +
-                             " px after the image border (extrapolated)");
-      }
-      r.origin_px = trace[0] + gap * d;
-    } else if (root_how == "block") {
+    if (s->root_how == "border") {
+      if (StageFailure why = PlaceOriginAtBorder(s)) return why;
+    } else if (s->root_how == "block") {
       r.rig_detail = "strip leaves a clamp inside the photo";
-      r.origin_px = trace.front();
+      r.origin_px = s->trace.front();
     } else {
       r.rig_detail = "held end guessed";
-      r.origin_px = trace.front();
+      r.origin_px = s->trace.front();
     }
   }
   if (options.edge_px) {
     r.origin_px = *options.edge_px;
     r.rig_detail = "origin given by --edge-px; " + r.rig_detail;
   }
-  r.level_deg = level / kDeg;
+  r.level_deg = s->level / kDeg;
+  return std::nullopt;
+}
 
-  // ---- 8. Millimetres in the frame of docs/spec/cantilever.md.
-  const Vec2 x_img = direction * Vec2(std::cos(level), -std::sin(level));
+namespace {
+
+// The traced line in the profile frame [mm]: origin at r.origin_px, x along the horizontal
+// towards the overhang, y up, both through the rig's plane.
+std::vector<Vec2> TraceInMillimetres(ExtractState* s) {
+  ExtractionSummary& r = s->summary;
+  const Rig& rig = s->rig;
+  const double level = s->level;
+  const Vec2 x_img = s->direction * Vec2(std::cos(level), -std::sin(level));
   const Vec2 up_img(-std::sin(level), -std::cos(level));
   const Vec2 o = rig.PlaneFromImage(r.origin_px);
   const Vec2 hx = (rig.PlaneFromImage(r.origin_px + 20.0 * x_img) - o).normalized();
@@ -1720,21 +1804,28 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   if (hy.dot(rig.PlaneFromImage(r.origin_px + 20.0 * up_img) - o) < 0.0) hy = -hy;
   r.mm_per_px = rig.MmPerPxAt(r.origin_px);
   std::vector<Vec2> mm;
-  for (const Vec2& p : trace) {
+  for (const Vec2& p : s->trace) {
     const Vec2 q = rig.PlaneFromImage(p) - o;
     mm.emplace_back(q.dot(hx), q.dot(hy));
   }
-  if (r.rig_type == "clamp" && root_how == "border" && !options.edge_px) {
+  if (r.rig_type == "clamp" && s->root_how == "border" && !s->options.edge_px) {
     mm.insert(mm.begin(), Vec2(0.0, 0.0));
-    trace.insert(trace.begin(), r.origin_px);
+    s->trace.insert(s->trace.begin(), r.origin_px);
   }
+  return mm;
+}
+
+}  // namespace
+
+StageFailure MapToMillimetres(ExtractState* s) {
+  const std::vector<Vec2> mm = TraceInMillimetres(s);
   // The profile starts where the traced line crosses x = 0 (the vertical through the origin).
   size_t start = 0;
   Vec2 first_mm;
   std::vector<Vec2> bridge;  // points between first_mm and the traced line
   if (mm.front().x() >= 0.0) {
     const Vec2 d = (mm[std::min<size_t>(5, mm.size() - 1)] - mm[0]).normalized();
-    if (platform.found && !options.edge_px && d.x() > 1e-3) {
+    if (s->platform.found && !s->options.edge_px && d.x() > 1e-3) {
       // A strip resting on a platform leaves its edge level (θ(0) = 0, docs/spec/cantilever.md):
       // the gap to the first measured point is bridged by the parabola that is level at x = 0 and
       // meets that point with its slope. A straight line along that slope would put the start too
@@ -1743,7 +1834,7 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
       const double c = m1 / (2.0 * std::max(x1, 1e-9));
       const double y0 = mm[0].y() - c * x1 * x1;
       first_mm = Vec2(0.0, y0);
-      const int pieces = static_cast<int>(std::ceil(x1 / (0.25 * options.step_mm)));
+      const int pieces = static_cast<int>(std::ceil(x1 / (0.25 * s->options.step_mm)));
       for (int k = 1; k < pieces; ++k) {
         const double x = x1 * k / pieces;
         bridge.emplace_back(x, y0 + c * x * x);
@@ -1751,20 +1842,29 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
     } else {
       first_mm = mm[0] - (mm[0].x() / std::max(d.x(), 1e-3)) * d;
     }
-    if (mm[0].x() > std::max(3.0 * set.width * r.mm_per_px, 1.0)) {
-      r.warnings.push_back("the traced line starts " + Fmt(mm[0].x(), 2) +
-                           " mm beyond the edge; extrapolated to it");
+    if (mm[0].x() > std::max(3.0 * s->set.width * s->summary.mm_per_px, 1.0)) {
+      s->summary.warnings.push_back(
+          {"trace_starts_beyond_edge", "the traced line starts " + Fmt(mm[0].x(), 2) +
+                                           " mm beyond the edge; extrapolated to it"});
     }
   } else {
     while (start + 1 < mm.size() && mm[start + 1].x() < 0.0) ++start;
-    if (start + 1 >= mm.size()) return fail("the strip does not reach past the edge (x > 0)");
+    if (start + 1 >= mm.size()) return "the strip does not reach past the edge (x > 0)";
     const double f = -mm[start].x() / (mm[start + 1].x() - mm[start].x());
     first_mm = mm[start] + f * (mm[start + 1] - mm[start]);
     ++start;
   }
-  std::vector<Vec2> curve{first_mm};
-  curve.insert(curve.end(), bridge.begin(), bridge.end());
-  curve.insert(curve.end(), mm.begin() + start, mm.end());
+  s->curve = {first_mm};
+  s->curve.insert(s->curve.end(), bridge.begin(), bridge.end());
+  s->curve.insert(s->curve.end(), mm.begin() + start, mm.end());
+  s->start = start;
+  return std::nullopt;
+}
+
+void AssembleProfile(ExtractState* s) {
+  const ExtractOptions& options = s->options;
+  const std::string& source = s->summary.source;
+  const std::vector<Vec2>& curve = s->curve;
   // Arc length along the traced line (not along the chords between samples): k·step, and the
   // whole length at the tip.
   double length = 0.0;
@@ -1788,76 +1888,148 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
                      " points at that spacing (" + std::to_string(kMinProfilePoints) +
                      " needed: --step-mm " + Fmt(std::max(kMinStepMm, enough), 2) + " or less)");
   }
+  ExtractionSummary& r = s->summary;
   Profile& p = r.profile;
   p.source = source;
   for (size_t k = 0; k < resampled.size(); ++k) {
-    const double s = k + 1 == resampled.size() ? length : k * options.step_mm;
-    p.s.push_back(s * 1e-3);
+    const double arc = k + 1 == resampled.size() ? length : k * options.step_mm;
+    p.s.push_back(arc * 1e-3);
     p.x.push_back(resampled[k].x() * 1e-3);
     p.y.push_back(resampled[k].y() * 1e-3);
   }
   r.length_mm = length;
   r.tip_mm = resampled.back();
   // The overlay shows the part that became the profile.
-  trace.erase(trace.begin(), trace.begin() + std::min(start, trace.size()));
+  std::vector<Vec2>& trace = s->trace;
+  trace.erase(trace.begin(), trace.begin() + std::min(s->start, trace.size()));
   r.trace_px = trace;
+}
 
+void DiagnoseSilhouette(ExtractState* s) {
+  ExtractionSummary& r = s->summary;
+  const SectionSet& set = s->set;
+  const int first = s->first, last = s->last;
   // Widening of the silhouette towards the tip: the sign of an oblique view.
-  {
-    std::vector<double> near_root, near_tip;
-    const int n = last - first + 1;
-    for (int i = first; i <= last; ++i) {
-      if (!set.s[i].valid) continue;
-      if (i - first < n / 5) near_root.push_back(set.s[i].width());
-      if (last - i < n / 5) near_tip.push_back(set.s[i].width());
-    }
-    if (!near_root.empty() && !near_tip.empty()) r.widening = Median(near_tip) / Median(near_root);
+  std::vector<double> near_root, near_tip;
+  const int n = last - first + 1;
+  for (int i = first; i <= last; ++i) {
+    if (!set.s[i].valid) continue;
+    if (i - first < n / 5) near_root.push_back(set.s[i].width());
+    if (last - i < n / 5) near_tip.push_back(set.s[i].width());
   }
+  if (!near_root.empty() && !near_tip.empty()) r.widening = Median(near_tip) / Median(near_root);
   // An oblique view shows a face that is much fainter than the near edge: the silhouette is
   // then much wider than its solid core, and often widens towards the tip.
-  {
-    std::vector<double> solid;
-    for (int i = first; i <= last; ++i)
-      if (set.s[i].present) solid.push_back(set.s[i].solid);
-    r.core_width_px = solid.empty() ? 0.0 : Median(solid);
-  }
+  std::vector<double> solid;
+  for (int i = first; i <= last; ++i)
+    if (set.s[i].present) solid.push_back(set.s[i].solid);
+  r.core_width_px = solid.empty() ? 0.0 : Median(solid);
   const bool faint_face = r.width_px > 1.6 * r.core_width_px;
-  if (options.trace == TraceLine::kMid && (r.widening > 1.5 || faint_face)) {
-    r.warnings.push_back("the silhouette " +
-                         (r.widening > 1.5 ? "widens " + Fmt(r.widening, 1) + "x towards the tip"
-                                           : "is " + Fmt(r.width_px / r.core_width_px, 1) +
-                                                 "x wider than its solid core") +
-                         " (an oblique view?): its mid-line is biased; --trace upper or lower "
-                         "follows the near edge");
+  if (s->options.trace == TraceLine::kMid && (r.widening > 1.5 || faint_face)) {
+    r.warnings.push_back(
+        {"oblique_view",
+         "the silhouette " +
+             (r.widening > 1.5
+                  ? "widens " + Fmt(r.widening, 1) + "x towards the tip"
+                  : "is " + Fmt(r.width_px / r.core_width_px, 1) + "x wider than its solid core") +
+             " (an oblique view?): its mid-line is biased; --trace upper or "
+             "lower follows the near edge"});
   }
   if (r.contrast < 10.0 * r.noise) {
-    r.warnings.push_back("low contrast: strip " + Fmt(r.contrast, 1) + " vs noise " +
-                         Fmt(r.noise, 1) + " grey levels");
+    r.warnings.push_back({"low_contrast", "low contrast: strip " + Fmt(r.contrast, 1) +
+                                              " vs noise " + Fmt(r.noise, 1) + " grey levels"});
   }
-  const int span = last - first + 1;
-  for (int i = first; i <= last; ++i) r.rejected_sections += !set.s[i].Usable(options.trace);
-  if (r.rejected_sections > span / 5) {
-    r.warnings.push_back(std::to_string(r.rejected_sections) + " of " + std::to_string(span) +
-                         " cross-sections had no usable " + r.trace +
-                         " line (fibres, specks, faint edges)");
+  for (int i = first; i <= last; ++i) r.rejected_sections += !set.s[i].Usable(s->options.trace);
+  if (r.rejected_sections > n / 5) {
+    r.warnings.push_back({"sections_rejected", std::to_string(r.rejected_sections) + " of " +
+                                                   std::to_string(n) +
+                                                   " cross-sections had no usable " + r.trace +
+                                                   " line (fibres, specks, faint edges)"});
   }
+}
 
+StageFailure CheckResult(const ExtractState& s) {
+  const ExtractionSummary& r = s.summary;
   if (r.profile.size() < static_cast<size_t>(kMinProfilePoints)) {
-    return fail("the profile has only " + std::to_string(r.profile.size()) + " points (strip " +
-                Fmt(r.length_mm, 2) + " mm long at " + Fmt(options.step_mm, 2) + " mm steps)");
+    return "the profile has only " + std::to_string(r.profile.size()) + " points (strip " +
+           Fmt(r.length_mm, 2) + " mm long at " + Fmt(s.options.step_mm, 2) + " mm steps)";
   }
   try {
     CheckProfile(r.profile);
   } catch (const InputError& e) {
     std::string m = e.what();
     const auto colon = m.find(": ");
-    return fail("the extracted profile is not a hanging strip: " +
-                (colon == std::string::npos ? m : m.substr(colon + 2)));
+    return "the extracted profile is not a hanging strip: " +
+           (colon == std::string::npos ? m : m.substr(colon + 2));
   }
-  if (past_cap("with the profile done")) return r;
-  r.success = true;
-  r.seconds = deadline.Elapsed();
-  return r;
+  return std::nullopt;
+}
+
+}  // namespace extract_internal
+
+namespace {
+
+using extract_internal::ExtractState;
+using extract_internal::StageFailure;
+
+// The summary of a run that stopped. A photo that fails once the detection image exists is
+// first checked for being a calibration board, so that the error names the mix-up rather than
+// the stage it broke (the check costs nothing on photos that extract, and cannot refuse one).
+ExtractionSummary Failed(ExtractState&& s, const std::string& message) {
+  ExtractionSummary& r = s.summary;
+  r.success = false;
+  r.message = !s.small.empty() && extract_internal::LooksLikeCalibrationBoard(s.small)
+                  ? "this looks like a calibration board (a chessboard), not a strip: give "
+                    "board photos to textile calibrate, which writes the rig file for --rig"
+                  : message;
+  r.seconds = s.deadline.Elapsed();
+  return std::move(r);
+}
+
+// The time cap (ExtractOptions::max_seconds), read between stages; each stage is a bounded
+// pass over the photo, so the cap bounds a run to the cap plus one stage. True (and the
+// summary says so, with no profile) once it is reached.
+bool PastCap(ExtractState* s, const char* stage) {
+  const std::optional<std::string> why = s->deadline.Reached(stage);
+  if (!why) return false;
+  ExtractionSummary& r = s->summary;
+  r.profile = Profile{};
+  r.success = false;
+  r.message = *why + "; no profile";
+  r.seconds = s->deadline.Elapsed();
+  return true;
+}
+
+}  // namespace
+
+ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const ExtractOptions& options,
+                                 const std::string& source) {
+  using namespace extract_internal;
+  ExtractState s(gray, rig, options, source);  // starts the time cap's clock
+  CheckExtractInputs(gray, rig, options, source);
+  s.summary.trace = TraceName(options.trace);
+  if (PastCap(&s, "before the strip was looked for")) return std::move(s.summary);
+  ReduceImages(&s);
+  if (StageFailure why = FindStrip(&s)) return Failed(std::move(s), *why);
+  FindStripBlocks(&s);
+  if (StageFailure why = FindHeldEnd(&s)) return Failed(std::move(s), *why);
+  if (StageFailure why = TraceCoarseLine(&s)) return Failed(std::move(s), *why);
+  if (PastCap(&s, "after the strip's centre line was found")) return std::move(s.summary);
+  if (StageFailure why = FindRig(&s)) return Failed(std::move(s), *why);
+  if (StageFailure why = MeasureSections(&s)) return Failed(std::move(s), *why);
+  if (PastCap(&s, "after the cross-sections were measured")) return std::move(s.summary);
+  TraceMeasuredLine(&s);
+  if (StageFailure why = FindTipEnd(&s)) return Failed(std::move(s), *why);
+  CheckEdgeGiven(s, &s.summary.warnings);
+  if (StageFailure why = PlaceOrigin(&s)) return Failed(std::move(s), *why);
+  if (StageFailure why = MapToMillimetres(&s)) return Failed(std::move(s), *why);
+  AssembleProfile(&s);
+  DiagnoseSilhouette(&s);
+  if (StageFailure why = CheckResult(s)) return Failed(std::move(s), *why);
+  if (PastCap(&s, "with the profile done")) return std::move(s.summary);
+  s.summary.success = true;
+  s.summary.seconds = s.deadline.Elapsed();
+  return std::move(s.summary);
 }
 
 }  // namespace textile

@@ -105,7 +105,7 @@ cv::Mat DrawExtractionOverlay(const cv::Mat& gray, const ExtractionSummary& r, i
         "green: traced line; amber/azure: upper/lower edge; red: origin, x; magenta: up, tip; " +
         std::string(r.platform_px.empty() ? "" : "cyan: platform; ") + "orange: blocks");
   }
-  for (const auto& w : r.warnings) lines.push_back("warning: " + w);
+  for (const Note& w : r.warnings) lines.push_back("warning: " + w.text);
   const double font = std::max(0.4, side / 2200.0);
   const int thick = std::max(1, static_cast<int>(font * 1.5));
   int baseline = 0;

@@ -98,7 +98,7 @@ TEST(ExtractSynthetic, DarkStripLeavingTheBorderIsTracedToSubpixelAccuracy) {
   EXPECT_NEAR(r.profile.y.front(), 0.0, 1e-9);
   EXPECT_GT(r.tip_mm.x(), 0.0);
   EXPECT_LT(r.tip_mm.y(), 0.0);
-  EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
+  EXPECT_TRUE(r.warnings.empty()) << r.warnings.front().text;
 }
 
 TEST(ExtractSynthetic, LightStripOnDarkBackground) {
@@ -676,9 +676,12 @@ TEST(ExtractFailures, EdgeFarFromTheStripIsRefused) {
 TEST(ExtractFailures, EdgeWellAlongTheStripIsWarnedAbout) {
   const SyntheticPhoto photo = testing::Render(BorderScene());
   const auto warned = [](const ExtractionSummary& r) {
-    for (const std::string& w : r.warnings)
-      if (w.find("along the strip from its held end") != std::string::npos) return true;
-    return false;
+    bool text = false;
+    for (const Note& w : r.warnings)
+      text |= w.text.find("along the strip from its held end") != std::string::npos;
+    // The code says the same as the text.
+    EXPECT_EQ(text, HasNote(r.warnings, "edge_px_along_strip"));
+    return text;
   };
   ExtractOptions at_border;
   at_border.edge_px = photo.origin;

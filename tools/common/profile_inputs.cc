@@ -117,7 +117,7 @@ nlohmann::json ExtractionJson(const LoadedProfile& in) {
           {"polarity", r.polarity},   {"direction", r.direction},
           {"trace", r.trace},         {"points", r.profile.size()},
           {"length_mm", r.length_mm}, {"tip_mm", {r.tip_mm.x(), r.tip_mm.y()}},
-          {"mm_per_px", r.mm_per_px}, {"warnings", r.warnings}};
+          {"mm_per_px", r.mm_per_px}, {"warnings", r.WarningTexts()}};
 }
 
 PhotoInputOptions PhotoFlags::Options() const {

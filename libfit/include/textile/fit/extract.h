@@ -28,6 +28,7 @@
 
 #include "textile/fit/profile.h"
 #include "textile/fit/rig.h"
+#include "textile/sim/note.h"
 
 namespace textile {
 
@@ -105,7 +106,10 @@ struct ExtractionSummary {
   double mm_per_px = 0.0;             // local scale at the origin [mm/px]
   double level_deg = 0.0;             // the horizontal used, counter-clockwise from rows [deg]
   int rejected_sections = 0;          // cross-sections dropped as outliers (fibres, specks)
-  std::vector<std::string> warnings;  // doubts worth a look, one line each
+  // Doubts worth a look, one line each, with their codes: other_polarity_band_ignored,
+  // held_end_guessed, tip_end_unclear, edge_px_along_strip, border_gap_extrapolated,
+  // trace_starts_beyond_edge, oblique_view, low_contrast, sections_rejected.
+  std::vector<Note> warnings;
   double seconds = 0.0;               // wall time of the extraction
 
   // Geometry in full-resolution pixels, for overlays and checks.
@@ -119,6 +123,8 @@ struct ExtractionSummary {
 
   // Two or three lines for people: rig, polarity, direction, length, tip, warnings.
   std::string BriefReport() const;
+  // The warnings' texts, in order (what JSON results list as "warnings").
+  std::vector<std::string> WarningTexts() const;
 };
 
 // Reads a photo as 8-bit grey. The header is checked before anything is decoded: the format

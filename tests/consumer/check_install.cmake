@@ -1,5 +1,6 @@
 # Install the build tree into a scratch prefix, then configure, build and run tests/consumer
-# against it. Fails on any step. Args: BUILD_DIR, SOURCE_DIR, WORK_DIR.
+# against it; the installed `textile bench` runs too. Fails on any step.
+# Args: BUILD_DIR, SOURCE_DIR, WORK_DIR.
 file(REMOVE_RECURSE ${WORK_DIR})
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -9,6 +10,11 @@ function(run)
   set(LAST_OUTPUT "${out}" PARENT_SCOPE)
 endfunction()
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
+# The installed `textile bench` finds the installed textile-bench beside it.
+run(${WORK_DIR}/prefix/bin/textile bench --list)
+if(NOT LAST_OUTPUT MATCHES "hinge-curve\t")
+  message(FATAL_ERROR "installed textile bench --list printed: ${LAST_OUTPUT}")
+endif()
 # A sanitizer build installs instrumented libraries; the consumer must link the runtime too.
 set(flags "")
 if(SANITIZE)

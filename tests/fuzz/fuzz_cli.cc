@@ -1,5 +1,5 @@
 // libFuzzer target: the `textile` command line. The input is an argument list, one argument per
-// line ('\n'); the app is built as tools/main.cc builds it (textile::cli::RegisterAllCommands),
+// line ('\n'); the app is built as tools/common/app_main.cc builds it (RegisterAllCommands),
 // and the arguments are parsed and, when cheap, the subcommand runs for real.
 //
 // What runs (decided so that one execution stays in the milliseconds and nothing is written
@@ -16,10 +16,10 @@
 //   fuzzer keeps looking for new ones (KnownBug below; delete each skip with its fix). None
 //   at the moment.
 //
-// Checks, as tools/main.cc maps failures (docs/spec/cli.md): a parse error, InputError or
-// ComputeError is an answer; any other exception would reach the user as "error: internal: ..." and
-// is a bug, as is a crash or a sanitizer report. A run that fails leaves no new file in the scratch
-// folder and the inputs byte-identical (outputs are atomic).
+// Checks, as tools/common/app_main.cc maps failures (docs/spec/cli.md): a parse error,
+// InputError or ComputeError is an answer; any other exception would reach the user as
+// "error: internal: ..." and is a bug, as is a crash or a sanitizer report. A run that fails
+// leaves no new file in the scratch folder and the inputs byte-identical (outputs are atomic).
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -211,7 +211,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   } catch (const textile::ComputeError&) {
   } catch (const std::bad_alloc&) {
   } catch (...) {
-    __builtin_trap();  // would be "error: internal: ..." (tools/main.cc)
+    __builtin_trap();  // would be "error: internal: ..." (tools/common/app_main.cc)
   }
   if (failed && !ScratchUntouched()) __builtin_trap();  // a failed run left or changed a file
   return 0;

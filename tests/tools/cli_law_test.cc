@@ -220,7 +220,7 @@ TEST(CliLaw, RejectsNonFiniteKappa) {
   EXPECT_NE(r.err.find("--kappa"), std::string::npos) << r.err;
 }
 
-// A benchmark's CSV (tools/bench/bench_common.cc WriteCsv): a header line, then one line per row;
+// A benchmark's CSV (bench/bench_common.cc WriteCsv): a header line, then one line per row;
 // strings are in double quotes and may hold commas (never a quote), numbers are bare.
 struct Csv {
   std::vector<std::string> header;

@@ -95,9 +95,9 @@ TEST(CliStartup, AReportThatCannotBeWrittenIsAFailure) {
   EXPECT_EQ(testing::ReadAll(err), "error: cannot write the report to stdout\n");
 }
 
-// The executable installs the signal cleanup (tools/main.cc): an `extract` stopped with SIGTERM
-// once its private folder exists dies of the signal and leaves nothing (SignalCleanup.* test the
-// handler itself).
+// The executable installs the signal cleanup (tools/common/app_main.cc): an `extract` stopped
+// with SIGTERM once its private folder exists dies of the signal and leaves nothing
+// (SignalCleanup.* test the handler itself).
 TEST(CliStartup, AStoppedRunDiesOfTheSignalAndLeavesNothing) {
   const fs::path d = Scratch("CliStartup.Stopped");
   const std::string photos =

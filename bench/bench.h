@@ -1,5 +1,5 @@
-#ifndef TEXTILE_TOOLS_BENCH_BENCH_H_
-#define TEXTILE_TOOLS_BENCH_BENCH_H_
+#ifndef TEXTILE_BENCH_BENCH_H_
+#define TEXTILE_BENCH_BENCH_H_
 
 // The benchmarks of docs/spec/benchmarks.md behind `textile bench NAME`. Each one runs its
 // study, returns rows (one JSON object per CSV row, columns as docs/spec/benchmarks.md names them,
@@ -32,7 +32,7 @@ struct Benchmark {
   std::function<Result(const Context&)> run;
 };
 
-// Benchmarks register themselves, one file each (tools/bench/<name>.cc), with a namespace-scope
+// Benchmarks register themselves, one file each (bench/<name>.cc), with a namespace-scope
 //   const bool kRegistered = AddBenchmark(40, FitAccuracyBenchmark);
 // `order` follows docs/spec/benchmarks.md: bend-force 10, hinge-curve 15, stability 20,
 // acpm-accuracy 30, fit-accuracy 40, elastica 45, extract-accuracy 50, drape-convergence 60,
@@ -52,4 +52,4 @@ double MedianSeconds(const std::function<void()>& f, int repeats);
 
 }  // namespace textile::bench
 
-#endif  // TEXTILE_TOOLS_BENCH_BENCH_H_
+#endif  // TEXTILE_BENCH_BENCH_H_

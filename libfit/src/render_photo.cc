@@ -17,6 +17,7 @@
 #include "textile/sim/elastica.h"
 #include "textile/sim/error.h"
 #include "textile/sim/polyline.h"
+#include "render_photo_stages.h"
 
 namespace textile {
 namespace {
@@ -477,17 +478,25 @@ StripShape SolveStripShape(const BendingLaw& law, double areal_density,
   return shape;
 }
 
-// Frame the photo: the whole strip with a margin, and some of the platform. Returns the aim
-// point [mm] (options.aim_mm when given).
-Eigen::Vector2d FrameAim(const RenderPhotoOptions& o, const StripShape& shape, double t_mm) {
-  const double W = o.width_px * o.mm_per_px, H = o.height_px * o.mm_per_px;
-  double xmax = 0, ymin = 0;
+// The strip's reach [mm]: its furthest x and lowest y over both faces.
+void StripExtent(const StripShape& shape, double* xmax, double* ymin) {
+  *xmax = 0;
+  *ymin = 0;
   for (int i = 0; i < shape.n; ++i) {
-    xmax = std::max(xmax, shape.upper[i].x());
-    xmax = std::max(xmax, shape.lower[i].x());
-    ymin = std::min(ymin, shape.lower[i].y());
-    ymin = std::min(ymin, shape.upper[i].y());
+    *xmax = std::max(*xmax, shape.upper[i].x());
+    *xmax = std::max(*xmax, shape.lower[i].x());
+    *ymin = std::min(*ymin, shape.lower[i].y());
+    *ymin = std::min(*ymin, shape.upper[i].y());
   }
+}
+
+}  // namespace
+
+namespace fit_internal {
+
+Eigen::Vector2d FrameAim(const RenderPhotoOptions& o, double xmax, double ymin) {
+  const double t_mm = o.thickness * 1e3;
+  const double W = o.width_px * o.mm_per_px, H = o.height_px * o.mm_per_px;
   const double margin = 0.08 * std::min(W, H);
   // The platform takes a sixth to a quarter of the width, the strip the rest.
   const double plat = std::clamp(W - xmax - 2 * margin, W / 6.0, W / 4.0);
@@ -499,6 +508,10 @@ Eigen::Vector2d FrameAim(const RenderPhotoOptions& o, const StripShape& shape, d
   return Eigen::Vector2d(-plat + W / 2.0 + o.aim_dx * W,
                          t_mm + top_margin - H / 2.0 - o.aim_dy * H);
 }
+
+}  // namespace fit_internal
+
+namespace {
 
 // The platform and the strip: on the platform out of view to the left, over the edge, down to
 // its tip; the shades of the layers.
@@ -736,7 +749,9 @@ RenderedPhoto RenderPhoto(const BendingLaw& law, double areal_density,
   PhotoBuild b(o);
   b.t_mm = o.thickness * 1e3;
   b.shape = SolveStripShape(law, areal_density, o);
-  b.aim = FrameAim(o, b.shape, b.t_mm);
+  double xmax = 0.0, ymin = 0.0;
+  StripExtent(b.shape, &xmax, &ymin);
+  b.aim = fit_internal::FrameAim(o, xmax, ymin);
   b.cam = MakeCamera(o, b.aim);
   const double W = o.width_px * o.mm_per_px, H = o.height_px * o.mm_per_px;
   b.far = 1.5 * std::max(W, H) + std::abs(b.aim.x()) + std::abs(b.aim.y());

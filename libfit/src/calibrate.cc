@@ -11,8 +11,10 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
+#include <span>
 #include <sstream>
 
+#include "calibrate_stages.h"
 #include "deadline.h"
 #include "textile/sim/error.h"
 
@@ -178,10 +180,93 @@ BoardDetection DetectChessboard(const cv::Mat& gray, int cols, int rows, const s
   return d;
 }
 
-CalibrationSummary CalibrateRig(const std::vector<cv::Mat>& boards,
-                                const std::vector<std::string>& sources,
-                                const CalibrateOptions& o) {
-  const fit_internal::Deadline deadline(o.max_seconds);
+namespace fit_internal {
+
+std::vector<CalibrationSummary::LensCandidate> SelectLensModel(std::span<const LensModelFit> fits,
+                                                               int boards, int corners) {
+  const int models = static_cast<int>(fits.size());
+  const double points = static_cast<double>(boards) * corners;
+  // p-value of model b's gain over the nested model a.
+  const auto p_gain = [&](int a, int b) {
+    const double dof = 2.0 * points - (4.0 + 6.0 * boards + fits[b].count);
+    const double extra = fits[b].count - fits[a].count;
+    const double sse_a = fits[a].rms_px * fits[a].rms_px * points;
+    const double sse_b = fits[b].rms_px * fits[b].rms_px * points;
+    const double F = dof > 0 && sse_b > 0 ? ((sse_a - sse_b) / extra) / (sse_b / dof) : 0.0;
+    return F > 0 ? gsl_cdf_fdist_Q(F, extra, std::max(dof, 1.0)) : 1.0;
+  };
+  std::vector<CalibrationSummary::LensCandidate> candidates;
+  for (int chosen = 0;; ++chosen) {
+    CalibrationSummary::LensCandidate c{fits[chosen].terms, fits[chosen].rms_px, 1.0, 1.0, 0.0};
+    if (chosen + 1 < models) {
+      c.p_next = p_gain(chosen, chosen + 1);
+      c.p_value = p_gain(chosen, models - 1);
+      c.significance = chosen == 0 ? kLensK1Significance : kLensHigherTermsSignificance;
+    }
+    candidates.push_back(c);
+    if (!(std::min(c.p_next, c.p_value) < c.significance)) break;
+  }
+  return candidates;
+}
+
+}  // namespace fit_internal
+
+namespace {
+
+// Nested lens models, simplest first; the last is OpenCV's default. Each is fitted, and only
+// the terms that lower the reprojection error significantly are kept (SelectLensModel): boards
+// that barely differ in pose (a few degrees) do not determine k2 or k3, and a fit gave
+// k2 = -7.6 on four distortion-free renders, 6 px at the photo's corners.
+struct LensModel {
+  const char* terms;
+  int flags;
+  int count;  // free distortion coefficients
+};
+const LensModel kLensModels[] = {
+    {"none", cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3 | cv::CALIB_ZERO_TANGENT_DIST,
+     0},
+    {"k1", cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3 | cv::CALIB_ZERO_TANGENT_DIST, 1},
+    {"k1, k2", cv::CALIB_FIX_K3 | cv::CALIB_ZERO_TANGENT_DIST, 2},
+    {"k1, k2, p1, p2", cv::CALIB_FIX_K3, 4},
+    {"k1, k2, p1, p2, k3", 0, 5}};
+constexpr int kLensModelCount = static_cast<int>(std::size(kLensModels));
+
+// What the stages of CalibrateRig share; the summary s is the result.
+struct Calibration {
+  Calibration(const std::vector<cv::Mat>& boards, const std::vector<std::string>& sources,
+              const CalibrateOptions& o)
+      : boards(boards), sources(sources), o(o), deadline(o.max_seconds) {}
+  const std::vector<cv::Mat>& boards;
+  const std::vector<std::string>& sources;
+  const CalibrateOptions& o;
+  const fit_internal::Deadline deadline;
+  CalibrationSummary s;
+  std::vector<cv::Point3f> object;  // the board's corners in its own frame [mm]
+  std::vector<cv::Point2f> plane;   // ... in the plane [mm]
+  std::vector<cv::Point2f> first;   // the first board's corners, undistorted once a lens is kept
+  Rig rig;
+
+  // The time cap (CalibrateOptions::max_seconds): each board's corner search and the lens fit
+  // are bounded by OpenCV's own criteria; the cap is read before each of them. Once reached,
+  // s says so and the calibration stops.
+  bool PastCap(const std::string& stage) {
+    const std::optional<std::string> why = deadline.Reached(stage);
+    if (!why) return false;
+    s.message = "calibrate: " + *why + "; no rig";
+    s.seconds = deadline.Elapsed();
+    return true;
+  }
+};
+
+std::vector<cv::Point2f> ToCv(const std::vector<Eigen::Vector2d>& v) {
+  std::vector<cv::Point2f> out;
+  for (const auto& p : v) out.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
+  return out;
+}
+
+// Bad options, no photo, or photos of several sizes (InputError).
+void CheckCalibrateInputs(const std::vector<cv::Mat>& boards,
+                          const std::vector<std::string>& sources, const CalibrateOptions& o) {
   if (std::string why; !o.Check(&why)) throw InputError("calibrate: " + why);
   if (boards.empty()) throw InputError("calibrate: no board photo given");
   if (sources.size() != boards.size()) throw InputError("calibrate: one source name per photo");
@@ -193,216 +278,224 @@ CalibrationSummary CalibrateRig(const std::vector<cv::Mat>& boards,
                        " px (one camera, one size)");
     }
   }
-  CalibrationSummary s;
-  s.boards = static_cast<int>(boards.size());
-  // The time cap (CalibrateOptions::max_seconds): each board's corner search and the lens fit
-  // are bounded by OpenCV's own criteria; the cap is read before each of them.
-  const auto past_cap = [&](const std::string& stage) {
-    const std::optional<std::string> why = deadline.Reached(stage);
-    if (!why) return false;
-    s.message = "calibrate: " + *why + "; no rig";
-    s.seconds = deadline.Elapsed();
-    return true;
-  };
-  for (size_t i = 0; i < boards.size(); ++i) {
-    if (past_cap("before the corners of " + sources[i] + " were searched")) return s;
-    s.detections.push_back(DetectChessboard(boards[i], o.cols, o.rows, sources[i], o.detect_side_px));
-    if (!s.detections.back().found) {
-      s.message = sources[i] + ": chessboard with " + std::to_string(o.cols) + "x" +
-                  std::to_string(o.rows) + " inner corners not found (check --board: inner corners, "
-                  "not squares)";
-      return s;
+}
+
+// The corners of every board; false (with the message) at the first board without them.
+bool DetectBoards(Calibration& c) {
+  for (size_t i = 0; i < c.boards.size(); ++i) {
+    if (c.PastCap("before the corners of " + c.sources[i] + " were searched")) return false;
+    c.s.detections.push_back(
+        DetectChessboard(c.boards[i], c.o.cols, c.o.rows, c.sources[i], c.o.detect_side_px));
+    if (!c.s.detections.back().found) {
+      c.s.message = c.sources[i] + ": chessboard with " + std::to_string(c.o.cols) + "x" +
+                    std::to_string(c.o.rows) +
+                    " inner corners not found (check --board: inner corners, not squares)";
+      return false;
     }
   }
-  // A second photo of a pose adds no pose: the lens would be fitted to fewer views than given
-  // (a copy of the one board under another name gave fx 7417 px instead of 8000 and k2 = -26).
-  for (size_t j = 1; j < boards.size(); ++j) {
+  return true;
+}
+
+// A second photo of a pose adds no pose: the lens would be fitted to fewer views than given
+// (a copy of the one board under another name gave fx 7417 px instead of 8000 and k2 = -26).
+void RefuseRepeatedPoses(const Calibration& c) {
+  for (size_t j = 1; j < c.boards.size(); ++j) {
     for (size_t i = 0; i < j; ++i) {
-      const double d = CornerDistancePx(s.detections[i].corners_px, s.detections[j].corners_px);
+      const double d =
+          CornerDistancePx(c.s.detections[i].corners_px, c.s.detections[j].corners_px);
       if (d < kSamePosePx) {
         std::ostringstream m;
         m.setf(std::ios::fixed);
         m.precision(2);
-        m << sources[j] << ": the board is in the same pose as in " << sources[i]
+        m << c.sources[j] << ": the board is in the same pose as in " << c.sources[i]
           << " (every corner within " << d << " px; a copy?): more boards must show other poses";
         throw InputError(m.str());
       }
     }
   }
-  // The board's own frame [mm]: corner (i, j) at (i, j) squares.
-  std::vector<cv::Point3f> object;
-  std::vector<cv::Point2f> plane;
-  for (int j = 0; j < o.rows; ++j) {
-    for (int i = 0; i < o.cols; ++i) {
-      object.emplace_back(static_cast<float>(i * o.square_mm), static_cast<float>(j * o.square_mm), 0.f);
-      plane.emplace_back(static_cast<float>(i * o.square_mm), static_cast<float>(j * o.square_mm));
-    }
-  }
-  const auto to_cv = [](const std::vector<Eigen::Vector2d>& v) {
-    std::vector<cv::Point2f> out;
-    for (const auto& p : v) out.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()));
-    return out;
-  };
+}
 
-  Rig rig;
-  rig.image_size = Eigen::Vector2i(boards[0].cols, boards[0].rows);
-  std::vector<cv::Point2f> first = to_cv(s.detections[0].corners_px);
-  if (boards.size() > 1 && o.lens) {
-    std::vector<std::vector<cv::Point3f>> objects(boards.size(), object);
-    std::vector<std::vector<cv::Point2f>> images;
-    for (const auto& d : s.detections) images.push_back(to_cv(d.corners_px));
-    // Nested lens models, simplest first; the last is OpenCV's default. Each is fitted, and
-    // only the terms that lower the reprojection error significantly are kept (below): boards
-    // that barely differ in pose (a few degrees) do not determine k2 or k3, and a fit gave
-    // k2 = -7.6 on four distortion-free renders, 6 px at the photo's corners.
-    struct Model {
-      const char* terms;
-      int flags;
-      int count;  // free distortion coefficients
-    };
-    const Model models[] = {
-        {"none",
-         cv::CALIB_FIX_K1 | cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3 | cv::CALIB_ZERO_TANGENT_DIST, 0},
-        {"k1", cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3 | cv::CALIB_ZERO_TANGENT_DIST, 1},
-        {"k1, k2", cv::CALIB_FIX_K3 | cv::CALIB_ZERO_TANGENT_DIST, 2},
-        {"k1, k2, p1, p2", cv::CALIB_FIX_K3, 4},
-        {"k1, k2, p1, p2, k3", 0, 5}};
-    constexpr int kModels = static_cast<int>(std::size(models));
-    std::vector<cv::Mat> Ks(kModels), dists(kModels), sigmas(kModels);
-    std::vector<double> rms(kModels);
-    for (int m = kModels - 1; m >= 0; --m) {  // the full model first: it decides plausibility
-      std::vector<cv::Mat> rvecs, tvecs;
-      cv::Mat sigma_extrinsic, per_view;
-      if (past_cap("before the lens fit")) return s;
-      dists[m] = cv::Mat::zeros(5, 1, CV_64F);
-      try {
-        rms[m] = cv::calibrateCamera(objects, images, boards[0].size(), Ks[m], dists[m], rvecs,
-                                     tvecs, sigmas[m], sigma_extrinsic, per_view, models[m].flags);
-      } catch (const cv::Exception& e) {
-        s.message = "lens calibration failed: " + e.err;
-        return s;
-      }
-      if (m == kModels - 1 && (!std::isfinite(rms[m]) || rms[m] > o.max_error_px)) {
-        std::ostringstream msg;
-        msg << "lens calibration over " << boards.size() << " boards has an RMS error of " << rms[m]
-            << " px (more than " << o.max_error_px
-            << " px): the boards or the corner counts are inconsistent";
-        s.message = msg.str();
-        return s;
-      }
-    }
-    // Forward selection by significance: from none, the next model is taken while it, or the
-    // full model, lowers the squared error over all boards significantly (F-test). The RMS is
-    // no measure of what a term does to the photo: corner noise dominates it over the boards,
-    // while radial distortion grows as r^3 outside them (k1 = -0.1 at fx = 4000 px on a
-    // 2000 px photo: 3.6 % off the RMS over six boards, p = 2e-8, 2.2 mm at the corners).
-    const double points = static_cast<double>(boards.size()) * object.size();
-    // p-value of model b's gain over the nested model a.
-    const auto p_gain = [&](int a, int b) {
-      const double dof = 2.0 * points - (4.0 + 6.0 * boards.size() + models[b].count);
-      const double extra = models[b].count - models[a].count;
-      const double sse_a = rms[a] * rms[a] * points, sse_b = rms[b] * rms[b] * points;
-      const double F = dof > 0 && sse_b > 0 ? ((sse_a - sse_b) / extra) / (sse_b / dof) : 0.0;
-      return F > 0 ? gsl_cdf_fdist_Q(F, extra, std::max(dof, 1.0)) : 1.0;
-    };
-    int chosen = 0;
-    for (;; ++chosen) {
-      CalibrationSummary::LensCandidate c{models[chosen].terms, rms[chosen], 1.0, 1.0, 0.0};
-      if (chosen + 1 < kModels) {
-        c.p_next = p_gain(chosen, chosen + 1);
-        c.p_value = p_gain(chosen, kModels - 1);
-        c.significance = chosen == 0 ? kLensK1Significance : kLensHigherTermsSignificance;
-      }
-      s.lens_candidates.push_back(c);
-      if (!(std::min(c.p_next, c.p_value) < c.significance)) break;
-    }
-    s.lens_terms = models[chosen].terms;
-    s.lens_rms_px = rms[chosen];
-    s.lens_next_rms_px = rms[std::min(chosen + 1, kModels - 1)];
-    s.lens_full_rms_px = rms[kModels - 1];
-    // With no distortion term determined by the boards, the rig is the homography alone, as
-    // with one board.
-    if (models[chosen].count > 0) {
-      const cv::Mat& K = Ks[chosen];
-      const cv::Mat& dist = dists[chosen];
-      Lens lens;
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) lens.camera_matrix(r, c) = K.at<double>(r, c);
-      for (int k = 0; k < static_cast<int>(dist.total()); ++k)
-        lens.distortion.push_back(dist.at<double>(k));
-      // 1-σ of k1, k2, p1, p2, k3 (OpenCV's intrinsics order: fx, fy, cx, cy, then these).
-      for (int k = 0; k < 5; ++k) s.distortion_sigma.push_back(sigmas[chosen].at<double>(4 + k));
-      // A model fitted to too few or too similar views can fold the photo's corners over: extract
-      // would refuse the rig, so it is not written.
-      if (const std::string why = LensProblemOverImage(lens, boards[0].cols, boards[0].rows);
-          !why.empty()) {
-        s.message = "lens calibration over " + std::to_string(boards.size()) +
-                    " boards gives an implausible distortion: " + why +
-                    " (add boards in other poses, or --no-lens)";
-        return s;
-      }
-      rig.lens = lens;
-      s.lens_model = true;
-      // The first board's corners without distortion, in the same camera's pixels, undone as
-      // extraction undoes the photos (Lens::Undistort; the check above made sure it converges
-      // over the whole photo).
-      for (cv::Point2f& c : first) {
-        const std::optional<Eigen::Vector2d> ideal = lens.Undistort({c.x, c.y});
-        if (!ideal) {
-          s.message = "lens calibration: the fitted model cannot be undone at a corner of " +
-                      sources[0] + " (add boards in other poses, or --no-lens)";
-          return s;
-        }
-        c = cv::Point2f(static_cast<float>(ideal->x()), static_cast<float>(ideal->y()));
-      }
+// The board's own frame [mm]: corner (i, j) at (i, j) squares.
+void LayOutGrid(Calibration& c) {
+  for (int j = 0; j < c.o.rows; ++j) {
+    for (int i = 0; i < c.o.cols; ++i) {
+      const float x = static_cast<float>(i * c.o.square_mm);
+      const float y = static_cast<float>(j * c.o.square_mm);
+      c.object.emplace_back(x, y, 0.f);
+      c.plane.emplace_back(x, y);
     }
   }
-  if (past_cap("before the homography")) return s;
-  // Plane <- image, least squares over all corners (no outliers on a found board).
-  const cv::Mat Hcv = cv::findHomography(first, plane, 0);
+}
+
+// One nested model fitted over all boards by OpenCV.
+struct LensFit {
+  cv::Mat K, dist, sigma;
+  double rms = 0.0;
+};
+
+// Fits every nested model, the full one first: it decides plausibility. False (with the
+// message) if a fit throws, the full model's error is too large, or the time cap is reached.
+bool FitLensModels(Calibration& c, std::vector<LensFit>* fits) {
+  std::vector<std::vector<cv::Point3f>> objects(c.boards.size(), c.object);
+  std::vector<std::vector<cv::Point2f>> images;
+  for (const auto& d : c.s.detections) images.push_back(ToCv(d.corners_px));
+  fits->resize(kLensModelCount);
+  for (int m = kLensModelCount - 1; m >= 0; --m) {
+    LensFit& f = (*fits)[m];
+    std::vector<cv::Mat> rvecs, tvecs;
+    cv::Mat sigma_extrinsic, per_view;
+    if (c.PastCap("before the lens fit")) return false;
+    f.dist = cv::Mat::zeros(5, 1, CV_64F);
+    try {
+      f.rms = cv::calibrateCamera(objects, images, c.boards[0].size(), f.K, f.dist, rvecs, tvecs,
+                                  f.sigma, sigma_extrinsic, per_view, kLensModels[m].flags);
+    } catch (const cv::Exception& e) {
+      c.s.message = "lens calibration failed: " + e.err;
+      return false;
+    }
+    if (m == kLensModelCount - 1 && (!std::isfinite(f.rms) || f.rms > c.o.max_error_px)) {
+      std::ostringstream msg;
+      msg << "lens calibration over " << c.boards.size() << " boards has an RMS error of "
+          << f.rms << " px (more than " << c.o.max_error_px
+          << " px): the boards or the corner counts are inconsistent";
+      c.s.message = msg.str();
+      return false;
+    }
+  }
+  return true;
+}
+
+// Takes the chosen model's lens into the rig if it is plausible over the photo, and undoes it
+// on the first board's corners. False (with the message) if it folds the photo or cannot be
+// undone at a corner.
+bool AdoptLens(Calibration& c, const LensFit& fit) {
+  Lens lens;
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) lens.camera_matrix(r, k) = fit.K.at<double>(r, k);
+  for (int k = 0; k < static_cast<int>(fit.dist.total()); ++k)
+    lens.distortion.push_back(fit.dist.at<double>(k));
+  // 1-σ of k1, k2, p1, p2, k3 (OpenCV's intrinsics order: fx, fy, cx, cy, then these).
+  for (int k = 0; k < 5; ++k) c.s.distortion_sigma.push_back(fit.sigma.at<double>(4 + k));
+  // A model fitted to too few or too similar views can fold the photo's corners over: extract
+  // would refuse the rig, so it is not written.
+  if (const std::string why = LensProblemOverImage(lens, c.boards[0].cols, c.boards[0].rows);
+      !why.empty()) {
+    c.s.message = "lens calibration over " + std::to_string(c.boards.size()) +
+                  " boards gives an implausible distortion: " + why +
+                  " (add boards in other poses, or --no-lens)";
+    return false;
+  }
+  c.rig.lens = lens;
+  c.s.lens_model = true;
+  // The first board's corners without distortion, in the same camera's pixels, undone as
+  // extraction undoes the photos (Lens::Undistort; the check above made sure it converges
+  // over the whole photo).
+  for (cv::Point2f& p : c.first) {
+    const std::optional<Eigen::Vector2d> ideal = lens.Undistort({p.x, p.y});
+    if (!ideal) {
+      c.s.message = "lens calibration: the fitted model cannot be undone at a corner of " +
+                    c.sources[0] + " (add boards in other poses, or --no-lens)";
+      return false;
+    }
+    p = cv::Point2f(static_cast<float>(ideal->x()), static_cast<float>(ideal->y()));
+  }
+  return true;
+}
+
+// Fits the nested lens models, keeps the significant terms (SelectLensModel) and, with any
+// term kept, adopts the lens. False (with the message) when a stage fails.
+bool CalibrateLens(Calibration& c) {
+  std::vector<LensFit> fits;
+  if (!FitLensModels(c, &fits)) return false;
+  std::vector<fit_internal::LensModelFit> rms;
+  for (int m = 0; m < kLensModelCount; ++m)
+    rms.push_back({kLensModels[m].terms, kLensModels[m].count, fits[m].rms});
+  c.s.lens_candidates = fit_internal::SelectLensModel(rms, static_cast<int>(c.boards.size()),
+                                                      static_cast<int>(c.object.size()));
+  const int chosen = static_cast<int>(c.s.lens_candidates.size()) - 1;
+  c.s.lens_terms = kLensModels[chosen].terms;
+  c.s.lens_rms_px = fits[chosen].rms;
+  c.s.lens_next_rms_px = fits[std::min(chosen + 1, kLensModelCount - 1)].rms;
+  c.s.lens_full_rms_px = fits[kLensModelCount - 1].rms;
+  // With no distortion term determined by the boards, the rig is the homography alone, as
+  // with one board.
+  if (kLensModels[chosen].count == 0) return true;
+  return AdoptLens(c, fits[chosen]);
+}
+
+// Plane <- image, least squares over all corners of the first board (no outliers on a found
+// board). False (with the message) for a degenerate view.
+bool FitHomography(Calibration& c) {
+  const cv::Mat Hcv = cv::findHomography(c.first, c.plane, 0);
   if (Hcv.empty()) {
-    s.message = sources[0] + ": no homography from the corners found (degenerate board view)";
-    return s;
+    c.s.message = c.sources[0] + ": no homography from the corners found (degenerate board view)";
+    return false;
   }
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) rig.plane_from_image(r, c) = Hcv.at<double>(r, c);
-  rig.plane_from_image /= rig.plane_from_image(2, 2);
-  const Eigen::Matrix3d image_from_plane = rig.plane_from_image.inverse();
+    for (int k = 0; k < 3; ++k) c.rig.plane_from_image(r, k) = Hcv.at<double>(r, k);
+  c.rig.plane_from_image /= c.rig.plane_from_image(2, 2);
+  return true;
+}
 
-  // Errors on the first board: in the photo (reprojected grid vs corners found, undistorted) and
-  // in the plane (corners mapped through the rig vs the true grid).
+// Errors on the first board: in the photo (reprojected grid vs corners found, undistorted) and
+// in the plane (corners mapped through the rig vs the true grid); and the scale at the centre.
+void MeasureRig(Calibration& c) {
+  CalibrationSummary& s = c.s;
+  const Eigen::Matrix3d image_from_plane = c.rig.plane_from_image.inverse();
   double se_px = 0, se_mm = 0;
-  for (size_t k = 0; k < plane.size(); ++k) {
-    const Eigen::Vector2d found(first[k].x, first[k].y);
-    const Eigen::Vector2d grid(plane[k].x, plane[k].y);
+  for (size_t k = 0; k < c.plane.size(); ++k) {
+    const Eigen::Vector2d found(c.first[k].x, c.first[k].y);
+    const Eigen::Vector2d grid(c.plane[k].x, c.plane[k].y);
     const double e_px = (Apply(image_from_plane, grid) - found).norm();
-    const double e_mm = (Apply(rig.plane_from_image, found) - grid).norm();
+    const double e_mm = (Apply(c.rig.plane_from_image, found) - grid).norm();
     se_px += e_px * e_px;
     se_mm += e_mm * e_mm;
     s.max_error_px = std::max(s.max_error_px, e_px);
     s.max_error_mm = std::max(s.max_error_mm, e_mm);
   }
-  s.rms_error_px = std::sqrt(se_px / plane.size());
-  s.rms_error_mm = std::sqrt(se_mm / plane.size());
-  rig.reprojection_error_px = s.rms_error_px;
-  rig.source = sources[0];
-  const Eigen::Vector2d centre = Apply(
-      image_from_plane, Eigen::Vector2d((o.cols - 1) * o.square_mm / 2, (o.rows - 1) * o.square_mm / 2));
-  Rig probe = rig;
+  s.rms_error_px = std::sqrt(se_px / c.plane.size());
+  s.rms_error_mm = std::sqrt(se_mm / c.plane.size());
+  c.rig.reprojection_error_px = s.rms_error_px;
+  c.rig.source = c.sources[0];
+  const Eigen::Vector2d centre =
+      Apply(image_from_plane, Eigen::Vector2d((c.o.cols - 1) * c.o.square_mm / 2,
+                                              (c.o.rows - 1) * c.o.square_mm / 2));
+  Rig probe = c.rig;
   probe.lens.reset();  // the scale of the undistorted homography at the centre
   s.mm_per_px = probe.MmPerPxAt(centre);
-  s.seconds = deadline.Elapsed();
+}
+
+}  // namespace
+
+// Stages: check the inputs, find the corners, refuse repeated poses, fit and choose the lens
+// (several boards), fit the homography on the first board, measure it, judge its error.
+CalibrationSummary CalibrateRig(const std::vector<cv::Mat>& boards,
+                                const std::vector<std::string>& sources,
+                                const CalibrateOptions& o) {
+  Calibration c(boards, sources, o);
+  CheckCalibrateInputs(boards, sources, o);
+  c.s.boards = static_cast<int>(boards.size());
+  if (!DetectBoards(c)) return c.s;
+  RefuseRepeatedPoses(c);
+  LayOutGrid(c);
+  c.rig.image_size = Eigen::Vector2i(boards[0].cols, boards[0].rows);
+  c.first = ToCv(c.s.detections[0].corners_px);
+  if (boards.size() > 1 && o.lens && !CalibrateLens(c)) return c.s;
+  if (c.PastCap("before the homography")) return c.s;
+  if (!FitHomography(c)) return c.s;
+  MeasureRig(c);
+  CalibrationSummary& s = c.s;
+  s.seconds = c.deadline.Elapsed();
+  s.rig = c.rig;
   if (!(s.rms_error_px <= o.max_error_px)) {
     std::ostringstream m;
     m.precision(3);
-    m << sources[0] << ": reprojection error " << s.rms_error_px << " px RMS is implausible (more than "
-      << o.max_error_px << " px): the board is not flat, is blurred, or the lens needs several "
-      << "board photos";
+    m << sources[0] << ": reprojection error " << s.rms_error_px
+      << " px RMS is implausible (more than " << o.max_error_px
+      << " px): the board is not flat, is blurred, or the lens needs several board photos";
     s.message = m.str();
-    s.rig = rig;
     return s;
   }
-  s.rig = rig;
   s.success = true;
   return s;
 }

@@ -17,6 +17,7 @@
 #include "textile/sim/elastica.h"
 #include "textile/sim/error.h"
 #include "textile/sim/polyline.h"
+#include "render_photo_stages.h"
 
 namespace textile {
 namespace {
@@ -424,38 +425,78 @@ double DistanceToProfile(const Profile& truth, double x, double y) {
   return DistanceToPolyline(truth.x, truth.y, x, y);
 }
 
-RenderedPhoto RenderPhoto(const BendingLaw& law, double areal_density,
-                          const RenderPhotoOptions& o) {
-  if (std::string why; !o.Check(&why)) throw InputError("render-photo: " + why);
-  const double px = o.mm_per_px;
-  const double t_mm = o.thickness * 1e3;
-  const double L_mm = o.overhang * 1e3;
+namespace {
 
-  // The strip's mid-line, sampled about every quarter pixel of arc.
+// The strip's mid-line and faces in the bending plane [mm], resting on the platform.
+struct StripShape {
+  ElasticaProfile e;
+  int n = 0;                                        // samples
+  std::vector<Eigen::Vector2d> mid, upper, lower;   // #n points [mm]
+  std::vector<Eigen::Vector2d> normal;              // #n unit normals, upwards at the edge
+};
+
+// What the stages of RenderPhoto share: the strip, the camera and the scene being built, and
+// the one random stream (its draws keep their order: fibres, then the light).
+struct PhotoBuild {
+  explicit PhotoBuild(const RenderPhotoOptions& o) : o(o), rng(o.seed) {}
+  const RenderPhotoOptions& o;
+  double t_mm = 0.0;  // thickness [mm]
+  StripShape shape;
+  Eigen::Vector2d aim = Eigen::Vector2d::Zero();  // the point the camera looks at [mm]
+  Camera cam;
+  double far = 0.0;  // beyond the photo on every side [mm]
+  std::vector<Eigen::Vector3d> band;  // the strip's outline, platform part included [mm]
+  Scene sc;
+  std::mt19937_64 rng;
+  std::uniform_real_distribution<double> u01{0.0, 1.0};
+  std::normal_distribution<double> gauss{0.0, 1.0};
+};
+
+// The strip's mid-line, sampled about every quarter pixel of arc, and its two faces.
+StripShape SolveStripShape(const BendingLaw& law, double areal_density,
+                           const RenderPhotoOptions& o) {
+  const double t_mm = o.thickness * 1e3;
   ElasticaOptions eo;
-  eo.num_samples = std::clamp(static_cast<int>(L_mm / px * 4.0), 201, 60001);
+  eo.num_samples = std::clamp(static_cast<int>(o.overhang * 1e3 / o.mm_per_px * 4.0), 201, 60001);
   eo.rel_tol = 1e-9;
-  const ElasticaProfile e = SolveHeavyElastica(law, areal_density, o.overhang, eo);
+  StripShape shape;
+  shape.e = SolveHeavyElastica(law, areal_density, o.overhang, eo);
+  const ElasticaProfile& e = shape.e;
   if (!e.converged) throw ComputeError("render-photo: elastica failed: " + e.message);
-  const int n = static_cast<int>(e.s.size());
-  std::vector<Eigen::Vector2d> mid(n), upper(n), lower(n), normal(n);
+  const int n = shape.n = static_cast<int>(e.s.size());
+  shape.mid.resize(n);
+  shape.upper.resize(n);
+  shape.lower.resize(n);
+  shape.normal.resize(n);
   for (int i = 0; i < n; ++i) {
     // Resting on the platform, the mid-line starts at (0, t/2) (docs/spec/cantilever.md).
-    mid[i] = Eigen::Vector2d(e.x[i], e.y[i]) * 1e3 + Eigen::Vector2d(0, t_mm / 2);
-    normal[i] = Eigen::Vector2d(std::sin(e.theta[i]), std::cos(e.theta[i]));
-    upper[i] = mid[i] + 0.5 * t_mm * normal[i];
-    lower[i] = mid[i] - 0.5 * t_mm * normal[i];
+    shape.mid[i] = Eigen::Vector2d(e.x[i], e.y[i]) * 1e3 + Eigen::Vector2d(0, t_mm / 2);
+    shape.normal[i] = Eigen::Vector2d(std::sin(e.theta[i]), std::cos(e.theta[i]));
+    shape.upper[i] = shape.mid[i] + 0.5 * t_mm * shape.normal[i];
+    shape.lower[i] = shape.mid[i] - 0.5 * t_mm * shape.normal[i];
   }
+  return shape;
+}
 
-  // Frame the photo: the whole strip with a margin, and some of the platform.
-  const double W = o.width_px * px, H = o.height_px * px;
-  double xmax = 0, ymin = 0;
-  for (int i = 0; i < n; ++i) {
-    xmax = std::max(xmax, upper[i].x());
-    xmax = std::max(xmax, lower[i].x());
-    ymin = std::min(ymin, lower[i].y());
-    ymin = std::min(ymin, upper[i].y());
+// The strip's reach [mm]: its furthest x and lowest y over both faces.
+void StripExtent(const StripShape& shape, double* xmax, double* ymin) {
+  *xmax = 0;
+  *ymin = 0;
+  for (int i = 0; i < shape.n; ++i) {
+    *xmax = std::max(*xmax, shape.upper[i].x());
+    *xmax = std::max(*xmax, shape.lower[i].x());
+    *ymin = std::min(*ymin, shape.lower[i].y());
+    *ymin = std::min(*ymin, shape.upper[i].y());
   }
+}
+
+}  // namespace
+
+namespace fit_internal {
+
+Eigen::Vector2d FrameAim(const RenderPhotoOptions& o, double xmax, double ymin) {
+  const double t_mm = o.thickness * 1e3;
+  const double W = o.width_px * o.mm_per_px, H = o.height_px * o.mm_per_px;
   const double margin = 0.08 * std::min(W, H);
   // The platform takes a sixth to a quarter of the width, the strip the rest.
   const double plat = std::clamp(W - xmax - 2 * margin, W / 6.0, W / 4.0);
@@ -463,210 +504,272 @@ RenderedPhoto RenderPhoto(const BendingLaw& law, double areal_density,
   // background from it), at least 6 % of the height.
   const double spare = H - (t_mm - ymin);
   const double top_margin = std::clamp(0.6 * spare, 0.06 * H, 0.3 * H);
-  const Eigen::Vector2d aim =
-      o.aim_mm ? *o.aim_mm
-               : Eigen::Vector2d(-plat + W / 2.0 + o.aim_dx * W, t_mm + top_margin - H / 2.0 - o.aim_dy * H);
-  const Camera cam = MakeCamera(o, aim);
+  if (o.aim_mm) return *o.aim_mm;
+  return Eigen::Vector2d(-plat + W / 2.0 + o.aim_dx * W,
+                         t_mm + top_margin - H / 2.0 - o.aim_dy * H);
+}
 
-  // Far points of the platform and of the strip lying on it: beyond the photo on every side.
-  const double far = 1.5 * std::max(W, H) + std::abs(aim.x()) + std::abs(aim.y());
-  RenderedPhoto r;
-  Scene sc;
+}  // namespace fit_internal
+
+namespace {
+
+// The platform and the strip: on the platform out of view to the left, over the edge, down to
+// its tip; the shades of the layers.
+void AddPlatformAndStrip(PhotoBuild& b) {
+  const RenderPhotoOptions& o = b.o;
+  Scene& sc = b.sc;
   sc.bg = o.background_reflectance;
   sc.plat = o.platform_reflectance;
   sc.plat_top = 0.5 * (o.platform_reflectance + (o.light_strip ? 0.3 : 0.9));
   sc.face = o.face_reflectance;
   sc.strip_refl = o.strip_reflectance;
-  std::mt19937_64 rng(o.seed);
-  std::uniform_real_distribution<double> u01(0.0, 1.0);
-  std::normal_distribution<double> gauss(0.0, 1.0);
+  const double far = b.far;
+  sc.platform.push_back(
+      Project(b.cam, {{-far, 0, 0}, {0, 0, 0}, {0, -far, 0}, {-far, -far, 0}}, true));
+  const int n = b.shape.n;
+  b.band.push_back({-far, b.t_mm, 0});
+  for (int i = 0; i < n; ++i) b.band.push_back({b.shape.upper[i].x(), b.shape.upper[i].y(), 0});
+  for (int i = n - 1; i >= 0; --i)
+    b.band.push_back({b.shape.lower[i].x(), b.shape.lower[i].y(), 0});
+  b.band.push_back({-far, 0, 0});
+  sc.strip.push_back(Project(b.cam, b.band, false));
+}
 
-  sc.platform.push_back(Project(cam, {{-far, 0, 0}, {0, 0, 0}, {0, -far, 0}, {-far, -far, 0}}, true));
-  // The strip: on the platform out of view to the left, over the edge, down to its tip.
-  std::vector<Eigen::Vector3d> band;
-  band.push_back({-far, t_mm, 0});
-  for (int i = 0; i < n; ++i) band.push_back({upper[i].x(), upper[i].y(), 0});
-  for (int i = n - 1; i >= 0; --i) band.push_back({lower[i].x(), lower[i].y(), 0});
-  band.push_back({-far, 0, 0});
-  sc.strip.push_back(Project(cam, band, false));
-
-  // Oblique view: the top or bottom face behind the side face, whichever faces the camera, and
-  // the platform's top face on which the strip lies.
-  if (o.strip_width > 0) {
-    const double depth = o.strip_width * 1e3;
-    const Eigen::Vector2d cam_xy = cam.C.head<2>();
-    for (int i = 0; i + 1 < n; ++i) {
-      for (int side : {+1, -1}) {
-        const auto& b = side > 0 ? upper : lower;
-        const Eigen::Vector2d nrm = side * normal[i];
-        if (nrm.dot(cam_xy - b[i]) <= 0) continue;
-        sc.faces.push_back(Project(cam,
-                                   {{b[i].x(), b[i].y(), 0},
-                                    {b[i + 1].x(), b[i + 1].y(), 0},
-                                    {b[i + 1].x(), b[i + 1].y(), -depth},
-                                    {b[i].x(), b[i].y(), -depth}},
+// Oblique view: the top or bottom face behind the side face, whichever faces the camera, and
+// the platform's top face on which the strip lies.
+void AddObliqueFaces(PhotoBuild& b) {
+  if (!(b.o.strip_width > 0)) return;
+  const double depth = b.o.strip_width * 1e3, far = b.far, t_mm = b.t_mm;
+  const Camera& cam = b.cam;
+  const Eigen::Vector2d cam_xy = cam.C.head<2>();
+  for (int i = 0; i + 1 < b.shape.n; ++i) {
+    for (int side : {+1, -1}) {
+      const auto& f = side > 0 ? b.shape.upper : b.shape.lower;
+      const Eigen::Vector2d nrm = side * b.shape.normal[i];
+      if (nrm.dot(cam_xy - f[i]) <= 0) continue;
+      b.sc.faces.push_back(Project(cam,
+                                   {{f[i].x(), f[i].y(), 0},
+                                    {f[i + 1].x(), f[i + 1].y(), 0},
+                                    {f[i + 1].x(), f[i + 1].y(), -depth},
+                                    {f[i].x(), f[i].y(), -depth}},
                                    true));
-      }
-    }
-    if (cam.C.y() > t_mm) {
-      sc.faces.push_back(
-          Project(cam, {{-far, t_mm, 0}, {0, t_mm, 0}, {0, t_mm, -depth}, {-far, t_mm, -depth}}, true));
-    }
-    if (cam.C.y() > 0) {
-      const double pdepth = depth + 30.0;
-      sc.platform_top.push_back(
-          Project(cam, {{-far, 0, 0}, {0, 0, 0}, {0, 0, -pdepth}, {-far, 0, -pdepth}}, true));
     }
   }
+  if (cam.C.y() > t_mm) {
+    b.sc.faces.push_back(Project(
+        cam, {{-far, t_mm, 0}, {0, t_mm, 0}, {0, t_mm, -depth}, {-far, t_mm, -depth}}, true));
+  }
+  if (cam.C.y() > 0) {
+    const double pdepth = depth + 30.0;
+    b.sc.platform_top.push_back(
+        Project(cam, {{-far, 0, 0}, {0, 0, 0}, {0, 0, -pdepth}, {-far, 0, -pdepth}}, true));
+  }
+}
 
-  // Frayed tip and hairy edges: thin fibres of the strip's shade.
-  const Eigen::Vector2d tip = mid[n - 1];
-  const Eigen::Vector2d tip_t(std::cos(e.theta[n - 1]), -std::sin(e.theta[n - 1]));
-  for (int k = 0; k < o.tip_fibres; ++k) {
-    const Eigen::Vector2d start = tip + (u01(rng) - 0.5) * t_mm * normal[n - 1] - 0.2 * u01(rng) * tip_t;
-    const double ang = Deg(45.0) * gauss(rng);
-    const Eigen::Vector2d dir = std::cos(ang) * tip_t + std::sin(ang) * normal[n - 1];
-    const double len = 0.3 + 2.2 * u01(rng);
-    sc.strip.push_back(Project(cam, FibreQuad(start, start + len * dir, 0.01 + 0.02 * u01(rng)), true));
+// Frayed tip and hairy edges: thin fibres of the strip's shade.
+void AddFibres(PhotoBuild& b) {
+  const StripShape& sh = b.shape;
+  const int n = sh.n;
+  const double t_mm = b.t_mm;
+  const Eigen::Vector2d tip = sh.mid[n - 1];
+  const Eigen::Vector2d tip_t(std::cos(sh.e.theta[n - 1]), -std::sin(sh.e.theta[n - 1]));
+  for (int k = 0; k < b.o.tip_fibres; ++k) {
+    const Eigen::Vector2d start =
+        tip + (b.u01(b.rng) - 0.5) * t_mm * sh.normal[n - 1] - 0.2 * b.u01(b.rng) * tip_t;
+    const double ang = Deg(45.0) * b.gauss(b.rng);
+    const Eigen::Vector2d dir = std::cos(ang) * tip_t + std::sin(ang) * sh.normal[n - 1];
+    const double len = 0.3 + 2.2 * b.u01(b.rng);
+    b.sc.strip.push_back(
+        Project(b.cam, FibreQuad(start, start + len * dir, 0.01 + 0.02 * b.u01(b.rng)), true));
   }
-  for (int k = 0; k < o.edge_fibres; ++k) {
-    const int i = std::clamp(static_cast<int>(n * (0.05 + 0.93 * u01(rng))), 0, n - 2);
-    const double side = u01(rng) < 0.5 ? 1.0 : -1.0;
-    const Eigen::Vector2d base = (side > 0 ? upper[i] : lower[i]) - side * 0.05 * normal[i];
-    const Eigen::Vector2d ti(std::cos(e.theta[i]), -std::sin(e.theta[i]));
-    const double ang = Deg(50.0) * gauss(rng);
-    const Eigen::Vector2d dir = std::cos(ang) * side * normal[i] + std::sin(ang) * ti;
-    const double len = 0.1 + 0.6 * u01(rng);
-    sc.strip.push_back(Project(cam, FibreQuad(base, base + len * dir, 0.015 + 0.025 * u01(rng)), true));
+  for (int k = 0; k < b.o.edge_fibres; ++k) {
+    const int i = std::clamp(static_cast<int>(n * (0.05 + 0.93 * b.u01(b.rng))), 0, n - 2);
+    const double side = b.u01(b.rng) < 0.5 ? 1.0 : -1.0;
+    const Eigen::Vector2d base = (side > 0 ? sh.upper[i] : sh.lower[i]) - side * 0.05 * sh.normal[i];
+    const Eigen::Vector2d ti(std::cos(sh.e.theta[i]), -std::sin(sh.e.theta[i]));
+    const double ang = Deg(50.0) * b.gauss(b.rng);
+    const Eigen::Vector2d dir = std::cos(ang) * side * sh.normal[i] + std::sin(ang) * ti;
+    const double len = 0.1 + 0.6 * b.u01(b.rng);
+    b.sc.strip.push_back(
+        Project(b.cam, FibreQuad(base, base + len * dir, 0.015 + 0.025 * b.u01(b.rng)), true));
   }
+}
 
-  // Everything drawn must be in front of the camera.
-  for (const auto& X : band) {
-    if (cam.Depth(X) <= 1.0) throw ComputeError("render-photo: the scene passes behind the camera");
+// Everything drawn must be in front of the camera, and the strip (beyond the edge) inside the
+// photo with its tip clear of the border (ComputeError).
+void CheckFraming(const PhotoBuild& b) {
+  for (const auto& X : b.band) {
+    if (b.cam.Depth(X) <= 1.0)
+      throw ComputeError("render-photo: the scene passes behind the camera");
   }
-  // The strip (beyond the edge) must lie inside the photo with its tip clear of the border.
-  const int w = o.width_px, h = o.height_px;
-  for (int i = 0; i < n; ++i) {
-    for (const auto* p : {&upper[i], &lower[i]}) {
-      const Eigen::Vector2d q = cam.Project(*p);
+  const int w = b.o.width_px, h = b.o.height_px;
+  const Eigen::Vector2d tip = b.shape.mid[b.shape.n - 1];
+  for (int i = 0; i < b.shape.n; ++i) {
+    for (const auto* p : {&b.shape.upper[i], &b.shape.lower[i]}) {
+      const Eigen::Vector2d q = b.cam.Project(*p);
       if (q.x() < 4 || q.y() < 4 || q.x() > w - 5 || q.y() > h - 5) {
         std::ostringstream m;
-        m << "render-photo: the strip (L = " << L_mm << " mm, tip at (" << tip.x() << ", "
-          << tip.y() << ") mm) does not fit in a " << w << "x" << h << " photo at " << px
-          << " mm/px; use a larger photo or scale";
+        m << "render-photo: the strip (L = " << b.o.overhang * 1e3 << " mm, tip at (" << tip.x()
+          << ", " << tip.y() << ") mm) does not fit in a " << w << "x" << h << " photo at "
+          << b.o.mm_per_px << " mm/px; use a larger photo or scale";
         throw ComputeError(m.str());
       }
     }
   }
+}
 
-  // Light: a gradient in a random direction, a soft shadow of the strip down and away.
+// A soft shadow of the strip, down and away: its map over cells of sc.shadow_cell px.
+void AddShadow(PhotoBuild& b) {
+  const RenderPhotoOptions& o = b.o;
+  Scene& sc = b.sc;
+  const int w = o.width_px, h = o.height_px;
+  sc.shadow = o.shadow;
+  sc.shadow_cell = std::max(2.0, std::max(w, h) / 400.0);
+  cv::Mat m = cv::Mat::zeros(static_cast<int>(h / sc.shadow_cell) + 2,
+                             static_cast<int>(w / sc.shadow_cell) + 2, CV_32F);
+  const Eigen::Vector2d shift(2.5 + 2.0 * b.u01(b.rng), -(3.0 + 3.0 * b.u01(b.rng)));  // [mm]
+  std::vector<cv::Point> pts;
+  for (const auto& X : b.band) {
+    const Eigen::Vector2d q = b.cam.Project(Eigen::Vector2d(X.x() + shift.x(), X.y() + shift.y()));
+    pts.emplace_back(static_cast<int>(std::lround(q.x() / sc.shadow_cell * 16)),
+                     static_cast<int>(std::lround(q.y() / sc.shadow_cell * 16)));
+  }
+  const cv::Point* data = pts.data();
+  const int np = static_cast<int>(pts.size());
+  cv::Mat shadow_mask = cv::Mat::zeros(m.size(), CV_8U);
+  cv::fillPoly(shadow_mask, &data, &np, 1, cv::Scalar(255), cv::LINE_8, 4);
+  shadow_mask.convertTo(m, CV_32F, 1.0 / 255.0);
+  // Broad and soft: a few mm of penumbra.
+  const double sigma = std::max(1.0, 3.0 / o.mm_per_px / sc.shadow_cell);
+  cv::GaussianBlur(m, m, cv::Size(0, 0), sigma);
+  sc.shadow_map = m;
+}
+
+// Light: a gradient in a random direction, a shadow, and the weave's texture.
+void AddLight(PhotoBuild& b) {
+  const RenderPhotoOptions& o = b.o;
+  Scene& sc = b.sc;
   std::uniform_real_distribution<double> ang(0.0, 2 * kPi);
-  const double ga = ang(rng);
+  const double ga = ang(b.rng);
   sc.gradient = o.gradient;
   sc.gradient_dir = Eigen::Vector2d(std::cos(ga), std::sin(ga));
-  if (o.shadow > 0) {
-    sc.shadow = o.shadow;
-    sc.shadow_cell = std::max(2.0, std::max(w, h) / 400.0);
-    cv::Mat m = cv::Mat::zeros(static_cast<int>(h / sc.shadow_cell) + 2,
-                               static_cast<int>(w / sc.shadow_cell) + 2, CV_32F);
-    const Eigen::Vector2d shift(2.5 + 2.0 * u01(rng), -(3.0 + 3.0 * u01(rng)));  // [mm]
-    std::vector<cv::Point> pts;
-    for (const auto& X : band) {
-      const Eigen::Vector2d q = cam.Project(Eigen::Vector2d(X.x() + shift.x(), X.y() + shift.y()));
-      pts.emplace_back(static_cast<int>(std::lround(q.x() / sc.shadow_cell * 16)),
-                       static_cast<int>(std::lround(q.y() / sc.shadow_cell * 16)));
-    }
-    const cv::Point* data = pts.data();
-    const int np = static_cast<int>(pts.size());
-    cv::Mat shadow_mask = cv::Mat::zeros(m.size(), CV_8U);
-    cv::fillPoly(shadow_mask, &data, &np, 1, cv::Scalar(255), cv::LINE_8, 4);
-    shadow_mask.convertTo(m, CV_32F, 1.0 / 255.0);
-    // Broad and soft: a few mm of penumbra.
-    const double sigma = std::max(1.0, 3.0 / px / sc.shadow_cell);
-    cv::GaussianBlur(m, m, cv::Size(0, 0), sigma);
-    sc.shadow_map = m;
-  }
+  if (o.shadow > 0) AddShadow(b);
   if (o.texture > 0) {
     sc.texture = o.texture;
-    sc.texture_cell = std::max(1.5, 0.4 / px);  // weave-sized blotches
-    cv::Mat m(static_cast<int>(h / sc.texture_cell) + 2, static_cast<int>(w / sc.texture_cell) + 2,
-              CV_32F);
+    sc.texture_cell = std::max(1.5, 0.4 / o.mm_per_px);  // weave-sized blotches
+    cv::Mat m(static_cast<int>(o.height_px / sc.texture_cell) + 2,
+              static_cast<int>(o.width_px / sc.texture_cell) + 2, CV_32F);
     cv::RNG trng(o.seed * 31u + 5u);
     trng.fill(m, cv::RNG::NORMAL, 0.0, 1.0);
     sc.texture_map = m;
   }
+}
 
-  r.photo = RenderScene(sc, o, o.seed);
+// The chessboard in the bending plane, centred on the aim point, on a white card: its photo
+// and its corners.
+void RenderBoard(const PhotoBuild& b, RenderedPhoto* r) {
+  const RenderPhotoOptions& o = b.o;
+  const double sq = BoardSquareMm(o);
+  Scene board;
+  board.bg = o.light_strip ? 0.3 : o.background_reflectance;
+  board.plat = 0.92;        // the card
+  board.strip_refl = 0.06;  // the black squares
+  board.gradient = o.gradient;
+  board.gradient_dir = b.sc.gradient_dir;
+  // Board frame: x along a row, y down the rows; corner (i, j) at (i sq, j sq).
+  const Eigen::Vector2d b0 =
+      b.aim - Eigen::Vector2d((o.board_cols - 1) * sq / 2.0, -(o.board_rows - 1) * sq / 2.0);
+  const auto plane = [&](double bx, double by) {
+    return Eigen::Vector3d(b0.x() + bx, b0.y() - by, 0.0);
+  };
+  const double m0 = -2.0 * sq, mx = (o.board_cols + 1) * sq, my = (o.board_rows + 1) * sq;
+  board.platform.push_back(
+      Project(b.cam, {plane(m0, m0), plane(mx, m0), plane(mx, my), plane(m0, my)}, true));
+  for (int a = -1; a < o.board_cols; ++a) {
+    for (int c = -1; c < o.board_rows; ++c) {
+      if (((a + c) % 2 + 2) % 2 != 0) continue;
+      const double x0 = a * sq, y0 = c * sq;
+      board.strip.push_back(Project(
+          b.cam, {plane(x0, y0), plane(x0 + sq, y0), plane(x0 + sq, y0 + sq), plane(x0, y0 + sq)},
+          true));
+    }
+  }
+  r->board = RenderScene(board, o, o.seed + 1000003u);
+  r->board_cols = o.board_cols;
+  r->board_rows = o.board_rows;
+  r->board_square_mm = sq;
+  for (int j = 0; j < o.board_rows; ++j) {
+    for (int i = 0; i < o.board_cols; ++i) {
+      r->board_corners_px.push_back(b.cam.Project(plane(i * sq, j * sq)));
+      r->board_corners_mm.emplace_back(i * sq, j * sq);
+    }
+  }
+}
+
+// The truth: camera, rig, the strip's lines in the plane and in the photo.
+void FillTruth(const PhotoBuild& b, RenderedPhoto* r) {
+  const StripShape& sh = b.shape;
+  r->image_from_plane = b.cam.ImageFromPlane();
+  r->camera_matrix = b.cam.K;
+  r->rig.plane_from_image = r->image_from_plane.inverse();
+  r->rig.plane_from_image /= r->rig.plane_from_image(2, 2);
+  r->rig.image_size = Eigen::Vector2i(b.o.width_px, b.o.height_px);
+  r->rig.reprojection_error_px = 0.0;
+  r->rig.source = "render-photo truth";
+  r->truth = ToProfile(sh.e.s, sh.mid, "render-photo truth (mid-line)");
+  r->truth_upper = ToProfile(sh.e.s, sh.upper, "render-photo truth (upper boundary)");
+  r->truth_lower = ToProfile(sh.e.s, sh.lower, "render-photo truth (lower boundary)");
+  r->truth_px.reserve(sh.n);
+  for (int i = 0; i < sh.n; ++i) r->truth_px.push_back(b.cam.Project(sh.mid[i]));
+  r->origin_px = b.cam.Project(Eigen::Vector2d(0, 0));
+  r->tip_x_mm = sh.mid[sh.n - 1].x();
+  r->tip_y_mm = sh.mid[sh.n - 1].y();
+  r->aim_mm = b.aim;
+}
+
+// One line naming what the photo shows.
+std::string DescribePhoto(const RenderPhotoOptions& o) {
+  std::ostringstream d;
+  d.precision(3);
+  d << (o.light_strip ? "light" : "dark") << " strip, overhang "
+    << (o.overhang_left ? "left" : "right") << ", yaw " << o.yaw_deg << "°, pitch "
+    << o.pitch_deg << "°, roll " << o.roll_deg << "°, blur " << o.blur_px << " px, noise "
+    << o.noise << ", jpeg " << o.jpeg_quality << ", fibres " << o.tip_fibres << "+"
+    << o.edge_fibres << (o.strip_width > 0 ? ", oblique face" : "");
+  return d.str();
+}
+
+}  // namespace
+
+// Stages: the strip's shape, the framing and camera, the scene's layers (platform and strip,
+// oblique faces, fibres), the framing check, the light; then the photo, the board and the truth.
+RenderedPhoto RenderPhoto(const BendingLaw& law, double areal_density,
+                          const RenderPhotoOptions& o) {
+  if (std::string why; !o.Check(&why)) throw InputError("render-photo: " + why);
+  PhotoBuild b(o);
+  b.t_mm = o.thickness * 1e3;
+  b.shape = SolveStripShape(law, areal_density, o);
+  double xmax = 0.0, ymin = 0.0;
+  StripExtent(b.shape, &xmax, &ymin);
+  b.aim = fit_internal::FrameAim(o, xmax, ymin);
+  b.cam = MakeCamera(o, b.aim);
+  const double W = o.width_px * o.mm_per_px, H = o.height_px * o.mm_per_px;
+  b.far = 1.5 * std::max(W, H) + std::abs(b.aim.x()) + std::abs(b.aim.y());
+  AddPlatformAndStrip(b);
+  AddObliqueFaces(b);
+  AddFibres(b);
+  CheckFraming(b);
+  AddLight(b);
+
+  RenderedPhoto r;
+  r.photo = RenderScene(b.sc, o, o.seed);
   if (o.jpeg_quality > 0) {
     image_codecs::Encode(".jpg", r.photo, &r.encoded, {cv::IMWRITE_JPEG_QUALITY, o.jpeg_quality});
     r.photo = image_codecs::Decode(cv::Mat(r.encoded), cv::IMREAD_GRAYSCALE);
   }
-
-  // The chessboard in the bending plane, centred on the aim point, on a white card.
-  const double sq = BoardSquareMm(o);
-  {
-    Scene board;
-    board.bg = o.light_strip ? 0.3 : o.background_reflectance;
-    board.plat = 0.92;       // the card
-    board.strip_refl = 0.06;  // the black squares
-    board.gradient = o.gradient;
-    board.gradient_dir = sc.gradient_dir;
-    // Board frame: x along a row, y down the rows; corner (i, j) at (i sq, j sq).
-    const Eigen::Vector2d b0 = aim - Eigen::Vector2d((o.board_cols - 1) * sq / 2.0,
-                                                     -(o.board_rows - 1) * sq / 2.0);
-    const auto plane = [&](double bx, double by) {
-      return Eigen::Vector3d(b0.x() + bx, b0.y() - by, 0.0);
-    };
-    const double m0 = -2.0 * sq, mx = (o.board_cols + 1) * sq, my = (o.board_rows + 1) * sq;
-    board.platform.push_back(
-        Project(cam, {plane(m0, m0), plane(mx, m0), plane(mx, my), plane(m0, my)}, true));
-    for (int a = -1; a < o.board_cols; ++a) {
-      for (int b = -1; b < o.board_rows; ++b) {
-        if (((a + b) % 2 + 2) % 2 != 0) continue;
-        const double x0 = a * sq, y0 = b * sq;
-        board.strip.push_back(Project(
-            cam, {plane(x0, y0), plane(x0 + sq, y0), plane(x0 + sq, y0 + sq), plane(x0, y0 + sq)},
-            true));
-      }
-    }
-    RenderPhotoOptions bo = o;
-    r.board = RenderScene(board, bo, o.seed + 1000003u);
-    r.board_cols = o.board_cols;
-    r.board_rows = o.board_rows;
-    r.board_square_mm = sq;
-    for (int j = 0; j < o.board_rows; ++j) {
-      for (int i = 0; i < o.board_cols; ++i) {
-        r.board_corners_px.push_back(cam.Project(plane(i * sq, j * sq)));
-        r.board_corners_mm.emplace_back(i * sq, j * sq);
-      }
-    }
-  }
-
-  // Truth.
-  r.image_from_plane = cam.ImageFromPlane();
-  r.camera_matrix = cam.K;
-  r.rig.plane_from_image = r.image_from_plane.inverse();
-  r.rig.plane_from_image /= r.rig.plane_from_image(2, 2);
-  r.rig.image_size = Eigen::Vector2i(w, h);
-  r.rig.reprojection_error_px = 0.0;
-  r.rig.source = "render-photo truth";
-  r.truth = ToProfile(e.s, mid, "render-photo truth (mid-line)");
-  r.truth_upper = ToProfile(e.s, upper, "render-photo truth (upper boundary)");
-  r.truth_lower = ToProfile(e.s, lower, "render-photo truth (lower boundary)");
-  r.truth_px.reserve(n);
-  for (int i = 0; i < n; ++i) r.truth_px.push_back(cam.Project(mid[i]));
-  r.origin_px = cam.Project(Eigen::Vector2d(0, 0));
-  r.tip_x_mm = tip.x();
-  r.tip_y_mm = tip.y();
-  r.aim_mm = aim;
-  std::ostringstream d;
-  d.precision(3);
-  d << (o.light_strip ? "light" : "dark") << " strip, overhang " << (o.overhang_left ? "left" : "right")
-    << ", yaw " << o.yaw_deg << "°, pitch " << o.pitch_deg << "°, roll " << o.roll_deg
-    << "°, blur " << o.blur_px << " px, noise " << o.noise << ", jpeg " << o.jpeg_quality
-    << ", fibres " << o.tip_fibres << "+" << o.edge_fibres
-    << (o.strip_width > 0 ? ", oblique face" : "");
-  r.description = d.str();
+  RenderBoard(b, &r);
+  FillTruth(b, &r);
+  r.description = DescribePhoto(o);
   return r;
 }
 

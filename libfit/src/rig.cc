@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "textile/sim/error.h"
+#include "textile/sim/json_fields.h"
 #include "textile/sim/json_text.h"
 
 namespace textile {
@@ -26,46 +27,11 @@ constexpr double kMaxMmPerPx = 1e3;
 // Largest image side a rig may describe [px].
 constexpr int kMaxSidePx = 100000;
 
-class Fields {
- public:
-  Fields(const json& j, std::string source) : j_(j), source_(std::move(source)) {}
-  [[noreturn]] void Fail(const std::string& field, const std::string& problem) const {
-    throw InputError(source_ + ": " + field + ": " + problem);
-  }
-  const json& Get(const std::string& field) const {
-    if (!j_.contains(field)) Fail(field, "missing");
-    return j_.at(field);
-  }
-  double Number(const json& v, const std::string& field) const {
-    if (!v.is_number()) Fail(field, "expected a number, got " + std::string(v.type_name()));
-    const double x = v.get<double>();
-    if (!std::isfinite(x)) Fail(field, "is NaN or infinite");
-    return x;
-  }
-  std::vector<double> Numbers(const json& v, const std::string& field) const {
-    if (!v.is_array()) Fail(field, "expected an array of numbers");
-    std::vector<double> out;
-    for (size_t i = 0; i < v.size(); ++i) {
-      out.push_back(Number(v[i], field + "[" + std::to_string(i) + "]"));
-    }
-    return out;
-  }
-  Eigen::Matrix3d Matrix3(const std::string& field) const {
-    const json& v = Get(field);
-    if (!v.is_array() || v.size() != 3) Fail(field, "expected 3 rows of 3 numbers");
-    Eigen::Matrix3d m;
-    for (int r = 0; r < 3; ++r) {
-      const auto row = Numbers(v[r], field + "[" + std::to_string(r) + "]");
-      if (row.size() != 3) Fail(field, "expected 3 rows of 3 numbers");
-      for (int c = 0; c < 3; ++c) m(r, c) = row[c];
-    }
-    return m;
-  }
-
- private:
-  const json& j_;
-  std::string source_;
-};
+// A 3×3 matrix read by JsonFields::Matrix3 (row-major).
+Eigen::Matrix3d Matrix3(const JsonFields& f, const json& j, const std::string& field) {
+  const std::array<double, 9> v = f.Matrix3(f.Require(j, field), field);
+  return Eigen::Matrix<double, 3, 3, Eigen::RowMajor>(v.data());
+}
 
 // A lens model must be undone exactly where photos are measured: undistorting a point and
 // distorting it back must return it within this distance [px] (a tenth of the extraction's
@@ -422,32 +388,33 @@ void Rig::CheckForImage(int width, int height, const std::string& photo) const {
 
 Rig ParseRigJson(const std::string& text, const std::string& source) {
   const json j = ParseJsonText(text, source);
-  if (!j.is_object()) throw InputError(source + ": expected a JSON object (a rig file)");
-  const Fields f(j, source);
-  const json& type = f.Get("type");
-  if (!type.is_string()) f.Fail("type", "expected \"scale\" or \"homography\"");
+  const JsonFields f(source);
+  f.RequireObject(j);
+  const json& type = f.Require(j, "type");
+  if (!type.is_string()) f.Must("type", "be \"scale\" or \"homography\"", type);
   Rig rig;
   if (type == "scale") {
-    const double s = f.Number(f.Get("mm_per_px"), "mm_per_px");
-    if (s <= 0.0) f.Fail("mm_per_px", "must be > 0");
+    const json& v = f.Require(j, "mm_per_px");
+    const double s = f.Number(v, "mm_per_px");
+    if (s <= 0.0) f.Must("mm_per_px", "be > 0", v);
     rig = Rig::FromScale(s, source + ": mm_per_px");
   } else if (type == "homography") {
-    rig.plane_from_image = f.Matrix3("plane_from_image");
+    rig.plane_from_image = Matrix3(f, j, "plane_from_image");
     const double det = rig.plane_from_image.determinant();
     const double size = rig.plane_from_image.cwiseAbs().maxCoeff();
     if (!(std::abs(det) > 1e-12 * size * size * size)) {
       f.Fail("plane_from_image", "is singular (determinant " + std::to_string(det) + ")");
     }
   } else {
-    f.Fail("type", "expected \"scale\" or \"homography\", got " + type.dump());
+    f.Unknown("type", "type", type.get<std::string>(), "\"scale\" or \"homography\"");
   }
   rig.source = source;
   if (j.contains("image_size")) {
     const auto v = f.Numbers(j["image_size"], "image_size");
-    if (v.size() != 2) f.Fail("image_size", "expected [width, height] in pixels");
+    if (v.size() != 2) f.Must("image_size", "be [width, height] in pixels", j["image_size"]);
     for (const double x : v) {
       if (x < 1 || x > kMaxSidePx || x != std::floor(x)) {
-        f.Fail("image_size", "expected two whole numbers of pixels in 1 .. 100000");
+        f.Must("image_size", "be two whole numbers of pixels in 1 .. 100000", j["image_size"]);
       }
     }
     rig.image_size = Eigen::Vector2i(static_cast<int>(v[0]), static_cast<int>(v[1]));
@@ -458,17 +425,17 @@ Rig ParseRigJson(const std::string& text, const std::string& source) {
   }
   if (has_k) {
     Lens lens;
-    lens.camera_matrix = f.Matrix3("camera_matrix");
+    lens.camera_matrix = Matrix3(f, j, "camera_matrix");
     const Eigen::Matrix3d& K = lens.camera_matrix;
     if (!(K(0, 0) > 0 && K(1, 1) > 0) || K(1, 0) != 0 || K(2, 0) != 0 || K(2, 1) != 0 ||
         K(2, 2) != 1) {
-      f.Fail("camera_matrix", "expected [[fx, s, cx], [0, fy, cy], [0, 0, 1]] with fx, fy > 0");
+      f.Must("camera_matrix", "be [[fx, s, cx], [0, fy, cy], [0, 0, 1]] with fx, fy > 0",
+             j["camera_matrix"]);
     }
     lens.distortion = f.Numbers(j["distortion"], "distortion");
     const size_t n = lens.distortion.size();
     if (n != 4 && n != 5 && n != 8 && n != 12 && n != 14) {
-      f.Fail("distortion",
-             "expected 4, 5, 8, 12 or 14 coefficients (OpenCV's model), got " + std::to_string(n));
+      f.Must("distortion", "have 4, 5, 8, 12 or 14 coefficients (OpenCV's model)", j["distortion"]);
     }
     if (rig.plain_scale) f.Fail("distortion", "a plain scale rig has no lens model");
     if (rig.image_size) {
@@ -480,8 +447,9 @@ Rig ParseRigJson(const std::string& text, const std::string& source) {
     rig.lens = lens;
   }
   if (j.contains("reprojection_error_px")) {
-    const double e = f.Number(j["reprojection_error_px"], "reprojection_error_px");
-    if (e < 0) f.Fail("reprojection_error_px", "must be >= 0");
+    const json& v = j["reprojection_error_px"];
+    const double e = f.Number(v, "reprojection_error_px");
+    if (e < 0) f.Must("reprojection_error_px", "be >= 0", v);
     rig.reprojection_error_px = e;
   }
   return rig;

@@ -14,6 +14,7 @@
 
 #include "textile/sim/error.h"
 #include "textile/sim/units.h"
+#include "elastica_stages.h"
 
 // How the solver works (details and accuracy figures in docs/cantilever-facts.md).
 //
@@ -570,9 +571,79 @@ std::string ElasticaProfile::BriefReport() const {
   return s.str();
 }
 
-ElasticaProfile SolveHeavyElastica(const BendingLaw& law, double areal_density, double length,
-                                   const ElasticaOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+namespace sim_internal {
+
+ElasticaSamples SampleArcLengths(double length, const ElasticaOptions& options) {
+  ElasticaSamples samples;
+  samples.arc = options.arc_lengths;
+  if (samples.arc.empty()) {
+    const int n = options.num_samples;
+    samples.arc.resize(n);
+    for (int j = 0; j < n; ++j) samples.arc[j] = length * j / (n - 1.0);
+    samples.arc.back() = length;
+  }
+  const int n = static_cast<int>(samples.arc.size());
+  samples.targets.resize(n);
+  for (int j = 0; j < n; ++j) {
+    // Uniform samples get exact t; requested ones (L - s)/L.
+    samples.targets[n - 1 - j] = options.arc_lengths.empty()
+                                     ? (n - 1.0 - j) / (n - 1.0)
+                                     : (length - samples.arc[j]) / length;
+  }
+  return samples;
+}
+
+void UpdateShooting(const ShotOutcome& shot, bool sensitivities, double accept_step,
+                    ShootingState* state) {
+  ShootingState& st = *state;
+  const double z = st.z;
+  if (!shot.reached_clamp || shot.residual < 0.0) {
+    st.lo = std::max(st.lo, z);
+  } else if (shot.residual > 0.0) {
+    st.hi = std::min(st.hi, z);
+  }
+  double next = kNaN;
+  if (shot.reached_clamp && shot.slope > 0.0 && std::isfinite(shot.slope)) {
+    next = z - shot.residual / shot.slope;
+  }
+  const double scale = std::max(std::abs(z), std::numeric_limits<double>::min());
+  const double step = next - z;  // NaN when there is no Newton step
+  if (st.phase == ShootingPhase::kFinal && std::abs(step) <= accept_step * scale) {
+    st.correction = step;
+    st.done = true;
+    return;
+  }
+  if (std::abs(step) <= kCloseStep * scale) {
+    st.z = next;
+    st.phase = st.phase == ShootingPhase::kCoarse && sensitivities ? ShootingPhase::kFine
+                                                                   : ShootingPhase::kFinal;
+    return;
+  }
+  st.phase = ShootingPhase::kCoarse;
+  if (!(next > st.lo && next < st.hi)) {
+    next = std::isinf(st.hi) ? std::max(2.0 * z, z + 1.0) : 0.5 * (st.lo + st.hi);
+  }
+  const double rounding = 4.0 * std::numeric_limits<double>::epsilon() * st.hi;
+  if (std::isfinite(st.hi) && st.hi - st.lo <= rounding) {
+    // The bracket has collapsed to rounding without Newton settling (should not happen: the
+    // residual is smooth); take it as the root.
+    next = 0.5 * (st.lo + st.hi);
+    st.phase = ShootingPhase::kFinal;
+  }
+  st.z = next;
+}
+
+}  // namespace sim_internal
+
+namespace {
+
+using sim_internal::ElasticaSamples;
+using sim_internal::ShootingPhase;
+using sim_internal::ShootingState;
+
+// Refuses bad options, density, length, and what the law cannot give (InputError).
+void CheckElasticaInputs(const BendingLaw& law, double areal_density, double length,
+                         const ElasticaOptions& options) {
   if (std::string why; !options.Check(&why)) throw InputError("elastica options: " + why);
   if (!(std::isfinite(areal_density) && areal_density > 0.0))
     throw InputError("areal density must be a finite number > 0 kg/m², got " +
@@ -586,122 +657,84 @@ ElasticaProfile SolveHeavyElastica(const BendingLaw& law, double areal_density, 
   if (!options.arc_lengths.empty() && options.arc_lengths.back() > length)
     throw InputError("arc length " + Describe(options.arc_lengths.back(), 10) +
                      " m lies beyond the overhang length " + Describe(length, 10) + " m");
+}
 
-  ElasticaProfile profile;
-  profile.length = length;
-  profile.areal_density = areal_density;
-
-  // Sample arc lengths, and the matching t = (L - s)/L in ascending order.
-  std::vector<double> arc = options.arc_lengths;
-  if (arc.empty()) {
-    const int n = options.num_samples;
-    arc.resize(n);
-    for (int j = 0; j < n; ++j) arc[j] = length * j / (n - 1.0);
-    arc.back() = length;
-  }
-  const int n = static_cast<int>(arc.size());
-  std::vector<double> targets(n);
-  for (int j = 0; j < n; ++j) {
-    // Uniform samples get exact t; requested ones (L - s)/L.
-    targets[n - 1 - j] = options.arc_lengths.empty() ? (n - 1.0 - j) / (n - 1.0)
-                                                     : (length - arc[j]) / length;
-  }
-
-  // Deflection scale for the error control: the small-load tip angle, capped at 1.
-  const double alpha = areal_density * units::kGravity * length * length * length /
-                       law.Stiffness(0.0);
-  Shooter shooter(law, areal_density, length, alpha / 6.0,
-                  options.variation.empty() ? nullptr : &options.variation);
-  shooter.SetTimeCap(start, options.max_seconds);
-  const int final_directions = options.sensitivities ? kMaxDirections : 1;
-
-  // Safeguarded Newton on z with a bracket [lo, hi]: the residual at z = 0 (a flat tip) is
-  // negative for any load; hi stays +∞ until a trial overshoots.
-  double lo = 0.0, hi = std::numeric_limits<double>::infinity();
+// The first trial: the caller's guess when it gives a usable one, else InitialUnknown.
+double FirstUnknown(const ElasticaOptions& options, const Strip& strip) {
   double z = !std::isnan(options.log_tip_gap_guess) ? UnknownOfLogTipGap(options.log_tip_gap_guess)
              : !std::isnan(options.tip_angle_guess)  ? UnknownOfTipAngle(options.tip_angle_guess)
-                                                     : InitialUnknown(shooter.strip());
-  if (!(z > 0.0 && std::isfinite(z))) z = InitialUnknown(shooter.strip());
-  // Stages. kCoarse: Newton at a loose tolerance (a third of the steps) until its step is below
-  // kCloseStep (relative). kFine: one shot at the requested tolerance, only with sensitivities
-  // (they get no correction afterwards, so z must already be right). kFinal: the sampled pass;
-  // its own Newton step is applied linearly through the z-derivatives of the samples when below
-  // kAcceptStep, leaving an error O(step²) in the positions (and O(step) in the sensitivities).
-  enum class Stage { kCoarse, kFine, kFinal };
-  const double coarse_tol = std::max(options.rel_tol, 1e-7);
-  constexpr double kCloseStep = 1e-4;
+                                                     : InitialUnknown(strip);
+  if (!(z > 0.0 && std::isfinite(z))) z = InitialUnknown(strip);
+  return z;
+}
+
+// What the shooting leaves for the assembly of the profile.
+struct ShootingRun {
+  ShootingState state;
+  ShotResult last_shot;    // of the final pass
+  Eigen::MatrixXd record;  // the final pass's states at the sample targets, dim × n
+};
+
+// Shoots until the final pass is accepted (true), or fails with profile->message set (false).
+// Counts profile->shooting_iterations.
+bool RunShooting(Shooter& shooter, const ElasticaOptions& options,
+                 const std::vector<double>& targets, ShootingRun* run, ElasticaProfile* profile) {
+  const int final_directions = options.sensitivities ? kMaxDirections : 1;
+  const double coarse_tol = std::max(options.rel_tol, 1e-7);  // a third of the steps
+  // The final pass's Newton step is applied linearly through the z-derivatives of the samples,
+  // leaving an error O(step²) in the positions (and O(step) in the sensitivities).
   const double accept_step = options.sensitivities ? std::max(1e-9, 100.0 * options.rel_tol)
                                                    : std::max(1e-6, 100.0 * options.rel_tol);
-  Stage stage = Stage::kCoarse;
-  Eigen::MatrixXd record;
-  ShotResult shot;
-  double correction = 0.0;
-  for (;;) {
-    if (profile.shooting_iterations >= options.max_shooting_iterations) {
+  ShootingState& state = run->state;
+  while (!state.done) {
+    if (profile->shooting_iterations >= options.max_shooting_iterations) {
       std::ostringstream why;
       why << "shooting did not converge in " << options.max_shooting_iterations
-          << " integrations (tip angle bracket [" << Describe(lo, 10) << ", " << Describe(hi, 10)
-          << "] in the shooting unknown)";
-      profile.message = why.str();
-      profile.integration_steps = shooter.total_steps();
-      return profile;
+          << " integrations (tip angle bracket [" << Describe(state.lo, 10) << ", "
+          << Describe(state.hi, 10) << "] in the shooting unknown)";
+      profile->message = why.str();
+      return false;
     }
-    ++profile.shooting_iterations;
-    if (stage == Stage::kFinal) {
-      record.resize(kPrimary * (1 + final_directions), n);
-      shot = shooter.Shoot(z, options.rel_tol, final_directions, targets, &record);
+    ++profile->shooting_iterations;
+    ShotResult& shot = run->last_shot;
+    if (state.phase == ShootingPhase::kFinal) {
+      run->record.resize(kPrimary * (1 + final_directions), static_cast<int>(targets.size()));
+      shot = shooter.Shoot(state.z, options.rel_tol, final_directions, targets, &run->record);
     } else {
-      shot = shooter.Shoot(z, stage == Stage::kCoarse ? coarse_tol : options.rel_tol, 1, {},
-                           nullptr);
+      const double tol = state.phase == ShootingPhase::kCoarse ? coarse_tol : options.rel_tol;
+      shot = shooter.Shoot(state.z, tol, 1, {}, nullptr);
     }
     if (shot.kind == ShotResult::Kind::kFailed) {
-      profile.message = shot.failure;
-      profile.integration_steps = shooter.total_steps();
-      return profile;
+      profile->message = shot.failure;
+      return false;
     }
-    const bool reached = shot.kind == ShotResult::Kind::kReachedClamp;
-    if (!reached || shot.residual < 0.0) {
-      lo = std::max(lo, z);
-    } else if (shot.residual > 0.0) {
-      hi = std::min(hi, z);
-    }
-    double next = kNaN;
-    if (reached && shot.slope > 0.0 && std::isfinite(shot.slope)) {
-      next = z - shot.residual / shot.slope;
-    }
-    const double scale = std::max(std::abs(z), std::numeric_limits<double>::min());
-    const double step = next - z;  // NaN when there is no Newton step
-    if (stage == Stage::kFinal && std::abs(step) <= accept_step * scale) {
-      correction = step;
-      break;
-    }
-    if (std::abs(step) <= kCloseStep * scale) {
-      // Newton has settled (quadratic convergence: the next error is ~step²).
-      z = next;
-      stage = stage == Stage::kCoarse && options.sensitivities ? Stage::kFine : Stage::kFinal;
-      continue;
-    }
-    stage = Stage::kCoarse;
-    if (!(next > lo && next < hi)) {
-      next = std::isinf(hi) ? std::max(2.0 * z, z + 1.0) : 0.5 * (lo + hi);
-    }
-    if (std::isfinite(hi) && hi - lo <= 4.0 * std::numeric_limits<double>::epsilon() * hi) {
-      // The bracket has collapsed to rounding without Newton settling (should not happen: the
-      // residual is smooth); take it as the root.
-      next = 0.5 * (lo + hi);
-      stage = Stage::kFinal;
-    }
-    z = next;
+    const sim_internal::ShotOutcome outcome{shot.kind == ShotResult::Kind::kReachedClamp,
+                                            shot.residual, shot.slope};
+    sim_internal::UpdateShooting(outcome, options.sensitivities, accept_step, &state);
   }
+  return true;
+}
 
-  // Assemble the outputs. First apply the last Newton correction linearly, through the
-  // z-derivative of the recorded states (and of the state at the edge).
-  const bool log_form = shooter.log_form();
+// The state at the edge after the final pass, with the last Newton correction applied
+// linearly (also to the recorded states) through their z-derivatives.
+std::array<double, kMaxDim> CorrectedEdge(const Shooter& shooter, ShootingRun* run) {
+  const double correction = run->state.correction;
   std::array<double, kMaxDim> edge = shooter.final_state();
   for (int i = 0; i < kPrimary; ++i) {
     edge[i] += edge[kPrimary + i] * correction;
-    record.row(i) += record.row(kPrimary + i) * correction;
+    run->record.row(i) += run->record.row(kPrimary + i) * correction;
   }
+  return edge;
+}
+
+// Samples, tip and clamp of the profile from the corrected final pass.
+void AssembleShape(const BendingLaw& law, const ElasticaOptions& options, const Shooter& shooter,
+                   const ElasticaSamples& samples, const ShootingRun& run,
+                   const std::array<double, kMaxDim>& edge, ElasticaProfile* profile) {
+  const double length = profile->length;
+  const std::vector<double>& arc = samples.arc;
+  const int n = static_cast<int>(arc.size());
+  const bool log_form = shooter.log_form();
   const Strip& strip = shooter.strip();
   // S at distance u from the tip (1 for a uniform strip): κ = M⁻¹(m / S).
   auto multiplier = [&options](double u) {
@@ -709,62 +742,100 @@ ElasticaProfile SolveHeavyElastica(const BendingLaw& law, double areal_density, 
   };
   const double tip_x_scaled = edge[2], tip_y_scaled = edge[3];
 
-  profile.s = arc;
-  profile.x.resize(n);
-  profile.y.resize(n);
-  profile.theta.resize(n);
-  profile.kappa.resize(n);
-  profile.moment.resize(n);
+  profile->s = arc;
+  profile->x.resize(n);
+  profile->y.resize(n);
+  profile->theta.resize(n);
+  profile->kappa.resize(n);
+  profile->moment.resize(n);
   for (int j = 0; j < n; ++j) {
-    const double* y = record.col(n - 1 - j).data();
-    profile.theta[j] = Angle(log_form, y);
-    profile.moment[j] = strip.moment_scale * ScaledMoment(log_form, y);
-    profile.kappa[j] = law.Curvature(profile.moment[j] / multiplier(length - arc[j]));
-    profile.x[j] = length * (tip_x_scaled - y[2]);
-    profile.y[j] = -length * (tip_y_scaled - y[3]);
+    const double* y = run.record.col(n - 1 - j).data();
+    profile->theta[j] = Angle(log_form, y);
+    profile->moment[j] = strip.moment_scale * ScaledMoment(log_form, y);
+    profile->kappa[j] = law.Curvature(profile->moment[j] / multiplier(length - arc[j]));
+    profile->x[j] = length * (tip_x_scaled - y[2]);
+    profile->y[j] = -length * (tip_y_scaled - y[3]);
   }
   // The tip, from the initial state (exact map of z).
-  const double z_final = z + correction;
+  const double z_final = run.state.z + run.state.correction;
   if (log_form) {
-    profile.log_tip_gap = std::log(kSwitchGap) - (z_final - kSwitchAngle) / kSwitchGap;
-    profile.tip_angle = kHalfPi - std::exp(profile.log_tip_gap);
+    profile->log_tip_gap = std::log(kSwitchGap) - (z_final - kSwitchAngle) / kSwitchGap;
+    profile->tip_angle = kHalfPi - std::exp(profile->log_tip_gap);
   } else {
-    profile.tip_angle = z_final;
-    profile.log_tip_gap = std::log(kHalfPi - z_final);
+    profile->tip_angle = z_final;
+    profile->log_tip_gap = std::log(kHalfPi - z_final);
   }
-  profile.tip_x = length * tip_x_scaled;
-  profile.tip_y = -length * tip_y_scaled;
-  profile.clamp_moment = strip.moment_scale * ScaledMoment(log_form, edge.data());
-  profile.clamp_curvature = law.Curvature(profile.clamp_moment / multiplier(length));
-  if (!std::isnan(shot.kink_t)) profile.kink_arc_length = length * (1.0 - shot.kink_t);
+  profile->tip_x = length * tip_x_scaled;
+  profile->tip_y = -length * tip_y_scaled;
+  profile->clamp_moment = strip.moment_scale * ScaledMoment(log_form, edge.data());
+  profile->clamp_curvature = law.Curvature(profile->clamp_moment / multiplier(length));
+  if (!std::isnan(run.last_shot.kink_t))
+    profile->kink_arc_length = length * (1.0 - run.last_shot.kink_t);
+}
 
-  if (options.sensitivities) {
-    // Eliminate the tip through the shooting condition: dz/dp = -(∂r/∂p)/(∂r/∂z), where the
-    // residual r is θ(edge) or log(π/2) - ψ(edge); both are linear in the state's first
-    // component, so the ratio of that component's derivatives does it.
-    std::array<double, 3> dz_dp;
-    for (int k = 0; k < 3; ++k) dz_dp[k] = -edge[kPrimary * (k + 2)] / edge[kPrimary];
-    profile.dx_dp.resize(n, 3);
-    profile.dy_dp.resize(n, 3);
-    profile.dtheta_dp.resize(n, 3);
-    // Total derivative of primary component i along p-direction k at a state.
-    auto total = [&](const double* y, int k, int i) {
-      return y[kPrimary * (k + 2) + i] + y[kPrimary + i] * dz_dp[k];
-    };
-    for (int j = 0; j < n; ++j) {
-      const double* y = record.col(n - 1 - j).data();
-      const double phi = log_form ? std::exp(y[0]) : 0.0;
-      for (int k = 0; k < 3; ++k) {
-        const double inv_scale = 1.0 / strip.param_scale[k];
-        const double d_angle = log_form ? -phi * total(y, k, 0) : total(y, k, 0);
-        profile.dtheta_dp(j, k) = d_angle * inv_scale;
-        profile.dx_dp(j, k) = length * (total(edge.data(), k, 2) - total(y, k, 2)) * inv_scale;
-        profile.dy_dp(j, k) = -length * (total(edge.data(), k, 3) - total(y, k, 3)) * inv_scale;
-      }
+// d(x, y, θ)/d(b1, b2, c1) at the samples, from the final pass's variational states.
+void AssembleSensitivities(const Shooter& shooter, const ShootingRun& run,
+                           const std::array<double, kMaxDim>& edge, ElasticaProfile* profile) {
+  const double length = profile->length;
+  const int n = static_cast<int>(profile->s.size());
+  const bool log_form = shooter.log_form();
+  const Strip& strip = shooter.strip();
+  // Eliminate the tip through the shooting condition: dz/dp = -(∂r/∂p)/(∂r/∂z), where the
+  // residual r is θ(edge) or log(π/2) - ψ(edge); both are linear in the state's first
+  // component, so the ratio of that component's derivatives does it.
+  std::array<double, 3> dz_dp;
+  for (int k = 0; k < 3; ++k) dz_dp[k] = -edge[kPrimary * (k + 2)] / edge[kPrimary];
+  profile->dx_dp.resize(n, 3);
+  profile->dy_dp.resize(n, 3);
+  profile->dtheta_dp.resize(n, 3);
+  // Total derivative of primary component i along p-direction k at a state.
+  auto total = [&](const double* y, int k, int i) {
+    return y[kPrimary * (k + 2) + i] + y[kPrimary + i] * dz_dp[k];
+  };
+  for (int j = 0; j < n; ++j) {
+    const double* y = run.record.col(n - 1 - j).data();
+    const double phi = log_form ? std::exp(y[0]) : 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double inv_scale = 1.0 / strip.param_scale[k];
+      const double d_angle = log_form ? -phi * total(y, k, 0) : total(y, k, 0);
+      profile->dtheta_dp(j, k) = d_angle * inv_scale;
+      profile->dx_dp(j, k) = length * (total(edge.data(), k, 2) - total(y, k, 2)) * inv_scale;
+      profile->dy_dp(j, k) = -length * (total(edge.data(), k, 3) - total(y, k, 3)) * inv_scale;
     }
   }
+}
 
+}  // namespace
+
+// Stages: check the inputs, choose the samples, shoot (safeguarded Newton on the tip unknown),
+// then assemble the shape and, if asked, the sensitivities.
+ElasticaProfile SolveHeavyElastica(const BendingLaw& law, double areal_density, double length,
+                                   const ElasticaOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  CheckElasticaInputs(law, areal_density, length, options);
+
+  ElasticaProfile profile;
+  profile.length = length;
+  profile.areal_density = areal_density;
+  const ElasticaSamples samples = sim_internal::SampleArcLengths(length, options);
+
+  // Deflection scale for the error control: the small-load tip angle, capped at 1.
+  const double alpha = areal_density * units::kGravity * length * length * length /
+                       law.Stiffness(0.0);
+  Shooter shooter(law, areal_density, length, alpha / 6.0,
+                  options.variation.empty() ? nullptr : &options.variation);
+  shooter.SetTimeCap(start, options.max_seconds);
+
+  ShootingRun run;
+  run.state.z = FirstUnknown(options, shooter.strip());
+  const bool converged = RunShooting(shooter, options, samples.targets, &run, &profile);
   profile.integration_steps = shooter.total_steps();
+  if (!converged) return profile;
+
+  const std::array<double, kMaxDim> edge = CorrectedEdge(shooter, &run);
+  AssembleShape(law, options, shooter, samples, run, edge, &profile);
+  if (options.sensitivities) AssembleSensitivities(shooter, run, edge, &profile);
+
   profile.converged = true;
   std::ostringstream msg;
   msg << "converged in " << profile.shooting_iterations << " integrations";

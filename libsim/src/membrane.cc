@@ -4,9 +4,9 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
-#include <sstream>
 
 #include "textile/sim/error.h"
+#include "textile/sim/number_text.h"
 
 namespace textile {
 namespace {
@@ -14,12 +14,6 @@ namespace {
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 using Mat32 = Eigen::Matrix<double, 3, 2>;
-
-std::string Num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
 
 Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
@@ -378,15 +372,15 @@ MembraneLame MembraneLame::FromStretch(double stretch_stiffness, double poisson,
                                        double compression) {
   if (!(stretch_stiffness > 0) || !std::isfinite(stretch_stiffness)) {
     throw InputError("membrane: stretch_stiffness must be a positive number of N/m, got " +
-                     Num(stretch_stiffness));
+                     NumberText(stretch_stiffness));
   }
   if (!(poisson > -1 && poisson < 1)) {
     throw InputError("membrane: poisson must lie in (-1, 1) for a stable sheet, got " +
-                     Num(poisson));
+                     NumberText(poisson));
   }
   if (!(compression >= kMinCompressionRatio && compression <= 1)) {
-    throw InputError("membrane: compression ratio must lie in [" + Num(kMinCompressionRatio) +
-                     ", 1], got " + Num(compression));
+    throw InputError("membrane: compression ratio must lie in [" + NumberText(kMinCompressionRatio) +
+                     ", 1], got " + NumberText(compression));
   }
   MembraneLame l;
   l.compression = compression;
@@ -461,7 +455,7 @@ MembraneElements::MembraneElements(const TriangleMesh& rest, double stretch_stif
     const double area = 0.5 * normal.norm();
     if (!(area > 1e-14 * std::max(e1.squaredNorm(), e2.squaredNorm())) || !std::isfinite(area)) {
       throw InputError("membrane: rest triangle " + std::to_string(f) + " is degenerate (area " +
-                       Num(area) + " m²)");
+                       NumberText(area) + " m²)");
     }
     const Eigen::Vector3d t1 = e1.normalized(), t2 = normal.normalized().cross(t1);
     Eigen::Matrix2d dm;

@@ -6,23 +6,17 @@
 #include <exception>
 #include <mutex>
 #include <numbers>
-#include <sstream>
 #include <unordered_map>
 #include <unordered_set>
 
 #include "gmsh_api.h"
 #include "textile/sim/error.h"
+#include "textile/sim/number_text.h"
 
 namespace textile {
 namespace {
 
 using Eigen::Vector2d;
-
-std::string Num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
 
 double Cross(const Vector2d& a, const Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
@@ -131,7 +125,7 @@ Outline PolygonOutline(const Polyline2& outline_in) {
   }
   const double area = o.Area();
   if (!(std::abs(area) > 1e-9 * o.diameter * o.diameter)) {
-    throw InputError("pattern mesh: the outline is degenerate (area " + Num(area) + " m²)");
+    throw InputError("pattern mesh: the outline is degenerate (area " + NumberText(area) + " m²)");
   }
   // Simple polygon: non-adjacent edges do not touch; adjacent edges do not fold back.
   for (int i = 0; i < n; ++i) {
@@ -172,7 +166,7 @@ std::vector<Polyline2> CheckedSeams(const std::vector<Polyline2>& seams, const O
         p = outline.ProjectToBoundary(p);
       } else if (!outline.Contains(p)) {
         throw InputError(name + " point " + std::to_string(i) + " lies outside the pattern (" +
-                         Num(d * 1e3) + " mm from its boundary)");
+                         NumberText(d * 1e3) + " mm from its boundary)");
       }
       s.row(i) = p.transpose();
     }
@@ -181,7 +175,7 @@ std::vector<Polyline2> CheckedSeams(const std::vector<Polyline2>& seams, const O
       if ((pt(i + 1) - pt(i)).norm() <= snap) {
         throw InputError(name + " segment " + std::to_string(i) + " has zero length (points " +
                          std::to_string(i) + " and " + std::to_string(i + 1) + " coincide within " +
-                         Num(snap) + " m)");
+                         NumberText(snap) + " m)");
       }
     }
     for (int i = 0; i + 1 < n; ++i) {
@@ -250,8 +244,8 @@ class SizeField {
     if (!(d < options_.refinement_range)) return 1.0;  // range 0: no refinement at all
     const double f = options_.area_factor(d);
     if (!std::isfinite(f)) {
-      throw InputError("pattern mesh: area_factor(d = " + Num(d) + " m) returned " + Num(f) +
-                       "; it must be a finite number");
+      throw InputError("pattern mesh: area_factor(d = " + NumberText(d) + " m) returned " +
+                       NumberText(f) + "; it must be a finite number");
     }
     return std::max(1.0, std::ceil(f));
   }
@@ -261,8 +255,8 @@ class SizeField {
     if (!options_.max_size) return size;
     const double cap = options_.max_size(p.x(), p.y());
     if (!(std::isfinite(cap) && cap > 0.0)) {
-      throw InputError("pattern mesh: max_size(" + Num(p.x()) + ", " + Num(p.y()) +
-                       " m) returned " + Num(cap) + "; it must be a finite length > 0");
+      throw InputError("pattern mesh: max_size(" + NumberText(p.x()) + ", " + NumberText(p.y()) +
+                       " m) returned " + NumberText(cap) + "; it must be a finite length > 0");
     }
     return std::min(size, cap);
   }
@@ -629,7 +623,7 @@ PatternMesh MeshOutline(const Outline& outline, const std::vector<Polyline2>& se
   const double estimate = EstimateTriangleCount(outline, field, h);
   if (estimate > static_cast<double>(options.max_triangles)) {
     throw InputError("pattern mesh: about " + std::to_string(std::llround(estimate)) +
-                     " triangles at element size " + Num(h * 1e3) +
+                     " triangles at element size " + NumberText(h * 1e3) +
                      " mm would exceed the limit of " + std::to_string(options.max_triangles) +
                      "; use a larger element size");
   }
@@ -650,10 +644,11 @@ bool PatternMeshOptions::Check(std::string* why) const {
     return false;
   };
   if (!(element_size > 0) || !std::isfinite(element_size)) {
-    return fail("element_size must be a positive length in metres, got " + Num(element_size));
+    return fail("element_size must be a positive length in metres, got " +
+                NumberText(element_size));
   }
   if (!(refinement_range >= 0))
-    return fail("refinement_range must be >= 0, got " + Num(refinement_range));
+    return fail("refinement_range must be >= 0, got " + NumberText(refinement_range));
   if (refining_lines < -1)
     return fail("refining_lines must be >= -1, got " + std::to_string(refining_lines));
   if (max_triangles < 1)
@@ -668,8 +663,8 @@ PatternMesh MeshRectangle(double width, double height, const std::vector<Polylin
                           const PatternMeshOptions& options) {
   CheckOptions(options);
   if (!(width > 0) || !(height > 0) || !std::isfinite(width) || !std::isfinite(height)) {
-    throw InputError("pattern mesh: rectangle sides must be positive lengths, got " + Num(width) +
-                     " × " + Num(height) + " m");
+    throw InputError("pattern mesh: rectangle sides must be positive lengths, got " +
+                     NumberText(width) + " × " + NumberText(height) + " m");
   }
   Polyline2 corners(4, 2);
   corners << 0, 0, width, 0, width, height, 0, height;
@@ -680,8 +675,8 @@ PatternMesh MeshDisk(double radius, const std::vector<Polyline2>& seams,
                      const PatternMeshOptions& options) {
   CheckOptions(options);
   if (!(radius > 0) || !std::isfinite(radius)) {
-    throw InputError("pattern mesh: disk radius must be a positive length, got " + Num(radius) +
-                     " m");
+    throw InputError("pattern mesh: disk radius must be a positive length, got " +
+                     NumberText(radius) + " m");
   }
   Outline o;
   o.is_disk = true;

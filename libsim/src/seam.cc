@@ -11,7 +11,9 @@
 #include <sstream>
 
 #include "textile/sim/error.h"
+#include "textile/sim/json_fields.h"
 #include "textile/sim/json_text.h"
+#include "textile/sim/number_text.h"
 #include "textile/sim/units.h"
 
 namespace textile {
@@ -58,12 +60,6 @@ std::string KnownTypes() {
   std::string list;
   for (const PresetRow& row : kTable2) list += std::string(row.type) + ", ";
   return list + "fitted";
-}
-
-std::string Num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
 }
 
 // min and max of B_f(d) = a2 d² + a1 d + a0 over [lo, hi], with where they occur.
@@ -151,37 +147,40 @@ bool SeamProfile::Check(std::string* why) const {
   }
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(coefficients_mm[i])) {
-      return fail("coefficients_mm",
-                  "a" + std::to_string(2 - i) + " must be finite, got " + Num(coefficients_mm[i]));
+      return fail("coefficients_mm", "a" + std::to_string(2 - i) + " must be finite, got " +
+                                         NumberText(coefficients_mm[i]));
     }
   }
   if (!std::isfinite(range_mm[0]) || !std::isfinite(range_mm[1])) {
-    return fail("range_mm",
-                "must be finite, got [" + Num(range_mm[0]) + ", " + Num(range_mm[1]) + "]");
+    return fail("range_mm", "must be finite, got [" + NumberText(range_mm[0]) + ", " +
+                                NumberText(range_mm[1]) + "]");
   }
-  if (range_mm[0] < 0.0) return fail("range_mm", "lo must be >= 0 mm, got " + Num(range_mm[0]));
+  if (range_mm[0] < 0.0)
+    return fail("range_mm", "lo must be >= 0 mm, got " + NumberText(range_mm[0]));
   if (range_mm[0] >= range_mm[1]) {
-    return fail("range_mm",
-                "lo " + Num(range_mm[0]) + " mm must be < hi " + Num(range_mm[1]) + " mm");
+    return fail("range_mm", "lo " + NumberText(range_mm[0]) + " mm must be < hi " +
+                                NumberText(range_mm[1]) + " mm");
   }
   if (range_mm[1] > kMaxRangeMm) {
-    return fail("range_mm", "suspicious hi " + Num(range_mm[1]) + " mm, above " + Num(kMaxRangeMm) +
-                                " mm (the unit is mm)");
+    return fail("range_mm", "suspicious hi " + NumberText(range_mm[1]) + " mm, above " +
+                                NumberText(kMaxRangeMm) + " mm (the unit is mm)");
   }
   if (!(influence_mm >= kMinInfluenceMm && influence_mm <= kMaxRangeMm)) {
-    return fail("influence_mm", "must lie in [" + Num(kMinInfluenceMm) + ", " + Num(kMaxRangeMm) +
-                                    "] mm, got " + Num(influence_mm) + " (the unit is mm)");
+    return fail("influence_mm", "must lie in [" + NumberText(kMinInfluenceMm) + ", " +
+                                    NumberText(kMaxRangeMm) + "] mm, got " +
+                                    NumberText(influence_mm) + " (the unit is mm)");
   }
   if (!(fade_mm > 0.0 && fade_mm <= kMaxRangeMm)) {
-    return fail("fade_mm", "must lie in (0, " + Num(kMaxRangeMm) + "] mm, got " + Num(fade_mm));
+    return fail("fade_mm",
+                "must lie in (0, " + NumberText(kMaxRangeMm) + "] mm, got " + NumberText(fade_mm));
   }
   if (!(allowance_mm >= 0.0 && allowance_mm <= kMaxAllowanceMm)) {
-    return fail("allowance_mm",
-                "must lie in [0, " + Num(kMaxAllowanceMm) + "] mm, got " + Num(allowance_mm));
+    return fail("allowance_mm", "must lie in [0, " + NumberText(kMaxAllowanceMm) + "] mm, got " +
+                                    NumberText(allowance_mm));
   }
   if (!(rib_factor >= 1.0 && rib_factor <= kMaxRibFactor)) {
-    return fail("rib_factor",
-                "must lie in [1, " + Num(kMaxRibFactor) + "], got " + Num(rib_factor));
+    return fail("rib_factor", "must lie in [1, " + NumberText(kMaxRibFactor) + "], got " +
+                                  NumberText(rib_factor));
   }
   if (covariance) {
     const Eigen::Matrix3d& c = *covariance;
@@ -197,23 +196,24 @@ bool SeamProfile::Check(std::string* why) const {
                               .eigenvalues()
                               .minCoeff();
     if (lowest < -1e-9 * scale) {
-      return fail("covariance",
-                  "must be positive semi-definite, has the eigenvalue " + Num(lowest) + " < 0");
+      return fail("covariance", "must be positive semi-definite, has the eigenvalue " +
+                                    NumberText(lowest) + " < 0");
     }
   }
   // The stiffness factor must be positive wherever S follows it (a non-positive factor is a
   // broken fit, not a softening seam).
   const Extremes inside = QuadraticExtremes(coefficients_mm, 0.0, influence_mm);
   if (!(inside.min_value > 0.0)) {
-    return fail("coefficients_mm", "B_f(d) = " + Num(inside.min_value) +
-                                       " <= 0 at d = " + Num(inside.min_at) +
+    return fail("coefficients_mm", "B_f(d) = " + NumberText(inside.min_value) +
+                                       " <= 0 at d = " + NumberText(inside.min_at) +
                                        " mm; the stiffness factor must be "
                                        "positive on [0, influence_mm] = [0, " +
-                                       Num(influence_mm) + "] mm");
+                                       NumberText(influence_mm) + "] mm");
   }
   if (inside.max_value > kMaxFactor) {
-    return fail("coefficients_mm", "suspicious B_f(d) = " + Num(inside.max_value) + " at d = " +
-                                       Num(inside.max_at) + " mm, above " + Num(kMaxFactor) +
+    return fail("coefficients_mm", "suspicious B_f(d) = " + NumberText(inside.max_value) +
+                                       " at d = " + NumberText(inside.max_at) + " mm, above " +
+                                       NumberText(kMaxFactor) +
                                        " (coefficients are per mm: was d in m or cm?)");
   }
   // The multiplier actually used must be plausible too: under paper-literal it is
@@ -223,8 +223,8 @@ bool SeamProfile::Check(std::string* why) const {
     const double largest = 1.0 + inside.max_value * (b0 - 1.0);
     if (b0 > 1.0 && largest > kMaxFactor) {
       return fail("multiplier", "paper-literal: S(d) = 1 + B_f(d) (B_f(0) - 1) reaches " +
-                                    Num(largest) + " at d = " + Num(inside.max_at) + " mm, above " +
-                                    Num(kMaxFactor) +
+                                    NumberText(largest) + " at d = " + NumberText(inside.max_at) +
+                                    " mm, above " + NumberText(kMaxFactor) +
                                     " (use \"factor\", or check the coefficients)");
     }
   }
@@ -269,117 +269,61 @@ std::vector<std::string> SeamPresetNames() {
 
 namespace {
 
-class SeamReader {
- public:
-  explicit SeamReader(std::string source) : source_(std::move(source)) {}
-
-  [[noreturn]] void Fail(const std::string& field, const std::string& problem) const {
-    throw InputError(source_ + ": " + field + ": " + problem);
+// "layers": a whole number in the range of int.
+int ReadLayers(const JsonFields& f, const json& layers) {
+  if (!layers.is_number_integer()) f.Must("layers", "be a whole number", layers);
+  // Above 2^63 - 1 nlohmann holds the number unsigned: read as int64 it would wrap.
+  if (layers.is_number_unsigned() &&
+      layers.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<int>::max())) {
+    f.Fail("layers", "suspicious count " + JsonFields::Brief(layers));
   }
-
-  static std::string Brief(const json& v) {
-    std::string s = v.dump();
-    return s.size() > 40 ? s.substr(0, 37) + "..." : s;
+  const std::int64_t n = layers.get<std::int64_t>();
+  if (n < std::numeric_limits<int>::min() || n > std::numeric_limits<int>::max()) {
+    f.Fail("layers", "suspicious count " + JsonFields::Brief(layers));
   }
+  return static_cast<int>(n);
+}
 
-  double Number(const json& v, const std::string& field) const {
-    if (!v.is_number()) Fail(field, "must be a number, got " + Brief(v));
-    const double d = v.get<double>();
-    if (!std::isfinite(d)) Fail(field, "must be finite, got " + Brief(v));
-    return d;
-  }
-
-  template <std::size_t N>
-  std::array<double, N> Numbers(const json& v, const std::string& field, const char* shape) const {
-    if (!v.is_array() || v.size() != N)
-      Fail(field, std::string("must be an array ") + shape + ", got " + Brief(v));
-    std::array<double, N> out{};
-    for (std::size_t i = 0; i < N; ++i)
-      out[i] = Number(v[i], field + "[" + std::to_string(i) + "]");
-    return out;
-  }
-
-  std::string String(const json& v, const std::string& field) const {
-    if (!v.is_string()) Fail(field, "must be a string, got " + Brief(v));
-    return v.get<std::string>();
-  }
-
-  void CheckKeys(const json& obj, const std::set<std::string>& known) const {
-    for (const auto& [key, value] : obj.items()) {
-      if (!known.count(key)) {
-        std::string list;
-        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-        Fail(key, "unknown field (known: " + list + ")");
-      }
-    }
-  }
-
- private:
-  std::string source_;
-};
+// "multiplier": "factor" or "paper-literal".
+SeamMultiplierReading ReadMultiplier(const JsonFields& f, const json& v) {
+  const std::string m = f.String(v, "multiplier");
+  if (m == "factor") return SeamMultiplierReading::kFactor;
+  if (m != "paper-literal")
+    f.Unknown("multiplier", "reading", m, "\"factor\" or \"paper-literal\"");
+  return SeamMultiplierReading::kPaperLiteral;
+}
 
 }  // namespace
 
 SeamProfile ParseSeamJson(const std::string& text, const std::string& source) {
-  SeamReader r(source);
+  const JsonFields f(source);
   const json root = ParseJsonText(text, source);
-  if (!root.is_object()) r.Fail("(top level)", "must be a JSON object");
-  r.CheckKeys(root, {"type", "name", "layers", "coefficients_mm", "range_mm", "covariance",
-                     "influence_mm", "fade_mm", "allowance_mm", "multiplier", "rib_factor", "fit",
-                     "notes", "source", "assumptions"});
-  for (const char* k : {"type", "layers", "coefficients_mm"}) {
-    if (!root.contains(k)) r.Fail(k, "missing (required: type, layers, coefficients_mm)");
-  }
+  f.RequireObject(root);
+  f.CheckKeys(root, "",
+              {"type", "name", "layers", "coefficients_mm", "range_mm", "covariance",
+               "influence_mm", "fade_mm", "allowance_mm", "multiplier", "rib_factor", "fit",
+               "notes", "source", "assumptions"});
+  for (const char* k : {"type", "layers", "coefficients_mm"})
+    f.Require(root, k, "required: type, layers, coefficients_mm");
   SeamProfile p;
-  p.type = r.String(root["type"], "type");
-  const json& layers = root["layers"];
-  if (!layers.is_number_integer())
-    r.Fail("layers", "must be a whole number, got " + SeamReader::Brief(layers));
-  // Above 2^63 - 1 nlohmann holds the number unsigned: read as int64 it would wrap.
-  if (layers.is_number_unsigned() &&
-      layers.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<int>::max())) {
-    r.Fail("layers", "suspicious count " + SeamReader::Brief(layers));
-  }
-  const std::int64_t n = layers.get<std::int64_t>();
-  if (n < std::numeric_limits<int>::min() || n > std::numeric_limits<int>::max()) {
-    r.Fail("layers", "suspicious count " + SeamReader::Brief(layers));
-  }
-  p.layers = static_cast<int>(n);
-  p.coefficients_mm = r.Numbers<3>(root["coefficients_mm"], "coefficients_mm", "[a2, a1, a0]");
+  p.type = f.String(root["type"], "type");
+  p.layers = ReadLayers(f, root["layers"]);
+  p.coefficients_mm = f.FixedNumbers<3>(root["coefficients_mm"], "coefficients_mm", "[a2, a1, a0]");
   if (root.contains("range_mm"))
-    p.range_mm = r.Numbers<2>(root["range_mm"], "range_mm", "[lo, hi]");
+    p.range_mm = f.FixedNumbers<2>(root["range_mm"], "range_mm", "[lo, hi]");
   if (root.contains("covariance")) {
-    const json& c = root["covariance"];
-    if (!c.is_array() || c.size() != 3)
-      r.Fail("covariance", "must be a 3×3 array [[...], [...], [...]]");
-    Eigen::Matrix3d cov;
-    for (int i = 0; i < 3; ++i) {
-      const auto row = r.Numbers<3>(c[i], "covariance[" + std::to_string(i) + "]", "of 3 numbers");
-      for (int j = 0; j < 3; ++j) cov(i, j) = row[j];
-    }
-    p.covariance = cov;
+    const std::array<double, 9> c = f.Matrix3(root["covariance"], "covariance");
+    p.covariance = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>(c.data());
   }
-  if (root.contains("name")) p.name = r.String(root["name"], "name");
+  if (root.contains("name")) p.name = f.String(root["name"], "name");
   if (root.contains("influence_mm"))
-    p.influence_mm = r.Number(root["influence_mm"], "influence_mm");
-  if (root.contains("fade_mm")) p.fade_mm = r.Number(root["fade_mm"], "fade_mm");
+    p.influence_mm = f.Number(root["influence_mm"], "influence_mm");
+  if (root.contains("fade_mm")) p.fade_mm = f.Number(root["fade_mm"], "fade_mm");
   if (root.contains("allowance_mm"))
-    p.allowance_mm = r.Number(root["allowance_mm"], "allowance_mm");
-  if (root.contains("rib_factor")) p.rib_factor = r.Number(root["rib_factor"], "rib_factor");
-  if (root.contains("multiplier")) {
-    const std::string m = r.String(root["multiplier"], "multiplier");
-    if (m == "factor") {
-      p.multiplier = SeamMultiplierReading::kFactor;
-    } else if (m == "paper-literal") {
-      p.multiplier = SeamMultiplierReading::kPaperLiteral;
-    } else {
-      r.Fail("multiplier", "unknown reading '" + m + "' (use \"factor\" or \"paper-literal\")");
-    }
-  }
-  if (root.contains("fit")) {
-    if (!root["fit"].is_object()) r.Fail("fit", "must be an object");
-    p.fit = root["fit"];
-  }
+    p.allowance_mm = f.Number(root["allowance_mm"], "allowance_mm");
+  if (root.contains("rib_factor")) p.rib_factor = f.Number(root["rib_factor"], "rib_factor");
+  if (root.contains("multiplier")) p.multiplier = ReadMultiplier(f, root["multiplier"]);
+  if (root.contains("fit")) p.fit = f.Object(root["fit"], "fit");
   for (const char* k : {"notes", "source", "assumptions"}) {
     if (root.contains(k)) p.extra[k] = root[k];
   }
@@ -499,8 +443,8 @@ void CheckSeams(const std::vector<Seam>& seams, const TriangleMesh& mesh) {
   const Eigen::Vector2d lo = mesh.vertices.leftCols<2>().colwise().minCoeff().transpose();
   const Eigen::Vector2d hi = mesh.vertices.leftCols<2>().colwise().maxCoeff().transpose();
   const double tol = 1e-9 * (hi - lo).norm();  // geometric tolerance [m]
-  const std::string box =
-      "[" + Num(lo.x()) + ", " + Num(hi.x()) + "] × [" + Num(lo.y()) + ", " + Num(hi.y()) + "] m";
+  const std::string box = "[" + NumberText(lo.x()) + ", " + NumberText(hi.x()) + "] × [" +
+                          NumberText(lo.y()) + ", " + NumberText(hi.y()) + "] m";
   const std::vector<std::array<int, 2>> boundary = BoundaryEdges(mesh);
   for (std::size_t i = 0; i < seams.size(); ++i) {
     const Seam& seam = seams[i];
@@ -762,7 +706,7 @@ Eigen::VectorXd LumpedMasses(const TriangleMesh& mesh, double areal_density,
                              const std::vector<Seam>& seams) {
   if (!(areal_density > 0.0) || !std::isfinite(areal_density)) {
     throw InputError("lumped masses: areal density must be a finite number > 0 kg/m², got " +
-                     Num(areal_density));
+                     NumberText(areal_density));
   }
   CheckSeams(seams, mesh);
   Eigen::VectorXd mass = Eigen::VectorXd::Zero(mesh.num_vertices());

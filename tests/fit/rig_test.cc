@@ -311,22 +311,23 @@ TEST(Lens, UndistortFailsWhereTheModelIsNotInvertible) {
 TEST(Rig, RefusesBadFiles) {
   ExpectRefused("", "not valid JSON");
   ExpectRefused("{\"type\": \"scale\", ", "not valid JSON");
-  ExpectRefused("[1, 2]", "expected a JSON object");
+  ExpectRefused("[1, 2]", "rig.json: (top level): must be a JSON object, got [1,2]");
   ExpectRefused("{}", "type: missing");
-  ExpectRefused(R"({"type": "magic"})", "expected \"scale\" or \"homography\"");
+  ExpectRefused(R"({"type": "magic"})", "type: unknown type 'magic' (use \"scale\" or \"homography\")");
+  ExpectRefused(R"({"type": 3})", "type: must be \"scale\" or \"homography\", got 3");
   ExpectRefused(R"({"type": "scale"})", "mm_per_px: missing");
-  ExpectRefused(R"({"type": "scale", "mm_per_px": "0.1"})", "expected a number");
+  ExpectRefused(R"({"type": "scale", "mm_per_px": "0.1"})", "mm_per_px: must be a number, got \"0.1\"");
   ExpectRefused(R"({"type": "scale", "mm_per_px": NaN})", "not valid JSON");
-  ExpectRefused(R"({"type": "scale", "mm_per_px": 0})", "must be > 0");
+  ExpectRefused(R"({"type": "scale", "mm_per_px": 0})", "mm_per_px: must be > 0, got 0");
   ExpectRefused(R"({"type": "scale", "mm_per_px": -0.1})", "must be > 0");
   ExpectRefused(R"({"type": "scale", "mm_per_px": 1e-9})", "implausible");
   ExpectRefused(R"({"type": "homography"})", "plane_from_image: missing");
-  ExpectRefused(R"({"type": "homography", "plane_from_image": [[1, 0], [0, 1]]})", "3 rows of 3");
+  ExpectRefused(R"({"type": "homography", "plane_from_image": [[1, 0], [0, 1]]})", "plane_from_image: must be a 3×3 array");
   ExpectRefused(R"({"type": "homography", "plane_from_image": [[1, 0, 0], [2, 0, 0], [0, 0, 1]]})",
                 "singular");
   ExpectRefused(
       R"({"type": "homography", "plane_from_image": [[1, 0, 0], [0, 1, 0], [0, 0, null]]})",
-      "expected a number");
+      "plane_from_image[2][2]: must be a number, got null");
   const std::string h =
       R"("type": "homography", "plane_from_image": [[0.1, 0, 0], [0, 0.1, 0], [0, 0, 1]])";
   ExpectRefused("{" + h + R"(, "image_size": [0, 10]})", "image_size");
@@ -340,7 +341,8 @@ TEST(Rig, RefusesBadFiles) {
       "{" + h +
           R"(, "camera_matrix": [[1000, 0, 1], [0, 1000, 1], [0, 0, 1]], "distortion": [0, 0, 0]})",
       "4, 5, 8, 12 or 14");
-  ExpectRefused("{" + h + R"(, "reprojection_error_px": -1})", "must be >= 0");
+  ExpectRefused("{" + h + R"(, "reprojection_error_px": -1})",
+                "reprojection_error_px: must be >= 0, got -1");
   EXPECT_THROW(ReadRigJson("/nonexistent/rig.json"), InputError);
   EXPECT_THROW(Rig::FromScale(std::nan("")), InputError);
   EXPECT_THROW(Rig::FromScale(0.0), InputError);

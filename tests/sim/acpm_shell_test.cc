@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "textile/sim/acpm.h"
 #include "textile/sim/cantilever_outputs.h"
 #include "textile/sim/elastica.h"
 #include "textile/sim/error.h"

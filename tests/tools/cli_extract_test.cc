@@ -191,7 +191,7 @@ TEST(CliExtract, BadInputExitsTwoWithOneLineAndNoOutput) {
       {Quote(good) + " --rig " + Quote(dir / "rig-negative.json"),
        "rig-negative.json: mm_per_px: must be > 0"},
       {Quote(good) + " --rig " + Quote(dir / "rig-array.json"),
-       "rig-array.json: expected a JSON object"},
+       "rig-array.json: (top level): must be a JSON object"},
       {Quote(good), "give exactly one of --rig"},
       {Quote(good) + scale + " --rig " + Quote(dir / "rig-missing.json"),
        "give exactly one of --rig"},

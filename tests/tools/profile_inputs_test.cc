@@ -122,7 +122,7 @@ TEST(ProfileInputs, BadInputIsRefusedNamingTheFileOrFlag) {
   const Case cases[] = {
       {{png}, none, "strip.png is a photo: give exactly one of --rig"},
       {{png}, both, "give exactly one of --rig RIG.json and --mm-per-px S (both given)"},
-      {{png}, bad_rig, "rig.json: expected a JSON object"},
+      {{png}, bad_rig, "rig.json: (top level): must be a JSON object"},
       {{png}, bad_step, "step_mm must lie in"},
       {{(dir / "text.jpg").string()}, scale, "text.jpg: not a supported image"},
       {{(dir / "missing.png").string()}, scale, "missing.png: cannot open photo"},

@@ -1,7 +1,7 @@
 #ifndef TEXTILE_SIM_ACPM_SHELL_H_
 #define TEXTILE_SIM_ACPM_SHELL_H_
 
-// The shell model of the virtual ACPM200 (acpm.h): the 3D cloth engine (cloth_problem.h,
+// The shell model of the virtual ACPM200 (acpm.h, scene types in acpm_types.h): the 3D cloth engine (cloth_problem.h,
 // static_solver.h) pushes the sample over the platform edge in quasi-static steps.
 //
 //   textile::AcpmOptions options;                    // plain 200 mm sample
@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "textile/sim/acpm.h"
+#include "textile/sim/acpm_types.h"
 #include "textile/sim/static_solver.h"
 
 namespace textile {
@@ -59,7 +59,7 @@ struct ShellAcpmSettings {
   bool Check(std::string* why) const;
 };
 
-// The AcpmModel of acpm.h (so RunAcpm can call it): crossings of every ray at z_i [m].
+// An AcpmModel (acpm_types.h; RunAcpm of acpm.h calls it through ShellAcpmModel): crossings of every ray at z_i [m].
 AcpmCrossings ShellAcpmCrossings(const Material& material, const AcpmOptions& options,
                                  const std::vector<double>& ray_z,
                                  const ShellAcpmSettings& settings = {});

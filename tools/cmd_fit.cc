@@ -13,9 +13,9 @@
 #include "common/profile_inputs.h"
 #include "textile/fit/clapp.h"
 #include "textile/fit/direct_fit.h"
+#include "textile/fit/fit_report.h"
 #include "textile/fit/profile.h"
 #include "textile/fit/profile_compare.h"
-#include "textile/sim/cantilever_outputs.h"
 #include "textile/sim/error.h"
 #include "textile/sim/material.h"
 #include "textile/sim/units.h"
@@ -46,30 +46,20 @@ std::string InputStem(const std::string& path) {
   return stem;
 }
 
-// JSON null for a value that is not available (an undetermined constant's σ).
-nlohmann::json OrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
-
 struct Outcome {
   BendingLaw law = BendingLaw::FromKes(1, 1, 0);
   nlohmann::json report;
   std::vector<ProfileComparison> comparisons;  // per profile, for the plot
-  double offset = 0.0;
   double kappa_max = 0.0;
   std::string brief;
   std::string notes;  // what the user should know about a fit that succeeded ("; "-joined)
 };
 
-// The 3×3 covariance of (b1, b2, c1) in gf·cm, gf·cm, gf·cm² (rows and columns in that order).
-nlohmann::json CovarianceKesJson(const Eigen::Matrix3d& si) {
-  const double f[3] = {units::SiStiffnessToKes(1.0), units::SiStiffnessToKes(1.0),
-                       units::SiQuadraticToKes(1.0)};
-  nlohmann::json rows = nlohmann::json::array();
-  for (int i = 0; i < 3; ++i) {
-    nlohmann::json row = nlohmann::json::array();
-    for (int j = 0; j < 3; ++j) row.push_back(OrNull(si(i, j) * f[i] * f[j]));
-    rows.push_back(row);
-  }
-  return rows;
+// A fit can only hand out a law that a material file accepts: Clapp's regression, for one,
+// can wander to constants no fabric has when the polynomial is poor.
+void CheckFittedLaw(const BendingLaw& law, double rho, const std::string& method) {
+  if (std::string why; !FittedLawMaterial(law, rho, &why))
+    throw ComputeError("fit (" + method + ") gave an implausible law: " + why);
 }
 
 Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double rho) {
@@ -84,45 +74,14 @@ Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double
   Outcome out;
   for (const std::string& n : notes) out.notes += (out.notes.empty() ? "" : "; ") + n;
   out.law = *fit.law;
-  out.offset = fit.offset;
   out.kappa_max = fit.kappa_max;
   out.brief = fit.BriefReport();
-  nlohmann::json per = nlohmann::json::array();
   for (size_t i = 0; i < profiles.size(); ++i) {
-    const auto& r = fit.profiles[i];
-    per.push_back({{"source", r.source},
-                   {"overhang_mm", r.overhang * 1e3},
-                   {"data_length_mm", r.data_length * 1e3},
-                   {"rms_mm", r.rms * 1e3},
-                   {"max_mm", r.max * 1e3},
-                   {"clamp_curvature_per_cm", units::SiCurvatureToKes(r.clamp_curvature)}});
-    out.comparisons.push_back(
-        CompareWithElastica(out.law, rho, profiles[i], r.overhang, fit.offset, fit.rotation));
+    out.comparisons.push_back(CompareWithElastica(
+        out.law, rho, profiles[i], fit.profiles[i].overhang, fit.offset, fit.rotation));
   }
-  out.report = {{"method", "direct"},
-                {"b1_sd", OrNull(units::SiStiffnessToKes(fit.b1_sd))},
-                {"b2_sd", OrNull(units::SiStiffnessToKes(fit.b2_sd))},
-                {"c1_sd", OrNull(units::SiQuadraticToKes(fit.c1_sd))},
-                {"sd_units", "kes"},
-                {"covariance_kes", CovarianceKesJson(fit.covariance)},
-                {"rms_mm", fit.rms * 1e3},
-                {"start", fit.start},
-                {"point_scatter_mm", fit.point_scatter * 1e3},
-                {"fit_pattern", fit.fit_pattern.empty() ? nlohmann::json() : nlohmann::json(fit.fit_pattern)},
-                {"b1_observed", fit.b1_observed},
-                {"b2_observed", fit.b2_observed},
-                {"c1_observed", fit.c1_observed},
-                {"observability", fit.observability},
-                {"kappa_max_per_cm", units::SiCurvatureToKes(fit.kappa_max)},
-                {"offset_mm", fit.offset * 1e3},
-                {"offset_fitted", o.fit_offset},
-                {"rotation_deg", fit.rotation * 180.0 / M_PI},
-                {"rotation_fitted", o.fit_rotation},
-                {"note", out.notes.empty() ? nlohmann::json() : nlohmann::json(out.notes)},
-                {"robust_scale_mm", a.robust_mm},
-                {"iterations", fit.iterations},
-                {"seconds", fit.seconds},
-                {"profiles", per}};
+  CheckFittedLaw(out.law, rho, "direct");
+  out.report = FitReportJson(fit, o, rho, notes, {.robust_scale_mm = a.robust_mm});
   return out;
 }
 
@@ -133,56 +92,10 @@ Outcome RunClapp(const std::vector<Profile>& profiles, double rho) {
   out.law = *fit.law;
   out.kappa_max = fit.kappa_max;
   out.brief = fit.BriefReport();
-  nlohmann::json per = nlohmann::json::array();
-  double s2 = 0.0;
-  int n = 0;
-  for (size_t i = 0; i < profiles.size(); ++i) {
-    // Graded like the direct fit: the strip re-simulated with the fitted law at the length of
-    // Clapp's smooth curve, through the origin (Clapp's method has no offset).
-    const double L = fit.profiles[i].curve_length;
-    const ProfileComparison c = CompareWithElastica(out.law, rho, profiles[i], L, 0.0);
-    s2 += c.rms * c.rms * profiles[i].size();
-    n += static_cast<int>(profiles[i].size());
-    per.push_back({{"source", profiles[i].source},
-                   {"overhang_mm", L * 1e3},
-                   {"data_length_mm", profiles[i].s.back() * 1e3},
-                   {"rms_mm", c.rms * 1e3},
-                   {"max_mm", c.max * 1e3},
-                   {"polynomial_rms_mm", fit.profiles[i].residual_rms * 1e3}});
-    out.comparisons.push_back(c);
-  }
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  out.report = {
-      {"method", "clapp"},
-      {"b1_sd", OrNull(fit.covariance_available ? units::SiStiffnessToKes(fit.sd_b1) : nan)},
-      {"b2_sd", OrNull(fit.covariance_available ? units::SiStiffnessToKes(fit.sd_b2) : nan)},
-      {"c1_sd", OrNull(fit.covariance_available ? units::SiQuadraticToKes(fit.sd_c1) : nan)},
-      {"sd_units", "kes"},
-      {"rms_mm", std::sqrt(s2 / n) * 1e3},
-      {"b2_observed", fit.b2_observed},
-      {"kappa_max_per_cm", units::SiCurvatureToKes(fit.kappa_max)},
-      {"moment_rms_gfcm_per_cm", units::SiMomentToKes(fit.moment_rms)},
-      {"profiles", per}};
+  out.comparisons = GradeClappFit(fit, profiles, rho);
+  CheckFittedLaw(out.law, rho, "clapp");
+  out.report = FitReportJson(fit, profiles, out.comparisons, rho);
   return out;
-}
-
-// Classic outputs of the fitted law (docs/spec/cantilever.md): what the 41.5° test would report for
-// this material, and how that G relates to b1 and b2.
-void AddClassicOutputs(const BendingLaw& law, double rho, nlohmann::json* report) {
-  const BarrierCrossing x = FindBarrierCrossing(law, rho);
-  if (!x.converged) {
-    (*report)["classic_note"] = "no 41.5° crossing: " + x.message;
-    return;
-  }
-  const ClassicOutputs c = ComputeClassicOutputs(rho, x.overhang);
-  (*report)["crossing_overhang_mm"] = x.overhang * 1e3;
-  (*report)["bending_length_mm"] = c.bending_length * 1e3;
-  (*report)["flexural_rigidity_uNm"] = c.rigidity_micro_nm();
-  (*report)["flexural_rigidity_mgcm"] = c.rigidity_mg_cm();
-  (*report)["flexural_rigidity_gfcm"] = c.rigidity_gf_cm();
-  (*report)["G_over_b1"] = c.flexural_rigidity / law.b1();
-  (*report)["G_over_b2"] = c.flexural_rigidity / law.b2();
-  (*report)["classic_note"] = c.RelationToLaw(law);
 }
 
 void Plot(const FitArgs& a, const std::vector<Profile>& profiles, const Outcome& o, double rho,
@@ -308,23 +221,11 @@ void Run(const FitArgs& a) {
   Outcome o;
   try {
     o = a.method == "direct" ? RunDirect(a, profiles, rho) : RunClapp(profiles, rho);
-    // A fit can only hand out a law that a material file accepts: Clapp's regression, for one,
-    // can wander to constants no fabric has when the polynomial is poor.
-    try {
-      Material probe;
-      probe.areal_density = rho;
-      probe.bending = o.law;
-      ParseMaterialJson(MaterialToJson(probe).dump(), "fitted law");
-    } catch (const InputError& e) {
-      throw ComputeError(std::string("fit (") + a.method +
-                         ") gave an implausible law: " + e.what());
-    }
   } catch (const ComputeError& e) {
     if (photo_warnings.empty()) throw;
     throw ComputeError(e.what() + std::string(" (extraction warnings") + photo_warnings + ")");
   }
 
-  AddClassicOutputs(o.law, rho, &o.report);
   o.report["inputs"] = a.inputs;
   if (!photos.empty()) o.report["photos"] = photos;
   o.report["areal_density_gsm"] = a.gsm;

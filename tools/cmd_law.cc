@@ -188,9 +188,7 @@ void Plot(const Material& m, const std::string& material_path, double kappa_max,
   if (!measured.empty() || m.fit.is_object()) {
     if (const auto cov = m.bending_weft ? std::nullopt : FitCovariance(m, material_path, &no_band)) {
       const BendingLaw law = m.EffectiveLaw();
-      double reach = kappa_max;
-      if (m.fit.contains("kappa_max_per_cm") && m.fit["kappa_max_per_cm"].is_number())
-        reach = std::min(reach, units::KesCurvatureToSi(m.fit["kappa_max_per_cm"].get<double>()));
+      const double reach = std::min(kappa_max, FitCurvatureReach(m).value_or(kappa_max));
       chart::Series lo{.label = "±1σ of the fit", .dashed = true}, hi{.dashed = true};
       lo.color = hi.color = chart::PaletteColor(0);
       lo.line_width = hi.line_width = 1.0;
@@ -267,9 +265,7 @@ void Run(const LawArgs& a) {
       measured.push_back(ReadMomentCurvatureCsv(f));
       for (double k : measured.back().kappa) reach = std::max(reach, k);
     }
-    if (m.fit.is_object() && m.fit.contains("kappa_max_per_cm") &&
-        m.fit["kappa_max_per_cm"].is_number())
-      reach = std::max(reach, units::KesCurvatureToSi(m.fit["kappa_max_per_cm"].get<double>()));
+    if (const auto fit_reach = FitCurvatureReach(m)) reach = std::max(reach, *fit_reach);
     if (reach > 0.0) kappa_max = 1.1 * reach;
   }
   if (!a.plot.empty()) Plot(m, a.material, kappa_max, measured, a.log_kappa, a.plot);

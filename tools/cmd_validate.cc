@@ -18,11 +18,12 @@
 #include "common/cli.h"
 #include "common/profile_inputs.h"
 #include "textile/fit/direct_fit.h"
+#include "textile/fit/fit_report.h"
 #include "textile/fit/profile_compare.h"
 #include "textile/fit/validate.h"
-#include "textile/sim/cantilever_outputs.h"
 #include "textile/sim/error.h"
 #include "textile/sim/material.h"
+#include "textile/sim/note.h"
 #include "textile/sim/units.h"
 
 namespace textile::cli {
@@ -61,67 +62,33 @@ nlohmann::json ModelJson(const ModelComparison& k) {
 // JSON null for a value that is not available (an undetermined constant's σ).
 nlohmann::json OrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
 
-// The fit report `textile fit` writes into a material's `fit` (docs/spec/cli.md; cmd_fit.cc's
-// RunDirect and AddClassicOutputs), for the direct fit with default options that validate runs: no
-// rotation, offset fitted, Cauchy scale options.robust_scale. The classic outputs: what the
-// 41.5° test would report for this law, and how that G relates to b1 and b2.
-nlohmann::json FitReport(const DirectFitSummary& fit, const DirectFitOptions& options,
-                         const std::vector<LoadedProfile>& loaded, double gsm) {
-  const double rho = units::GsmToSi(gsm);
-  nlohmann::json per = nlohmann::json::array();
-  for (const auto& r : fit.profiles) {
-    per.push_back({{"source", r.source},
-                   {"overhang_mm", units::MToMm(r.overhang)},
-                   {"data_length_mm", units::MToMm(r.data_length)},
-                   {"rms_mm", units::MToMm(r.rms)},
-                   {"max_mm", units::MToMm(r.max)},
-                   {"clamp_curvature_per_cm", units::SiCurvatureToKes(r.clamp_curvature)}});
-  }
-  nlohmann::json report = {{"method", "direct"},
-                           {"b1_sd", OrNull(units::SiStiffnessToKes(fit.b1_sd))},
-                           {"b2_sd", OrNull(units::SiStiffnessToKes(fit.b2_sd))},
-                           {"c1_sd", OrNull(units::SiQuadraticToKes(fit.c1_sd))},
-                           {"sd_units", "kes"},
-                           {"rms_mm", units::MToMm(fit.rms)},
-                           {"b1_observed", fit.b1_observed},
-                           {"b2_observed", fit.b2_observed},
-                           {"c1_observed", fit.c1_observed},
-                           {"observability", fit.observability},
-                           {"kappa_max_per_cm", units::SiCurvatureToKes(fit.kappa_max)},
-                           {"offset_mm", units::MToMm(fit.offset)},
-                           {"offset_fitted", options.fit_offset},
-                           {"rotation_deg", fit.rotation * 180.0 / M_PI},
-                           {"rotation_fitted", options.fit_rotation},
-                           {"robust_scale_mm", units::MToMm(options.robust_scale)},
-                           {"iterations", fit.iterations},
-                           {"seconds", fit.seconds},
-                           {"profiles", per}};
-  const BendingLaw& law = *fit.law;
-  const BarrierCrossing x = FindBarrierCrossing(law, rho);
-  if (x.converged) {
-    const ClassicOutputs c = ComputeClassicOutputs(rho, x.overhang);
-    report["crossing_overhang_mm"] = units::MToMm(x.overhang);
-    report["bending_length_mm"] = units::MToMm(c.bending_length);
-    report["flexural_rigidity_uNm"] = c.rigidity_micro_nm();
-    report["flexural_rigidity_mgcm"] = c.rigidity_mg_cm();
-    report["flexural_rigidity_gfcm"] = c.rigidity_gf_cm();
-    report["G_over_b1"] = c.flexural_rigidity / law.b1();
-    report["G_over_b2"] = c.flexural_rigidity / law.b2();
-    report["classic_note"] = c.RelationToLaw(law);
-  } else {
-    report["classic_note"] = "no 41.5° crossing: " + x.message;
-  }
+// validate.json's `notes`: [{"code", "text"}].
+nlohmann::json NotesJson(const std::vector<Note>& notes) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const Note& n : notes) list.push_back({{"code", n.code}, {"text", n.text}});
+  return list;
+}
+
+// The material with the fit report `textile fit` writes (fit_report.h), for the direct fit with
+// default options that validate runs, and the verdicts.
+Material FittedMaterial(const ValidationSummary& v, const std::vector<LoadedProfile>& loaded,
+                        double gsm, const std::string& report_path) {
+  Material fitted = v.material;
+  fitted.fit = FitReportJson(v.fit, v.fit_options, units::GsmToSi(gsm),
+                             v.NoteTexts(validation_note::kFit), {.diagnostics = false});
   nlohmann::json photos = nlohmann::json::array();
-  for (const auto& in : loaded) {
-    if (!in.extraction) continue;
-    photos.push_back(ExtractionJson(in));
-  }
   std::vector<std::string> inputs;
-  for (const auto& in : loaded) inputs.push_back(in.source);
-  report["inputs"] = inputs;
-  if (!photos.empty()) report["photos"] = photos;
-  report["areal_density_gsm"] = gsm;
-  return report;
+  for (const auto& in : loaded) {
+    if (in.extraction) photos.push_back(ExtractionJson(in));
+    inputs.push_back(in.source);
+  }
+  fitted.fit["inputs"] = inputs;
+  if (!photos.empty()) fitted.fit["photos"] = photos;
+  fitted.fit["areal_density_gsm"] = gsm;
+  fitted.fit["validate"] = report_path;
+  fitted.fit["verdict"] = v.pass ? "pass" : "fail";
+  fitted.fit["holdout_verdict"] = HoldoutVerdictName(v.holdout_verdict);
+  return fitted;
 }
 
 void Plot(const ValidationSummary& v, const std::vector<Profile>& profiles, AtomicFile& out) {
@@ -252,7 +219,9 @@ nlohmann::json HoldoutJson(const ValidationSummary& v) {
   return list;
 }
 
-void Run(const ValidateArgs& a) {
+// Flags out of range, before any work (the library would refuse some only after the inputs
+// are read, in its own words).
+void CheckFlags(const ValidateArgs& a) {
   if (!std::isfinite(a.gsm) || a.gsm < 1.0 || a.gsm > 1e4)
     throw InputError("--gsm must be an areal density in [1, 10000] g/m², got " + Num(a.gsm));
   if (!std::isfinite(a.tolerance_mm) || a.tolerance_mm <= 0.0 || a.tolerance_mm > 50.0)
@@ -264,63 +233,24 @@ void Run(const ValidateArgs& a) {
   // As textile fit refuses the direct fit's options with --method clapp.
   if (a.width_given && a.model == "elastica")
     throw InputError("--width-mm: the shell's strip width; --model elastica simulates no shell");
-  ValidationOptions options;
-  options.tolerance = units::MmToM(a.tolerance_mm);
-  options.run_elastica = a.model != "shell";
-  options.run_shell = a.model != "elastica";
-  options.strip_width = units::MmToM(a.width_mm);
-  const bool run_elastica = options.run_elastica, run_shell = options.run_shell;
-  const PhotoInputOptions photo = a.photo.Options();
-  const std::string report_path = (std::filesystem::path(a.out_dir) / "validate.json").string();
-  const std::string png_path = (std::filesystem::path(a.out_dir) / "validate.png").string();
-  const std::string material_path = (std::filesystem::path(a.out_dir) / "fitted.json").string();
-  // Before any work: an input in the folder under an output's name would be replaced by it
-  // (the photo by the chart, the rig by the fitted material). (A profile given twice is refused
-  // by LoadProfileInputs, as in textile fit.)
-  std::vector<std::pair<std::string, std::string>> inputs{{"--rig", a.photo.rig_file}};
-  for (const std::string& in : a.inputs) inputs.emplace_back(in, in);
-  CheckDistinctOutputs({{"-o", report_path}, {"-o", png_path}, {"-o", material_path}}, inputs);
-  const std::vector<LoadedProfile> loaded = LoadProfileInputs(a.inputs, photo);
-  const bool any_photo =
-      std::any_of(loaded.begin(), loaded.end(), [](const auto& in) { return in.from_photo; });
-  // Valid photo flags with profiles only are not an error (textile fit takes them too, and a
-  // glob may or may not match photos), but the run does not use them: say so.
-  std::string note;
-  nlohmann::json notes = nlohmann::json::array();
-  if (!any_photo && !a.photo_flags_given.empty()) {
-    note = "no input is a photo: ";
-    for (size_t f = 0; f < a.photo_flags_given.size(); ++f)
-      note += (f ? ", " : "") + a.photo_flags_given[f];
-    note += " not used";
-    notes.push_back({{"code", "photo_flags_unused"}, {"text", note}});
-  }
-  const OutputFolder folder(a.out_dir);  // made when the files are committed
-  // Fail fast on an unusable folder; the three files appear together or not at all.
-  AtomicFileSet outputs;
-  AtomicFile& report_file = outputs.Add(report_path, folder.stage_dir());
-  AtomicFile& png_file = outputs.Add(png_path, folder.stage_dir());
-  AtomicFile& material_file = outputs.Add(material_path, folder.stage_dir());
+}
 
-  std::vector<Profile> profiles;
-  for (const auto& in : loaded) profiles.push_back(in.profile);
-  // The fit textile fit runs (a tilted rig is found and fitted with its rotation), the same
-  // cantilevers simulated, and each profile predicted by the law fitted to the others.
-  const ValidationSummary v = ValidateFit(profiles, units::GsmToSi(a.gsm), options);
-  if (!v.completed) throw ComputeError(v.message);
+struct OutputPaths {
+  std::string report, png, material;  // validate.json, validate.png, fitted.json
+};
+
+OutputPaths OutputPathsIn(const std::string& dir) {
+  const std::filesystem::path d(dir);
+  return {(d / "validate.json").string(), (d / "validate.png").string(),
+          (d / "fitted.json").string()};
+}
+
+// validate.json: the run's figures, verdicts and notes; `note`: the one-line note.
+nlohmann::json ReportJson(const ValidateArgs& a, const ValidationSummary& v,
+                          const std::vector<LoadedProfile>& loaded, const std::vector<Note>& notes,
+                          const std::string& note, const OutputPaths& out) {
   const DirectFitSummary& fit = v.fit;
-  const BendingLaw& law = v.material.bending;
-  std::string fit_note;  // as textile fit's report has it: the fit's own notes only
-  std::vector<std::string> holdout_notes;
-  for (const ValidationNote& n : v.notes) {
-    notes.push_back({{"code", ValidationNoteCodeName(n.code)}, {"text", n.text}});
-    if (n.code == ValidationNoteCode::kFit)
-      fit_note += (fit_note.empty() ? "" : "; ") + n.text;
-    else if (n.code != ValidationNoteCode::kHeldOutFitFailed)  // the held-out lines say it
-      holdout_notes.push_back(n.text);
-  }
-  if (!fit_note.empty()) note += (note.empty() ? "" : "; ") + fit_note;
-  const bool holdout_pass = v.holdout_verdict != HoldoutVerdict::kFail;
-
+  const bool run_elastica = v.options.run_elastica, run_shell = v.options.run_shell;
   nlohmann::json per = nlohmann::json::array();
   for (size_t i = 0; i < v.profiles.size(); ++i) {
     const ProfileValidation& k = v.profiles[i];
@@ -335,64 +265,47 @@ void Run(const ValidateArgs& a) {
                    {"why", k.why}});
   }
   const std::string shell_notes = v.shell_notes;
-  nlohmann::json report = {
-      {"inputs", a.inputs},
-      {"areal_density_gsm", a.gsm},
-      {"law_kes", LawToJson(law, false)},
-      {"fit",
-       {{"rms_mm", units::MToMm(fit.rms)},
-        {"offset_mm", units::MToMm(fit.offset)},
-        {"b1_sd_kes", OrNull(units::SiStiffnessToKes(fit.b1_sd))},
-        {"b2_sd_kes", OrNull(units::SiStiffnessToKes(fit.b2_sd))},
-        {"c1_sd_kes", OrNull(units::SiQuadraticToKes(fit.c1_sd))},
-        {"observability", fit.observability}}},
-      {"models",
-       {{"elastica", run_elastica ? "simulated" : "not run (--model shell)"},
-        {"shell", run_shell ? "simulated: 3D shell, tensor bending, " + shell_notes + ", strip " +
-                                  Num(a.width_mm) + " mm wide"
-                            : "not run (--model elastica)"}}},
-      {"tolerance",
-       {{"rms_mm", a.tolerance_mm},
-        {"max_mm", kMaxOverRms * a.tolerance_mm},
-        {"tip_mm", kMaxOverRms * a.tolerance_mm}}},
-      {"profiles", per},
-      {"verdict", v.pass ? "pass" : "fail"},
-      {"holdout_method",
-       "leave-one-out: each profile predicted at its fitted overhang by the law, offset and "
-       "rotation fitted to the other profiles, graded by the tolerance; sigma: that fit's "
-       "covariance through the elastica's sensitivities (docs/validation.md)"},
-      {"holdout", HoldoutJson(v)},
-      {"holdout_verdict", HoldoutVerdictName(v.holdout_verdict)},
-      {"note", note.empty() ? nlohmann::json() : nlohmann::json(note)},
-      {"notes", notes},
-      {"png", png_path},
-      {"material", material_path}};
-  const bool all_pass = v.pass && holdout_pass;
-  if (all_pass || !a.strict) {
-    Material fitted = v.material;
-    fitted.fit = FitReport(fit, v.fit_options, loaded, a.gsm);
-    fitted.fit["note"] = fit_note.empty() ? nlohmann::json() : nlohmann::json(fit_note);
-    fitted.fit["validate"] = report_path;
-    fitted.fit["verdict"] = v.pass ? "pass" : "fail";
-    fitted.fit["holdout_verdict"] = HoldoutVerdictName(v.holdout_verdict);
-    material_file.Write(MaterialToJson(fitted).dump(2) + "\n");
-    Plot(v, profiles, png_file);
-    report_file.Write(report.dump(2) + "\n");
-    outputs.Commit();
-  }
-  if (!all_pass && a.strict) {
-    std::string why;
-    for (const auto& k : v.profiles)
-      if (!k.pass) why += (why.empty() ? "" : "; ") + k.source + ": " + k.why;
-    for (const auto& h : v.holdout)
-      if (!h.ok) why += (why.empty() ? "" : "; ") + h.source + " held out: " + h.why;
-    throw ComputeError("validation failed (--strict): " + why);
-  }
+  return {{"inputs", a.inputs},
+          {"areal_density_gsm", a.gsm},
+          {"law_kes", LawToJson(v.material.bending, false)},
+          {"fit",
+           {{"rms_mm", units::MToMm(fit.rms)},
+            {"offset_mm", units::MToMm(fit.offset)},
+            {"b1_sd_kes", OrNull(units::SiStiffnessToKes(fit.b1_sd))},
+            {"b2_sd_kes", OrNull(units::SiStiffnessToKes(fit.b2_sd))},
+            {"c1_sd_kes", OrNull(units::SiQuadraticToKes(fit.c1_sd))},
+            {"observability", fit.observability}}},
+          {"models",
+           {{"elastica", run_elastica ? "simulated" : "not run (--model shell)"},
+            {"shell", run_shell ? "simulated: 3D shell, tensor bending, " + shell_notes +
+                                      ", strip " + Num(a.width_mm) + " mm wide"
+                                : "not run (--model elastica)"}}},
+          {"tolerance",
+           {{"rms_mm", a.tolerance_mm},
+            {"max_mm", kMaxOverRms * a.tolerance_mm},
+            {"tip_mm", kMaxOverRms * a.tolerance_mm}}},
+          {"profiles", per},
+          {"verdict", v.pass ? "pass" : "fail"},
+          {"holdout_method",
+           "leave-one-out: each profile predicted at its fitted overhang by the law, offset and "
+           "rotation fitted to the other profiles, graded by the tolerance; sigma: that fit's "
+           "covariance through the elastica's sensitivities (docs/validation.md)"},
+          {"holdout", HoldoutJson(v)},
+          {"holdout_verdict", HoldoutVerdictName(v.holdout_verdict)},
+          {"note", note.empty() ? nlohmann::json() : nlohmann::json(note)},
+          {"notes", NotesJson(notes)},
+          {"png", out.png},
+          {"material", out.material}};
+}
 
-  if (a.json) {
-    PrintJson(report);
-    return;
-  }
+// The text report: the law, each profile's figures, the held-out predictions, the verdicts.
+void PrintText(const ValidateArgs& a, const ValidationSummary& v, const std::string& note,
+               const OutputPaths& out) {
+  const DirectFitSummary& fit = v.fit;
+  const BendingLaw& law = v.material.bending;
+  const bool run_elastica = v.options.run_elastica, run_shell = v.options.run_shell;
+  const bool holdout_pass = v.holdout_verdict != HoldoutVerdict::kFail;
+  const std::string& shell_notes = v.shell_notes;
   const double tol_mm = a.tolerance_mm;
   std::cout << "fitted law: b1 = " << Num(law.b1_kes(), 5)
             << " gf·cm, b2 = " << Num(law.b2_kes(), 5) << " gf·cm, c1 = " << Num(law.c1_kes(), 5)
@@ -445,14 +358,90 @@ void Run(const ValidateArgs& a) {
     }
   }
   if (!note.empty()) std::cout << "note: " << note << "\n";
-  for (const std::string& n : holdout_notes) std::cout << "note: " << n << "\n";
+  // The held-out notes, each on its line; a held-out fit that failed is said by its own line.
+  for (const Note& n : v.notes)
+    if (n.code != validation_note::kFit && n.code != validation_note::kHeldOutFitFailed)
+      std::cout << "note: " << n.text << "\n";
   std::cout << "goodness of fit: " << (v.pass ? "PASS" : "FAIL") << " (tolerance: rms ≤ "
             << Num(tol_mm) << " mm, max and tip ≤ " << Num(kMaxOverRms * tol_mm) << " mm)\n"
             << "held out: "
             << (v.holdout_verdict == HoldoutVerdict::kNone ? "nothing (one profile)"
                 : holdout_pass                             ? "PASS (the same tolerance)"
                                                            : "FAIL (the same tolerance)")
-            << "\nwrote " << report_path << ", " << png_path << ", " << material_path << "\n";
+            << "\nwrote " << out.report << ", " << out.png << ", " << out.material << "\n";
+}
+
+// Valid photo flags with profiles only are not an error (textile fit takes them too, and a
+// glob may or may not match photos), but the run does not use them: say so.
+std::vector<Note> UnusedPhotoFlags(const ValidateArgs& a,
+                                   const std::vector<LoadedProfile>& loaded) {
+  const bool any_photo =
+      std::any_of(loaded.begin(), loaded.end(), [](const auto& in) { return in.from_photo; });
+  if (any_photo || a.photo_flags_given.empty()) return {};
+  std::string text = "no input is a photo: ";
+  for (size_t f = 0; f < a.photo_flags_given.size(); ++f)
+    text += (f ? ", " : "") + a.photo_flags_given[f];
+  return {{"photo_flags_unused", text + " not used"}};
+}
+
+// validate.json's `note` and the text's first note line: the photo flags and the fit's own
+// notes (as textile fit's report has them); the held-out notes print apart.
+std::string OneLineNote(const std::vector<Note>& notes) {
+  std::string note;
+  for (const Note& n : notes)
+    if (n.code == "photo_flags_unused" || n.code == validation_note::kFit)
+      note += (note.empty() ? "" : "; ") + n.text;
+  return note;
+}
+
+void Run(const ValidateArgs& a) {
+  CheckFlags(a);
+  ValidationOptions options;
+  options.tolerance = units::MmToM(a.tolerance_mm);
+  options.run_elastica = a.model != "shell";
+  options.run_shell = a.model != "elastica";
+  options.strip_width = units::MmToM(a.width_mm);
+  const PhotoInputOptions photo = a.photo.Options();
+  const OutputPaths out = OutputPathsIn(a.out_dir);
+  // Before any work: an input in the folder under an output's name would be replaced by it
+  // (the photo by the chart, the rig by the fitted material). (A profile given twice is refused
+  // by LoadProfileInputs, as in textile fit.)
+  std::vector<std::pair<std::string, std::string>> inputs{{"--rig", a.photo.rig_file}};
+  for (const std::string& in : a.inputs) inputs.emplace_back(in, in);
+  CheckDistinctOutputs({{"-o", out.report}, {"-o", out.png}, {"-o", out.material}}, inputs);
+  const std::vector<LoadedProfile> loaded = LoadProfileInputs(a.inputs, photo);
+  std::vector<Note> notes = UnusedPhotoFlags(a, loaded);
+  const OutputFolder folder(a.out_dir);  // made when the files are committed
+  // Fail fast on an unusable folder; the three files appear together or not at all.
+  AtomicFileSet outputs;
+  AtomicFile& report_file = outputs.Add(out.report, folder.stage_dir());
+  AtomicFile& png_file = outputs.Add(out.png, folder.stage_dir());
+  AtomicFile& material_file = outputs.Add(out.material, folder.stage_dir());
+
+  std::vector<Profile> profiles;
+  for (const auto& in : loaded) profiles.push_back(in.profile);
+  // The fit textile fit runs (a tilted rig is found and fitted with its rotation), the same
+  // cantilevers simulated, and each profile predicted by the law fitted to the others.
+  const ValidationSummary v = ValidateFit(profiles, units::GsmToSi(a.gsm), options);
+  if (!v.completed) throw ComputeError(v.message);
+  notes.insert(notes.end(), v.notes.begin(), v.notes.end());
+  const std::string note = OneLineNote(notes);
+  const nlohmann::json report = ReportJson(a, v, loaded, notes, note, out);
+  if (v.AllPass() || !a.strict) {
+    material_file.Write(MaterialToJson(FittedMaterial(v, loaded, a.gsm, out.report)).dump(2) +
+                        "\n");
+    Plot(v, profiles, png_file);
+    report_file.Write(report.dump(2) + "\n");
+    outputs.Commit();
+  } else {
+    throw ComputeError("validation failed (--strict): " + v.FailureReason());
+  }
+
+  if (a.json) {
+    PrintJson(report);
+    return;
+  }
+  PrintText(a, v, note, out);
 }
 
 }  // namespace

@@ -126,4 +126,11 @@ std::optional<Eigen::Matrix3d> FitCovariance(const Material& m, const std::strin
   return cov;
 }
 
+std::optional<double> FitCurvatureReach(const Material& m) {
+  const nlohmann::json& f = m.fit;
+  if (!f.is_object() || !f.contains("kappa_max_per_cm") || !f["kappa_max_per_cm"].is_number())
+    return std::nullopt;
+  return units::KesCurvatureToSi(f["kappa_max_per_cm"].get<double>());
+}
+
 }  // namespace textile

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <utility>
 
+#include "textile/fit/fit_report.h"
 #include "textile/sim/error.h"
 #include "textile/sim/polyline.h"
 #include "textile/sim/units.h"
@@ -28,21 +29,12 @@ void Join(const std::string& part, const char* separator, std::string* text) {
   *text += (text->empty() ? "" : separator) + part;
 }
 
-// The fitted law as the material every simulation takes, if a material file would take it: a
-// fit to a straight or vertical strip can run to constants no fabric has. Else nullopt, the
-// reason in *why.
+// The fitted law as the material every simulation takes, named "validated fit"
+// (FittedLawMaterial: none when a material file would refuse it, the reason in *why).
 std::optional<Material> MaterialOfLaw(const BendingLaw& law, double areal_density,
                                       std::string* why) {
-  Material m;
-  m.name = "validated fit";
-  m.areal_density = areal_density;
-  m.bending = law;
-  try {
-    ParseMaterialJson(MaterialToJson(m).dump(), "fitted law");
-  } catch (const InputError& e) {
-    *why = e.what();
-    return std::nullopt;
-  }
+  std::optional<Material> m = FittedLawMaterial(law, areal_density, why);
+  if (m) m->name = "validated fit";
   return m;
 }
 
@@ -129,7 +121,7 @@ bool FitAllProfiles(Validation* v) {
   std::vector<std::string> notes;
   out.fit = FitDirectCheckingTilt(v->profiles, v->areal_density, v->options.fit, &notes,
                                   &out.fit_options);
-  for (const std::string& n : notes) out.notes.push_back({ValidationNoteCode::kFit, n});
+  for (const std::string& n : notes) out.notes.push_back({validation_note::kFit, n});
   if (!out.fit.converged || !out.fit.law) {
     out.message = "fit: " + out.fit.message;
     return false;
@@ -241,7 +233,7 @@ void PredictEachHeldOut(Validation* v) {
   if (!o.hold_out || v->profiles.size() < 2) {
     out.holdout_verdict = HoldoutVerdict::kNone;
     out.notes.push_back(
-        {ValidationNoteCode::kNothingHeldOut,
+        {validation_note::kNothingHeldOut,
          o.hold_out ? "one profile: nothing is held out, only the goodness of fit is graded; "
                       "profiles at two or more overhangs test whether the law predicts one it "
                       "was not fitted to"
@@ -253,10 +245,10 @@ void PredictEachHeldOut(Validation* v) {
     HeldOutProfile h = PredictHeldOut(v, i);
     if (!h.predicted) {
       out.notes.push_back(
-          {ValidationNoteCode::kHeldOutFitFailed, h.source + " was not predicted: " + h.why});
+          {validation_note::kHeldOutFitFailed, h.source + " was not predicted: " + h.why});
     } else {
       if (!h.sigma_complete) {
-        out.notes.push_back({ValidationNoteCode::kSigmaIncomplete,
+        out.notes.push_back({validation_note::kSigmaIncomplete,
                              h.source + ": the fit to the other profiles does not determine "
                                         "every constant; its σ leaves the undetermined ones out "
                                         "and is a lower bound"});
@@ -264,7 +256,7 @@ void PredictEachHeldOut(Validation* v) {
       const double rms_sigma = h.elastica.check.run ? h.elastica.sigma.rms : h.shell.sigma.rms;
       if (2.0 * rms_sigma > o.tolerance) {
         out.notes.push_back(
-            {ValidationNoteCode::kPredictionUncertain,
+            {validation_note::kPredictionUncertain,
              h.source + ": the prediction's own 2σ (" + Mm(2.0 * rms_sigma) +
                  " mm rms) exceeds the tolerance: the other profiles determine the law too "
                  "loosely for this test to be sharp"});
@@ -308,20 +300,20 @@ const char* HoldoutVerdictName(HoldoutVerdict verdict) {
   return "none";
 }
 
-const char* ValidationNoteCodeName(ValidationNoteCode code) {
-  switch (code) {
-    case ValidationNoteCode::kFit:
-      return "fit";
-    case ValidationNoteCode::kNothingHeldOut:
-      return "nothing_held_out";
-    case ValidationNoteCode::kHeldOutFitFailed:
-      return "held_out_fit_failed";
-    case ValidationNoteCode::kSigmaIncomplete:
-      return "sigma_incomplete";
-    case ValidationNoteCode::kPredictionUncertain:
-      break;
-  }
-  return "prediction_uncertain";
+std::string ValidationSummary::FailureReason() const {
+  std::string why;
+  for (const ProfileValidation& k : profiles)
+    if (!k.pass) Join(k.source + ": " + k.why, "; ", &why);
+  for (const HeldOutProfile& h : holdout)
+    if (!h.ok) Join(h.source + " held out: " + h.why, "; ", &why);
+  return why;
+}
+
+std::vector<std::string> ValidationSummary::NoteTexts(std::string_view code) const {
+  std::vector<std::string> texts;
+  for (const Note& n : notes)
+    if (n.code == code) texts.push_back(n.text);
+  return texts;
 }
 
 std::string ValidationSummary::BriefReport() const {

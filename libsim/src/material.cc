@@ -4,10 +4,10 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 #include "textile/sim/error.h"
-#include "textile/sim/json_fields.h"
 #include "textile/sim/json_text.h"
 #include "textile/sim/textile_range.h"
 #include "textile/sim/units.h"
@@ -26,37 +26,61 @@ constexpr double kMinBKes = range::kMinStiffnessKes, kMaxBKes = range::kMaxStiff
 constexpr double kMaxAbsC1Kes = range::kMaxAbsQuadraticKes;
 constexpr double kMinBeta = 1e-3, kMaxBeta = 1e3;  // [-]
 
-// The "units" field of a law object: true for "kes", false for "si".
-bool LawUnits(const JsonFields& f, const json& b, const std::string& key, const char* kes_units,
-              const char* si_units) {
-  const json& v = b.at("units");
-  if (!v.is_string()) f.Must(key + ".units", "be \"kes\" or \"si\"", v);
-  const std::string units = v.get<std::string>();
-  if (units != "kes" && units != "si") {
-    f.Unknown(key + ".units", "units", units,
-              std::string("\"kes\": ") + kes_units + "; or \"si\": " + si_units);
-  }
-  return units == "kes";
+// The text of a JSON value in a message, cut to 40 characters.
+std::string Brief(const json& v) {
+  std::string s = v.dump();
+  return s.size() > 40 ? s.substr(0, 37) + "..." : s;
 }
 
-// {"law": "spline", "units", "kappa", "moment"[, "moment_sd"]}: knots in 1/cm and gf·cm/cm
-// ("kes") or 1/m and N ("si").
-BendingLaw SplineLaw(const JsonFields& f, const json& b, const std::string& key) {
-  f.CheckKeys(b, key, {"law", "units", "kappa", "moment", "moment_sd"});
-  for (const char* k : {"units", "kappa", "moment"}) {
-    f.Require(b, k, "a spline law is {\"law\": \"spline\", \"units\", \"kappa\", \"moment\"}",
-              key + "." + k);
+// The field checks below are shared by the parser, which quotes a value as the file writes it
+// (`got`), and by Material::Check, which quotes it as MaterialToJson would write it. Each returns
+// "" or the problem; a Pabst or spline law's returns "<field>: <problem>".
+
+// A Pabst law in KES numbers (b1, b2 in gf·cm, c1 in gf·cm²); got_b[i]: b1, b2 as written.
+std::string PabstLawProblem(double b1, double b2, double c1, const std::string& key,
+                            const std::string got_b[2], const std::string& unit_hint) {
+  const char* names[2] = {"b1", "b2"};
+  for (int i = 0; i < 2; ++i) {
+    const double bk = i == 0 ? b1 : b2;
+    const std::string field = key + "." + names[i];
+    if (bk <= 0.0) return field + ": must be > 0, got " + got_b[i];
+    if (bk < kMinBKes || bk > kMaxBKes) {
+      std::ostringstream s;
+      s << field << ": suspicious magnitude " << bk << " gf·cm, outside the textile range "
+        << kMinBKes << " .. " << kMaxBKes << " gf·cm" << unit_hint;
+      return s.str();
+    }
   }
-  const bool kes =
-      LawUnits(f, b, key, "kappa in 1/cm, moment in gf·cm/cm", "kappa in 1/m, moment in N");
-  std::vector<double> kappa = f.Numbers(b.at("kappa"), key + ".kappa");
-  std::vector<double> moment = f.Numbers(b.at("moment"), key + ".moment");
-  std::vector<double> sd;
-  if (b.contains("moment_sd")) sd = f.Numbers(b.at("moment_sd"), key + ".moment_sd");
+  if (std::abs(c1) > kMaxAbsC1Kes) {
+    std::ostringstream s;
+    s << key << ".c1: suspicious magnitude " << c1 << " gf·cm², |c1| above " << kMaxAbsC1Kes
+      << " gf·cm²" << unit_hint;
+    return s.str();
+  }
+  // |c1| alone says little (a technical fabric's sharp knee needs ~1e6 gf·cm²); a kink at a
+  // radius of curvature beyond a kilometre is a c1 out of scale with b1 and b2.
+  if (c1 != 0.0 && b1 != b2 && (b2 - b1) / (2.0 * c1) > 0.0 &&
+      (b2 - b1) / (2.0 * c1) < range::kMinKinkCurvatureKes) {
+    std::ostringstream s;
+    s << key << ".c1: suspicious magnitude " << c1
+      << " gf·cm²: it puts the kink κ0 = (b2 - b1)/(2 c1) at " << (b2 - b1) / (2.0 * c1)
+      << " /cm, below " << range::kMinKinkCurvatureKes << " /cm (a radius of 1 km)" << unit_hint;
+    return s.str();
+  }
+  const double sb1 = units::KesStiffnessToSi(b1), sb2 = units::KesStiffnessToSi(b2);
+  const double sc1 = units::KesQuadraticToSi(c1);
+  if (std::string why = BendingLaw::Invalidity(sb1, sb2, sc1); !why.empty())
+    return key + ": " + why;
+  return "";
+}
+
+// A spline law's knots, in KES (kes) or SI numbers.
+std::string SplineLawProblem(const std::vector<double>& kappa, const std::vector<double>& moment,
+                             const std::vector<double>& sd, const std::string& key, bool kes) {
   if (std::string why = BendingLaw::SplineInvalidity(kappa, moment, sd, key + ".kappa",
                                                      key + ".moment", key + ".moment_sd");
       !why.empty()) {
-    throw InputError(f.source() + ": " + why);  // why starts with the field
+    return why;  // why starts with the field
   }
   // The secant stiffness M_i/κ_i of each knot against the bounds of b1, b2 (KES), where a
   // unit mix-up shows.
@@ -66,153 +90,281 @@ BendingLaw SplineLaw(const JsonFields& f, const json& b, const std::string& key)
         kes ? moment[i] / kappa[i] : units::SiStiffnessToKes(moment[i] / kappa[i]);
     if (secant < kMinBKes || secant > kMaxBKes) {
       std::ostringstream s;
-      s << "suspicious secant stiffness M/kappa = " << secant << " gf·cm at this knot, outside "
-        << "the textile range " << kMinBKes << " .. " << kMaxBKes << " gf·cm" << unit_hint;
-      f.Fail(JsonFields::Element(key + ".moment", i), s.str());
+      s << key << ".moment[" << i << "]: suspicious secant stiffness M/kappa = " << secant
+        << " gf·cm at this knot, outside the textile range " << kMinBKes << " .. " << kMaxBKes
+        << " gf·cm" << unit_hint;
+      return s.str();
     }
   }
-  if (kes) return BendingLaw::FromSplineKes(std::move(kappa), std::move(moment), std::move(sd));
-  return BendingLaw::FromSpline(std::move(kappa), std::move(moment), std::move(sd));
+  return "";
 }
 
-// The plausibility of a Pabst law's constants in KES (b1, b2 > 0 and in the textile range, |c1|
-// and the kink κ0 in scale), refused with a unit hint.
-void CheckPabstMagnitudes(const JsonFields& f, const json& b, const std::string& key, double b1,
-                          double b2, double c1, bool kes) {
-  const char* names[2] = {"b1", "b2"};
-  const std::string unit_hint = kes ? " (units: kes)" : " (units: si; is this file in kes?)";
-  for (int i = 0; i < 2; ++i) {
-    const double bk = i == 0 ? b1 : b2;
-    if (bk <= 0.0) f.Must(key + "." + names[i], "be > 0", b.at(names[i]));
-    if (bk < kMinBKes || bk > kMaxBKes) {
-      std::ostringstream s;
-      s << "suspicious magnitude " << bk << " gf·cm, outside the textile range " << kMinBKes
-        << " .. " << kMaxBKes << " gf·cm" << unit_hint;
-      f.Fail(key + "." + names[i], s.str());
-    }
-  }
-  if (std::abs(c1) > kMaxAbsC1Kes) {
-    std::ostringstream s;
-    s << "suspicious magnitude " << c1 << " gf·cm², |c1| above " << kMaxAbsC1Kes << " gf·cm²"
-      << unit_hint;
-    f.Fail(key + ".c1", s.str());
-  }
-  // |c1| alone says little (a technical fabric's sharp knee needs ~1e6 gf·cm²); a kink at a
-  // radius of curvature beyond a kilometre is a c1 out of scale with b1 and b2.
-  if (c1 != 0.0 && b1 != b2 && (b2 - b1) / (2.0 * c1) > 0.0 &&
-      (b2 - b1) / (2.0 * c1) < range::kMinKinkCurvatureKes) {
-    std::ostringstream s;
-    s << "suspicious magnitude " << c1 << " gf·cm²: it puts the kink κ0 = (b2 - b1)/(2 c1) at "
-      << (b2 - b1) / (2.0 * c1) << " /cm, below " << range::kMinKinkCurvatureKes
-      << " /cm (a radius of 1 km)" << unit_hint;
-    f.Fail(key + ".c1", s.str());
-  }
-}
-
-// root[key]: a Pabst law {"units", "b1", "b2", "c1"} or a spline law.
-BendingLaw Law(const JsonFields& f, const json& root, const std::string& key) {
-  const json& b = f.Object(root.at(key), key,
-                           "{\"units\", \"b1\", \"b2\", \"c1\"} or {\"law\": \"spline\", "
-                           "\"units\", \"kappa\", \"moment\"}");
-  std::string law = "pabst";
-  if (b.contains("law")) {
-    if (!b.at("law").is_string()) f.Must(key + ".law", "be \"pabst\" or \"spline\"", b.at("law"));
-    law = b.at("law").get<std::string>();
-    if (law != "pabst" && law != "spline") {
-      f.Unknown(key + ".law", "law", law,
-                "\"pabst\": b1, b2, c1; or \"spline\": kappa, moment");
-    }
-  }
-  if (law == "spline") return SplineLaw(f, b, key);
-  f.CheckKeys(b, key, {"law", "units", "b1", "b2", "c1"});
-  for (const char* k : {"units", "b1", "b2", "c1"}) f.Require(b, k, "", key + "." + k);
-  const bool kes = LawUnits(f, b, key, "gf·cm, gf·cm²", "N·m, N·m²");
-  double v[3];
-  const char* names[3] = {"b1", "b2", "c1"};
-  for (int i = 0; i < 3; ++i) v[i] = f.Number(b.at(names[i]), key + "." + names[i]);
-  // Everything below in KES, which is how people read these numbers.
-  const double b1 = kes ? v[0] : units::SiStiffnessToKes(v[0]);
-  const double b2 = kes ? v[1] : units::SiStiffnessToKes(v[1]);
-  const double c1 = kes ? v[2] : units::SiQuadraticToKes(v[2]);
-  CheckPabstMagnitudes(f, b, key, b1, b2, c1, kes);
-  const double sb1 = units::KesStiffnessToSi(b1), sb2 = units::KesStiffnessToSi(b2);
-  const double sc1 = units::KesQuadraticToSi(c1);
-  if (std::string why = BendingLaw::Invalidity(sb1, sb2, sc1); !why.empty()) f.Fail(key, why);
-  return BendingLaw::FromSi(sb1, sb2, sc1);
-}
-
-// {"stiffness_N_per_m", "poisson", "compression_ratio"}, each optional, into m.
-void ReadStretch(const JsonFields& f, const json& root, Material* m) {
-  const json& st = f.Object(root["stretch"], "stretch",
-                            "{\"stiffness_N_per_m\", \"poisson\", \"compression_ratio\"}");
-  f.CheckKeys(st, "stretch", {"stiffness_N_per_m", "poisson", "compression_ratio"});
-  if (st.contains("stiffness_N_per_m")) {
-    const json& v = st["stiffness_N_per_m"];
-    m->stretch_stiffness = f.Number(v, "stretch.stiffness_N_per_m");
-    if (m->stretch_stiffness <= 0.0) f.Must("stretch.stiffness_N_per_m", "be > 0 N/m", v);
-    if (m->stretch_stiffness > 1e7)
-      f.Fail("stretch.stiffness_N_per_m", "suspicious magnitude, above 1e7 N/m");
-  }
-  if (st.contains("poisson")) {
-    m->poisson = f.Number(st["poisson"], "stretch.poisson");
-    if (m->poisson < 0.0 || m->poisson >= 0.5)
-      f.Must("stretch.poisson", "lie in [0, 0.5)", st["poisson"]);
-  }
-  if (st.contains("compression_ratio")) {
-    const json& v = st["compression_ratio"];
-    m->compression_ratio = f.Number(v, "stretch.compression_ratio");
-    if (!(m->compression_ratio >= kMinCompressionRatio && m->compression_ratio <= 1.0))
-      f.Must("stretch.compression_ratio", "lie in [0.001, 1] (1: as stiff as in tension)", v);
-  }
-}
-
-// areal_density_gsm: required, > 0 and within the textile range [kg/m² returned].
-double ReadArealDensity(const JsonFields& f, const json& root) {
-  const json& v = f.Require(root, "areal_density_gsm", "g/m², required");
-  const double gsm = f.Number(v, "areal_density_gsm");
-  if (gsm <= 0.0) f.Must("areal_density_gsm", "be > 0 g/m²", v);
+std::string ArealDensityProblem(double gsm, const std::string& got) {
+  if (gsm <= 0.0) return "must be > 0 g/m², got " + got;
   if (gsm < kMinGsm || gsm > kMaxGsm) {
     std::ostringstream s;
     s << "suspicious areal density " << gsm << " g/m², outside " << kMinGsm << " .. " << kMaxGsm
       << " g/m² (the unit is g/m², not kg/m²)";
-    f.Fail("areal_density_gsm", s.str());
+    return s.str();
   }
-  return units::GsmToSi(gsm);
+  return "";
 }
+
+std::string BetaProblem(double beta, const std::string& got) {
+  if (beta <= 0.0) return "must be > 0, got " + got;
+  if (beta < kMinBeta || beta > kMaxBeta)
+    return "suspicious factor " + got + ", outside 0.001 .. 1000";
+  return "";
+}
+
+std::string StretchStiffnessProblem(double k) {
+  if (k <= 0.0) return "must be > 0 N/m";
+  if (k > 1e7) return "suspicious magnitude, above 1e7 N/m";
+  return "";
+}
+
+std::string PoissonProblem(double nu) {
+  return nu < 0.0 || nu >= 0.5 ? "must lie in [0, 0.5)" : "";
+}
+
+std::string CompressionRatioProblem(double r) {
+  return r >= kMinCompressionRatio && r <= 1.0
+             ? ""
+             : "must lie in [0.001, 1] (1: as stiff as in tension)";
+}
+
+std::string FrictionProblem(double mu) {
+  return mu < 0.0 || mu > 10.0 ? "must lie in [0, 10]" : "";
+}
+
+class Reader {
+ public:
+  explicit Reader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void Fail(const std::string& field, const std::string& problem) const {
+    throw InputError(source_ + ": " + field + ": " + problem);
+  }
+
+  double Number(const json& obj, const std::string& key, const std::string& field) const {
+    const json& v = obj.at(key);
+    if (!v.is_number()) Fail(field, "must be a number, got " + Brief(v));
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) Fail(field, "must be finite, got " + Brief(v));
+    return d;
+  }
+
+  void CheckKeys(const json& obj, const std::string& where, const std::set<std::string>& known) const {
+    for (const auto& [key, value] : obj.items()) {
+      if (!known.count(key)) {
+        std::string list;
+        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+        Fail(where.empty() ? key : where + "." + key, "unknown field (known: " + list + ")");
+      }
+    }
+  }
+
+  BendingLaw Law(const json& root, const std::string& key) const {
+    const json& b = root.at(key);
+    if (!b.is_object()) {
+      Fail(key,
+           "must be an object {\"units\", \"b1\", \"b2\", \"c1\"} or {\"law\": \"spline\", "
+           "\"units\", \"kappa\", \"moment\"}");
+    }
+    std::string law = "pabst";
+    if (b.contains("law")) {
+      if (!b.at("law").is_string()) Fail(key + ".law", "must be \"pabst\" or \"spline\"");
+      law = b.at("law").get<std::string>();
+      if (law != "pabst" && law != "spline") {
+        Fail(key + ".law",
+             "unknown law '" + law + "' (use \"pabst\": b1, b2, c1; or \"spline\": kappa, moment)");
+      }
+    }
+    if (law == "spline") return SplineLaw(b, key);
+    CheckKeys(b, key, {"law", "units", "b1", "b2", "c1"});
+    for (const char* k : {"units", "b1", "b2", "c1"}) {
+      if (!b.contains(k)) Fail(key + "." + k, "missing");
+    }
+    const bool kes = Units(b, key, "gf·cm, gf·cm²", "N·m, N·m²");
+    double v[3];
+    const char* names[3] = {"b1", "b2", "c1"};
+    for (int i = 0; i < 3; ++i) v[i] = Number(b, names[i], key + "." + names[i]);
+    // Everything below in KES, which is how people read these numbers.
+    const double b1 = kes ? v[0] : units::SiStiffnessToKes(v[0]);
+    const double b2 = kes ? v[1] : units::SiStiffnessToKes(v[1]);
+    const double c1 = kes ? v[2] : units::SiQuadraticToKes(v[2]);
+    const std::string unit_hint = kes ? " (units: kes)" : " (units: si; is this file in kes?)";
+    const std::string got_b[2] = {Brief(b.at("b1")), Brief(b.at("b2"))};
+    if (std::string p = PabstLawProblem(b1, b2, c1, key, got_b, unit_hint); !p.empty())
+      throw InputError(source_ + ": " + p);
+    const double sb1 = units::KesStiffnessToSi(b1), sb2 = units::KesStiffnessToSi(b2);
+    const double sc1 = units::KesQuadraticToSi(c1);
+    return BendingLaw::FromSi(sb1, sb2, sc1);
+  }
+
+  // The "units" field of a law object: true for "kes", false for "si".
+  bool Units(const json& b, const std::string& key, const char* kes_units,
+             const char* si_units) const {
+    if (!b.at("units").is_string()) Fail(key + ".units", "must be \"kes\" or \"si\"");
+    const std::string units = b.at("units").get<std::string>();
+    if (units != "kes" && units != "si") {
+      Fail(key + ".units", "unknown units '" + units + "' (use \"kes\": " + kes_units +
+                               "; or \"si\": " + si_units + ")");
+    }
+    return units == "kes";
+  }
+
+  std::vector<double> Numbers(const json& obj, const std::string& key,
+                              const std::string& field) const {
+    const json& v = obj.at(key);
+    if (!v.is_array()) Fail(field, "must be an array of numbers, got " + Brief(v));
+    std::vector<double> out;
+    for (size_t i = 0; i < v.size(); ++i) {
+      if (!v[i].is_number())
+        Fail(field + "[" + std::to_string(i) + "]", "must be a number, got " + Brief(v[i]));
+      out.push_back(v[i].get<double>());
+    }
+    return out;
+  }
+
+  // {"law": "spline", "units", "kappa", "moment"[, "moment_sd"]}: knots in 1/cm and gf·cm/cm
+  // ("kes") or 1/m and N ("si").
+  BendingLaw SplineLaw(const json& b, const std::string& key) const {
+    CheckKeys(b, key, {"law", "units", "kappa", "moment", "moment_sd"});
+    for (const char* k : {"units", "kappa", "moment"}) {
+      if (!b.contains(k))
+        Fail(key + "." + k,
+             "missing (a spline law is {\"law\": \"spline\", \"units\", \"kappa\", \"moment\"})");
+    }
+    const bool kes =
+        Units(b, key, "kappa in 1/cm, moment in gf·cm/cm", "kappa in 1/m, moment in N");
+    std::vector<double> kappa = Numbers(b, "kappa", key + ".kappa");
+    std::vector<double> moment = Numbers(b, "moment", key + ".moment");
+    std::vector<double> sd;
+    if (b.contains("moment_sd")) sd = Numbers(b, "moment_sd", key + ".moment_sd");
+    if (std::string p = SplineLawProblem(kappa, moment, sd, key, kes); !p.empty())
+      throw InputError(source_ + ": " + p);
+    if (kes) return BendingLaw::FromSplineKes(std::move(kappa), std::move(moment), std::move(sd));
+    return BendingLaw::FromSpline(std::move(kappa), std::move(moment), std::move(sd));
+  }
+
+ private:
+  std::string source_;
+};
 
 }  // namespace
 
 Material ParseMaterialJson(const std::string& text, const std::string& source) {
-  const JsonFields f(source);
+  Reader r(source);
   const json root = ParseJsonText(text, source);
-  f.RequireObject(root);
-  f.CheckKeys(root, "", {"name", "areal_density_gsm", "bending", "bending_weft", "beta", "stretch",
+  if (!root.is_object()) r.Fail("(top level)", "must be a JSON object");
+  r.CheckKeys(root, "", {"name", "areal_density_gsm", "bending", "bending_weft", "beta", "stretch",
                          "friction", "fit", "notes", "assumptions", "source"});
   Material m;
-  if (root.contains("name")) m.name = f.String(root["name"], "name");
-  m.areal_density = ReadArealDensity(f, root);
-  f.Require(root, "bending", "required: {\"units\", \"b1\", \"b2\", \"c1\"}");
-  m.bending = Law(f, root, "bending");
-  if (root.contains("bending_weft")) m.bending_weft = Law(f, root, "bending_weft");
+  if (root.contains("name")) {
+    if (!root["name"].is_string()) r.Fail("name", "must be a string");
+    m.name = root["name"].get<std::string>();
+  }
+  if (!root.contains("areal_density_gsm")) r.Fail("areal_density_gsm", "missing (g/m², required)");
+  const double gsm = r.Number(root, "areal_density_gsm", "areal_density_gsm");
+  if (std::string p = ArealDensityProblem(gsm, Brief(root["areal_density_gsm"])); !p.empty())
+    r.Fail("areal_density_gsm", p);
+  m.areal_density = units::GsmToSi(gsm);
+  if (!root.contains("bending")) r.Fail("bending", "missing (required: {\"units\", \"b1\", \"b2\", \"c1\"})");
+  m.bending = r.Law(root, "bending");
+  if (root.contains("bending_weft")) m.bending_weft = r.Law(root, "bending_weft");
   if (root.contains("beta")) {
-    m.beta = f.Number(root["beta"], "beta");
-    if (m.beta <= 0.0) f.Must("beta", "be > 0", root["beta"]);
-    if (m.beta < kMinBeta || m.beta > kMaxBeta) {
-      f.Fail("beta", "suspicious factor " + JsonFields::Brief(root["beta"]) +
-                         ", outside 0.001 .. 1000");
+    m.beta = r.Number(root, "beta", "beta");
+    if (std::string p = BetaProblem(m.beta, Brief(root["beta"])); !p.empty()) r.Fail("beta", p);
+  }
+  if (root.contains("stretch")) {
+    const json& st = root["stretch"];
+    if (!st.is_object())
+      r.Fail("stretch",
+             "must be an object {\"stiffness_N_per_m\", \"poisson\", \"compression_ratio\"}");
+    r.CheckKeys(st, "stretch", {"stiffness_N_per_m", "poisson", "compression_ratio"});
+    if (st.contains("stiffness_N_per_m")) {
+      m.stretch_stiffness = r.Number(st, "stiffness_N_per_m", "stretch.stiffness_N_per_m");
+      if (std::string p = StretchStiffnessProblem(m.stretch_stiffness); !p.empty())
+        r.Fail("stretch.stiffness_N_per_m", p);
+    }
+    if (st.contains("poisson")) {
+      m.poisson = r.Number(st, "poisson", "stretch.poisson");
+      if (std::string p = PoissonProblem(m.poisson); !p.empty()) r.Fail("stretch.poisson", p);
+    }
+    if (st.contains("compression_ratio")) {
+      m.compression_ratio = r.Number(st, "compression_ratio", "stretch.compression_ratio");
+      if (std::string p = CompressionRatioProblem(m.compression_ratio); !p.empty())
+        r.Fail("stretch.compression_ratio", p);
     }
   }
-  if (root.contains("stretch")) ReadStretch(f, root, &m);
   if (root.contains("friction")) {
-    m.friction = f.Number(root["friction"], "friction");
-    if (m.friction < 0.0 || m.friction > 10.0)
-      f.Must("friction", "lie in [0, 10]", root["friction"]);
+    m.friction = r.Number(root, "friction", "friction");
+    if (std::string p = FrictionProblem(m.friction); !p.empty()) r.Fail("friction", p);
   }
-  if (root.contains("fit")) m.fit = f.Object(root["fit"], "fit");
+  if (root.contains("fit")) {
+    if (!root["fit"].is_object()) r.Fail("fit", "must be an object");
+    m.fit = root["fit"];
+  }
   for (const char* k : {"notes", "assumptions", "source"}) {
     if (root.contains(k)) m.extra[k] = root[k];
   }
   return m;
+}
+
+namespace {
+
+// A number as MaterialToJson writes it (JSON has no NaN or infinity: null).
+std::string Written(double v) { return Brief(json(v)); }
+
+// A law as Material::Check sees it: in the numbers MaterialToJson writes, checked as the
+// parser checks them. "" or "<key>.<field>: <problem>".
+std::string LawProblem(const BendingLaw& law, const std::string& key) {
+  if (law.is_spline()) {
+    std::vector<double> kappa, moment, sd;
+    for (double k : law.knot_kappa()) kappa.push_back(units::SiCurvatureToKes(k));
+    for (double m : law.knot_moment()) moment.push_back(units::SiMomentToKes(m));
+    for (double m : law.knot_moment_sd()) sd.push_back(units::SiMomentToKes(m));
+    const std::pair<const char*, const std::vector<double>*> arrays[3] = {
+        {"kappa", &kappa}, {"moment", &moment}, {"moment_sd", &sd}};
+    for (const auto& [name, values] : arrays)
+      for (size_t i = 0; i < values->size(); ++i)
+        if (!std::isfinite((*values)[i]))
+          return key + "." + name + "[" + std::to_string(i) + "]: must be a number, got null";
+    return SplineLawProblem(kappa, moment, sd, key, true);
+  }
+  const double v[3] = {law.b1_kes(), law.b2_kes(), law.c1_kes()};
+  const char* names[3] = {"b1", "b2", "c1"};
+  for (int i = 0; i < 3; ++i)
+    if (!std::isfinite(v[i])) return key + "." + names[i] + ": must be a number, got null";
+  const std::string got_b[2] = {Written(v[0]), Written(v[1])};
+  return PabstLawProblem(v[0], v[1], v[2], key, got_b, " (units: kes)");
+}
+
+}  // namespace
+
+bool Material::Check(std::string* why) const {
+  std::string w;
+  const auto field = [&w](const char* name, const std::string& problem) {
+    if (w.empty() && !problem.empty()) w = std::string(name) + ": " + problem;
+  };
+  const auto number = [&field](const char* name, double v) {
+    if (!std::isfinite(v)) field(name, "must be a number, got null");
+    return std::isfinite(v);
+  };
+  const double gsm = units::SiToGsm(areal_density);
+  if (number("areal_density_gsm", gsm))
+    field("areal_density_gsm", ArealDensityProblem(gsm, Written(gsm)));
+  if (w.empty()) w = LawProblem(bending, "bending");
+  if (w.empty() && bending_weft) w = LawProblem(*bending_weft, "bending_weft");
+  if (number("beta", beta)) field("beta", BetaProblem(beta, Written(beta)));
+  if (number("stretch.stiffness_N_per_m", stretch_stiffness))
+    field("stretch.stiffness_N_per_m", StretchStiffnessProblem(stretch_stiffness));
+  if (number("stretch.poisson", poisson)) field("stretch.poisson", PoissonProblem(poisson));
+  if (number("stretch.compression_ratio", compression_ratio))
+    field("stretch.compression_ratio", CompressionRatioProblem(compression_ratio));
+  if (number("friction", friction)) field("friction", FrictionProblem(friction));
+  if (why) *why = w;
+  return w.empty();
 }
 
 Material ReadMaterial(const std::string& path) {

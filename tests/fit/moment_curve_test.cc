@@ -79,5 +79,17 @@ TEST(MomentCurve, FitCovarianceComesFromTheReportWhenEverySdIsKnown) {
   EXPECT_THROW(FitCovariance(m, "m.json", &why), InputError);
 }
 
+TEST(MomentCurve, FitCurvatureReachIsTheReportsKappaMax) {
+  Material m;
+  EXPECT_FALSE(FitCurvatureReach(m).has_value());  // no fit report
+  m.fit = {{"method", "direct"}};
+  EXPECT_FALSE(FitCurvatureReach(m).has_value());  // a report without the number
+  m.fit["kappa_max_per_cm"] = "2";
+  EXPECT_FALSE(FitCurvatureReach(m).has_value());  // not a number
+  m.fit["kappa_max_per_cm"] = 2.0;
+  ASSERT_TRUE(FitCurvatureReach(m).has_value());
+  EXPECT_DOUBLE_EQ(*FitCurvatureReach(m), 200.0);  // 2 /cm = 200 /m
+}
+
 }  // namespace
 }  // namespace textile

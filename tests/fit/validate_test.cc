@@ -42,11 +42,7 @@ ValidationOptions ElasticaOnly(double tolerance) {
   return o;
 }
 
-bool HasNote(const ValidationSummary& v, ValidationNoteCode code) {
-  for (const ValidationNote& n : v.notes)
-    if (n.code == code) return true;
-  return false;
-}
+bool HasNote(const ValidationSummary& v, const char* code) { return HasNote(v.notes, code); }
 
 // A strip of a known material at 40, 60 and 80 mm: each profile, predicted by the law fitted to
 // the other two, lies within its noise. With isotropic noise σ on x and y a point's normal
@@ -83,8 +79,10 @@ TEST(ValidateFit, HeldOutProfilesOfAKnownMaterialArePredictedWithinTheNoise) {
     ASSERT_TRUE(h.law.has_value());
     EXPECT_NE(h.law->b1(), v.material.bending.b1());
   }
-  EXPECT_FALSE(HasNote(v, ValidationNoteCode::kNothingHeldOut));
+  EXPECT_FALSE(HasNote(v, validation_note::kNothingHeldOut));
   EXPECT_NE(v.BriefReport().find("held out: PASS"), std::string::npos) << v.BriefReport();
+  EXPECT_TRUE(v.AllPass());
+  EXPECT_EQ(v.FailureReason(), "");
 }
 
 // On a rig tilted by 1°, every leave-one-out fit finds the tilt (its two overhangs differ by
@@ -95,7 +93,7 @@ TEST(ValidateFit, HeldOutPredictionsAreTurnedWithTheRigTilt) {
   const ValidationSummary v = ValidateFit(data, kRho, ElasticaOnly(2.0 * kNoise));
   ASSERT_TRUE(v.completed) << v.message;
   EXPECT_TRUE(v.fit_options.fit_rotation);
-  EXPECT_TRUE(HasNote(v, ValidationNoteCode::kFit));
+  EXPECT_TRUE(HasNote(v, validation_note::kFit));
   ASSERT_EQ(v.holdout.size(), 3u);
   EXPECT_EQ(v.holdout_verdict, HoldoutVerdict::kPass) << v.BriefReport();
   for (const HeldOutProfile& h : v.holdout)
@@ -118,6 +116,10 @@ TEST(ValidateFit, AStifferStripHeldOutFailsItsPrediction) {
   ASSERT_TRUE(h.predicted) << h.why;
   EXPECT_FALSE(h.ok) << v.BriefReport();
   EXPECT_NE(h.why.find("elastica: rms"), std::string::npos) << h.why;
+  // Both verdicts do not pass, and the reason names the profile held out.
+  EXPECT_FALSE(v.AllPass());
+  EXPECT_NE(v.FailureReason().find(h.source + " held out: " + h.why), std::string::npos)
+      << v.FailureReason();
   // The miss is the material, not the fit's uncertainty: many of its σ.
   const double rms = h.elastica.check.comparison.rms;
   EXPECT_GT(rms, 0.5e-3);
@@ -158,8 +160,8 @@ TEST(ValidateFit, OneProfileHoldsNothingOut) {
   EXPECT_TRUE(v.pass);
   EXPECT_TRUE(v.holdout.empty());
   EXPECT_EQ(v.holdout_verdict, HoldoutVerdict::kNone);
-  ASSERT_TRUE(HasNote(v, ValidationNoteCode::kNothingHeldOut));
-  EXPECT_STREQ(ValidationNoteCodeName(ValidationNoteCode::kNothingHeldOut), "nothing_held_out");
+  ASSERT_TRUE(HasNote(v, validation_note::kNothingHeldOut));
+  EXPECT_STREQ(validation_note::kNothingHeldOut, "nothing_held_out");
   EXPECT_STREQ(HoldoutVerdictName(v.holdout_verdict), "none");
   EXPECT_NE(v.BriefReport().find("nothing held out"), std::string::npos) << v.BriefReport();
 }

@@ -4,6 +4,7 @@
 
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "textile/sim/error.h"
 #include "textile/sim/units.h"
@@ -230,6 +231,77 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(Material, MissingFileIsInputError) {
   EXPECT_THROW(ReadMaterial(kBad + "does-not-exist.json"), InputError);
+}
+
+}  // namespace
+}  // namespace textile
+
+namespace textile {
+namespace {
+
+// Material::Check says what the parser says of the same material written out (MaterialToJson),
+// without the file name: a fit's law is refused with the wording a material file gets.
+TEST(MaterialCheck, RefusesWhatTheParserRefusesInItsWords) {
+  std::vector<std::pair<std::string, Material>> bad;
+  const auto with = [&bad](const std::string& what, auto change) {
+    Material m;
+    m.areal_density = 0.2;
+    m.bending = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+    change(m);
+    bad.emplace_back(what, m);
+  };
+  with("b1 beyond the range", [](Material& m) { m.bending = BendingLaw::FromKes(2e5, 100, -1e7); });
+  with("b2 below the range",
+       [](Material& m) { m.bending = BendingLaw::FromKes(0.1, 1e-6, -1e-4); });
+  with("|c1| above the range", [](Material& m) { m.bending = BendingLaw::FromKes(1e4, 10, -1e9); });
+  with("kink beyond a kilometre",
+       [](Material& m) { m.bending = BendingLaw::FromKes(0.1, 0.2, 1e6); });
+  with("weft law beyond the range",
+       [](Material& m) { m.bending_weft = BendingLaw::FromKes(2e5, 100, -1e7); });
+  with("spline secant below the range", [](Material& m) {
+    m.bending = BendingLaw::FromSplineKes({0.0, 1.0, 2.0}, {0.0, 1e-7, 2e-7}, {});
+  });
+  with("areal density", [](Material& m) { m.areal_density = 20.0; });
+  with("beta", [](Material& m) { m.beta = 1e4; });
+  with("negative beta", [](Material& m) { m.beta = -1.0; });
+  with("stretch stiffness", [](Material& m) { m.stretch_stiffness = 1e8; });
+  with("poisson", [](Material& m) { m.poisson = 0.5; });
+  with("compression ratio", [](Material& m) { m.compression_ratio = 1e-4; });
+  with("friction", [](Material& m) { m.friction = 11.0; });
+  for (const auto& [what, m] : bad) {
+    std::string why;
+    EXPECT_FALSE(m.Check(&why)) << what;
+    EXPECT_FALSE(why.empty()) << what;
+    try {
+      ParseMaterialJson(MaterialToJson(m).dump(), "fitted law");
+      ADD_FAILURE() << what << ": the parser took it";
+    } catch (const InputError& e) {
+      EXPECT_EQ("fitted law: " + why, e.what()) << what;
+    }
+  }
+}
+
+TEST(MaterialCheck, NamesTheFieldAndTheRange) {
+  Material m;
+  m.areal_density = 0.2;
+  m.bending = BendingLaw::FromKes(2e5, 100, -1e7);
+  std::string why;
+  ASSERT_FALSE(m.Check(&why));
+  EXPECT_EQ(why,
+            "bending.b1: suspicious magnitude 200000 gf·cm, outside the textile range 1e-05 .. "
+            "100000 gf·cm (units: kes)");
+  EXPECT_FALSE(m.Check(nullptr));  // why is optional
+}
+
+TEST(MaterialCheck, AcceptsTheSamplesAndTheDefaults) {
+  for (const char* name : {"pabst-fig8", "pabst-dress", "pabst-interlining", "knee-spline"}) {
+    std::string why = "unset";
+    EXPECT_TRUE(ReadMaterial(kSamples + name + ".json").Check(&why)) << name << ": " << why;
+    EXPECT_EQ(why, "") << name;
+  }
+  Material m;
+  m.areal_density = 0.2;
+  EXPECT_TRUE(m.Check(nullptr));
 }
 
 }  // namespace

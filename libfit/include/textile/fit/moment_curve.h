@@ -48,6 +48,11 @@ double MomentSigma(const BendingLaw& law, const Eigen::Matrix3d& covariance, dou
 std::optional<Eigen::Matrix3d> FitCovariance(const Material& material, const std::string& source,
                                              std::string* why);
 
+// The largest curvature the fit's data reached [1/m] (`fit.kappa_max_per_cm`, textile fit):
+// the band of FitCovariance means nothing beyond it. None when the material carries no fit
+// report or the report has no such number.
+std::optional<double> FitCurvatureReach(const Material& material);
+
 }  // namespace textile
 
 #endif  // TEXTILE_FIT_MOMENT_CURVE_H_

@@ -30,6 +30,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "textile/fit/direct_fit.h"
@@ -38,6 +39,7 @@
 #include "textile/sim/acpm_shell.h"
 #include "textile/sim/bending_law.h"
 #include "textile/sim/material.h"
+#include "textile/sim/note.h"
 
 namespace textile {
 
@@ -123,21 +125,19 @@ enum class HoldoutVerdict {
 // "none", "pass", "fail".
 const char* HoldoutVerdictName(HoldoutVerdict verdict);
 
-enum class ValidationNoteCode {
-  kFit,                  // a note of the full fit (tilt, offset; FitDirectCheckingTilt)
-  kNothingHeldOut,       // one profile (or hold_out off): no prediction was made
-  kHeldOutFitFailed,     // a leave-one-out fit failed: that profile was not predicted
-  kSigmaIncomplete,      // a training fit left a constant undetermined: σ without it
-  kPredictionUncertain,  // 2σ of a prediction's rms exceeds the tolerance
-};
-// "fit", "nothing_held_out", "held_out_fit_failed", "sigma_incomplete",
-// "prediction_uncertain".
-const char* ValidationNoteCodeName(ValidationNoteCode code);
-
-struct ValidationNote {
-  ValidationNoteCode code;
-  std::string text;  // for people, one sentence
-};
+// The codes of ValidationSummary::notes (textile::Note).
+namespace validation_note {
+// A note of the full fit (tilt, offset; FitDirectCheckingTilt).
+inline constexpr char kFit[] = "fit";
+// One profile (or hold_out off): no prediction was made.
+inline constexpr char kNothingHeldOut[] = "nothing_held_out";
+// A leave-one-out fit failed: that profile was not predicted.
+inline constexpr char kHeldOutFitFailed[] = "held_out_fit_failed";
+// A training fit left a constant undetermined: σ without it.
+inline constexpr char kSigmaIncomplete[] = "sigma_incomplete";
+// 2σ of a prediction's rms exceeds the tolerance.
+inline constexpr char kPredictionUncertain[] = "prediction_uncertain";
+}  // namespace validation_note
 
 struct ValidationSummary {
   // False when a computation failed (the fit, a law no material file takes, a shell solve, an
@@ -158,7 +158,16 @@ struct ValidationSummary {
   std::vector<HeldOutProfile> holdout;  // one per profile when held out, else empty
   HoldoutVerdict holdout_verdict = HoldoutVerdict::kNone;
 
-  std::vector<ValidationNote> notes;
+  std::vector<Note> notes;  // codes: validation_note
+
+  // Both verdicts pass (goodness of fit, and held out unless nothing was held out).
+  bool AllPass() const { return pass && holdout_verdict != HoldoutVerdict::kFail; }
+  // Why the verdicts failed, "; "-joined: "<source>: <why>" for each profile that fails the
+  // goodness of fit, "<source> held out: <why>" for each held-out profile not ok. Empty when
+  // AllPass().
+  std::string FailureReason() const;
+  // The texts of the notes with this code, in order.
+  std::vector<std::string> NoteTexts(std::string_view code) const;
 
   // A few lines: the law, the goodness of fit, the held-out predictions, the verdicts.
   std::string BriefReport() const;

@@ -42,6 +42,12 @@ struct Material {
   nlohmann::json fit;                        // the `fit` report when a fit made this file
   nlohmann::json extra;                      // "notes"/"assumptions"/"source", carried through
 
+  // False, with "<field>: <problem>" in *why (if non-null), when a value lies outside what a
+  // material file accepts (textile_range.h's bounds, the law's own validity): the parser's
+  // checks and wording, without the file name, on the numbers MaterialToJson would write.
+  //   if (std::string why; !m.Check(&why)) throw InputError("fitted law: " + why);
+  bool Check(std::string* why) const;
+
   // The warp law with β applied (M_β = β M), which every simulation uses.
   BendingLaw EffectiveLaw() const { return bending.Scaled(beta); }
   // The weft law with β applied, or the warp law when the material is isotropic.

@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "bench/bench.h"
-#include "common/chart.h"
+#include "common/chart_file.h"
 #include "common/cli.h"
 #include "textile/sim/acpm_shell.h"
 #include "textile/sim/elastica.h"

@@ -16,7 +16,7 @@
 #include <time.h>
 
 #include "bench/bench.h"
-#include "common/chart.h"
+#include "common/chart_file.h"
 #include "textile/sim/bending_element.h"
 
 namespace textile::bench {

@@ -14,7 +14,7 @@
 #include <sstream>
 
 #include "bench/bench.h"
-#include "common/chart.h"
+#include "common/chart_file.h"
 #include "textile/sim/drape.h"
 
 namespace textile::bench {

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "bench/bench.h"
-#include "common/chart.h"
+#include "common/chart_file.h"
 #include "textile/sim/elastica.h"
 #include "textile/sim/units.h"
 

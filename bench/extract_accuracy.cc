@@ -16,7 +16,7 @@
 #include <sstream>
 
 #include "bench/bench.h"
-#include "common/chart.h"
+#include "common/chart_file.h"
 #include "textile/fit/extract.h"
 #include "textile/fit/image_codecs.h"
 #include "textile/fit/render_photo.h"

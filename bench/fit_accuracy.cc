@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "bench/bench.h"
-#include "common/chart.h"
+#include "common/chart_file.h"
 #include "common/cli.h"
 #include "textile/fit/clapp.h"
 #include "textile/fit/direct_fit.h"

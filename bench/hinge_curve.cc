@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "bench/bench.h"
-#include "common/chart.h"
+#include "common/chart_file.h"
 #include "textile/sim/bending_element.h"
 
 namespace textile::bench {

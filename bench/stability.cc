@@ -19,7 +19,7 @@
 #include <sstream>
 
 #include "bench/bench.h"
-#include "common/chart.h"
+#include "common/chart_file.h"
 #include "textile/sim/static_solver.h"
 
 namespace textile::bench {

@@ -11,7 +11,7 @@
 #include <sstream>
 
 #include "bench/bench.h"
-#include "common/chart.h"
+#include "common/chart_file.h"
 #include "common/cli.h"
 #include "textile/sim/error.h"
 #include "textile/sim/static_solver.h"

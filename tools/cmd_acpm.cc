@@ -10,7 +10,7 @@
 #include <optional>
 
 #include "common/atomic_file.h"
-#include "common/chart.h"
+#include "common/chart_file.h"
 #include "common/cli.h"
 #include "textile/sim/acpm.h"
 #include "textile/sim/error.h"

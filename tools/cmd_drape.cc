@@ -10,14 +10,13 @@
 #include <iostream>
 #include <limits>
 #include <numbers>
-#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <sstream>
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
-#include "textile/fit/image_codecs.h"
 #include "textile/sim/drape.h"
+#include "textile/sim/drape_picture.h"
 #include "textile/sim/error.h"
 #include "textile/sim/material.h"
 #include "textile/sim/mesh_io.h"
@@ -241,54 +240,6 @@ std::string DrapedPly(const DrapeResult& r, const DrapeSeedResult& s) {
   return PlyText(draped, scalars);
 }
 
-// The test's photo: the shadow seen from above, the support and the flat specimen's circles,
-// the seams as they lie on the draped cloth, and the nodes.
-cv::Mat ShadowImage(const DrapeResult& r, const DrapeSeedResult& s, const DrapeOptions& o) {
-  constexpr int kSize = 800;
-  const double half = 1.08 * o.specimen_radius;  // [m] from the centre to the image edge
-  const double px_per_m = kSize / (2.0 * half);
-  auto to_px = [&](double x, double y) {
-    return cv::Point(static_cast<int>(std::lround((x + half) * px_per_m)),
-                     static_cast<int>(std::lround((half - y) * px_per_m)));
-  };
-  cv::Mat img(kSize, kSize, CV_8UC3, cv::Scalar(250, 250, 250));
-  const DrapeShadow& sh = s.shadow;
-  for (int v = 0; v < kSize; ++v) {
-    for (int u = 0; u < kSize; ++u) {
-      const double x = u / px_per_m - half, y = half - v / px_per_m;
-      const int i = static_cast<int>(std::lround((x - sh.origin_x) / sh.cell));
-      const int j = static_cast<int>(std::lround((y - sh.origin_y) / sh.cell));
-      if (i < 0 || j < 0 || i >= sh.width || j >= sh.height) continue;
-      if (sh.mask[static_cast<size_t>(j) * sh.width + i])
-        img.at<cv::Vec3b>(v, u) = cv::Vec3b(70, 60, 50);
-    }
-  }
-  const cv::Point centre = to_px(0.0, 0.0);
-  cv::circle(img, centre, static_cast<int>(o.specimen_radius * px_per_m), cv::Scalar(160, 160, 160),
-             1, cv::LINE_AA);
-  cv::circle(img, centre, static_cast<int>(o.support_radius * px_per_m), cv::Scalar(60, 160, 240),
-             2, cv::LINE_AA);
-  for (const auto& path : r.seam_paths) {
-    for (size_t k = 1; k < path.size(); ++k) {
-      cv::line(img, to_px(s.positions(path[k - 1], 0), s.positions(path[k - 1], 1)),
-               to_px(s.positions(path[k], 0), s.positions(path[k], 1)), cv::Scalar(80, 80, 230), 2,
-               cv::LINE_AA);
-    }
-  }
-  for (size_t k = 0; k < s.nodes.angles.size(); ++k) {
-    const double t = s.nodes.angles[k], rad = s.nodes.radii[k];
-    cv::circle(img, to_px(rad * std::cos(t), rad * std::sin(t)), 6, cv::Scalar(40, 200, 40), 2,
-               cv::LINE_AA);
-  }
-  std::ostringstream caption;
-  caption.precision(3);
-  caption << "DC " << s.drape_coefficient << ", " << s.nodes.angles.size() << " nodes, seams "
-          << DrapeSeamsName(o.seams) << ", seed " << s.seed;
-  cv::putText(img, caption.str(), cv::Point(12, 28), cv::FONT_HERSHEY_SIMPLEX, 0.7,
-              cv::Scalar(30, 30, 30), 2, cv::LINE_AA);
-  return img;
-}
-
 nlohmann::json SummaryJson(const SolveSummary& s) {
   return {{"converged", s.converged},
           {"method", s.method},
@@ -311,10 +262,12 @@ nlohmann::json NumberOrNull(double v) {
 }
 
 nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Material& m,
-                          const DrapeArgs& a, double turn_down) {
+                          const DrapeArgs& a) {
   nlohmann::json j;
   j["converged"] = r.converged;
   j["message"] = r.message;
+  // The notes' texts (a refused run prints its one error line only, no notes).
+  j["note"] = r.notes.empty() ? nlohmann::json() : nlohmann::json(JoinNoteTexts(r.notes, "; "));
   j["drape_coefficient"] = NumberOrNull(r.drape_coefficient);
   j["drape_coefficient_sd"] = NumberOrNull(r.drape_coefficient_sd);
   j["nodes"] = NumberOrNull(r.nodes);
@@ -371,7 +324,7 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
                 {"contact_sink_mm", o.mount == DrapeMount::kResting
                                         ? nlohmann::json(units::MToMm(o.contact_sink))
                                         : nlohmann::json()},
-                {"rim_turn_down_mm", units::MToMm(turn_down)},
+                {"rim_turn_down_mm", units::MToMm(r.rim_turn_down)},
                 {"coarse_to_fine", o.coarse_to_fine},
                 {"extrapolate", o.rim_extrapolation},
                 {"base_vertices", r.base_vertices},
@@ -396,163 +349,10 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
   return j;
 }
 
-void Run(const DrapeArgs& a) {
-  DrapeOptions o = Options(a);
-  if (a.compression_ratio &&
-      !(*a.compression_ratio >= kMinCompressionRatio && *a.compression_ratio <= 1.0))
-    throw InputError("--compression-ratio: must be between " + Num(kMinCompressionRatio) +
-                     " and 1 (1: as stiff in compression as in tension)");
-  // Check the outputs before reading or computing (an output must not be an input): distinct files
-  // in usable folders. They appear together at the end, or none of them.
-  const std::string outline_path = OutlinePath(a.out);
-  CheckDistinctOutputs({{"-o", a.out},
-                        {"the outline (next to -o)", outline_path},
-                        {"--png", a.png},
-                        {"--obj", a.obj},
-                        {"--ply", a.ply}},
-                       {{"--material", a.material}, {"--seam-file", a.seam_file}});
-  Material m = ReadMaterial(a.material);
-  if (a.compression_ratio) m.compression_ratio = *a.compression_ratio;
-  // The fabric's turn-down length ℓ at the rim. DC converges from below as the rim's element e
-  // shrinks, by about 0.1 e/ℓ at e = ℓ/3 for a plain fabric (docs/drapemeter.md, "Resolution
-  // at the rim"; less with seams and near DC = 1, hence "up to").
-  const double turn_down = RimTurnDownLength(m, o);
-  // The rim extrapolation (split rim, second solve, the bracket's middle; docs/drapemeter.md,
-  // "Extrapolated DC") is the default wherever it applies: a clamped specimen with a rim band
-  // at least one rim element wide. --extrapolate demands it, --no-extrapolate turns it off.
-  // `--rim-mm auto` meshes the rim with ℓ/2 when extrapolating (within 0.01 of the converged
-  // DC in about 5 s), else ℓ/3 (an expected shortfall over 0.02 gets a note); at least 0.5 mm,
-  // at most the element size (which may itself be under 0.5 mm when the overhang is tiny).
-  const double rim_if_extrapolating =
-      a.rim_mm == "auto" ? AutoRimElementSize(m, o, true) : o.rim_element_size;
-  const bool extrapolate_possible = o.mount == DrapeMount::kClamped && rim_if_extrapolating > 0.0 &&
-                                    o.rim_band >= rim_if_extrapolating;
-  o.rim_extrapolation = a.extrapolate || (!a.no_extrapolate && extrapolate_possible);
-  bool rim_capped = false;
-  if (a.rim_mm == "auto")
-    o.rim_element_size = AutoRimElementSize(m, o, o.rim_extrapolation, &rim_capped);
-  if (std::string why; !o.Check(&why)) throw InputError("drape: " + why);
-  const double rim_size = o.rim_element_size > 0.0 ? o.rim_element_size : o.element_size;
-  std::string note;  // reported with the result (a refused run prints its one error line only)
-  // (An extrapolated DC has no first-order shortfall: no note.)
-  if (const double shortfall = 0.1 * rim_size / turn_down;
-      shortfall > 0.02 && !o.rim_extrapolation && o.mount == DrapeMount::kClamped) {
-    // The estimate is first order in rim / turn-down; past about 0.5 it says only "a lot" (a
-    // limp, heavy fabric printed 4e+03 for a DC that cannot exceed 1).
-    note = (shortfall > 0.5 ? std::string("DC may be far too low")
-                            : "DC may be low by up to about " + Num(shortfall, 1)) +
-           ": the rim's elements (" + Num(units::MToMm(rim_size), 3) +
-           " mm) are coarse against this fabric's turn-down length there (" +
-           Num(units::MToMm(turn_down), 2) + " mm); " +
-           (o.rim_element_size > 0.0 ? std::string("a smaller --rim-mm")
-                                     : std::string("--rim-mm auto")) +
-           " meshes it finer (slower; docs/drapemeter.md)";
-  }
-  if (rim_capped) {
-    // Decision (docs/drapemeter.md): auto stays fast and says so; an explicit --rim-mm meshes
-    // as finely as asked.
-    note += std::string(note.empty() ? "" : "; ") + "--rim-mm auto: the rim's elements (" +
-            Num(units::MToMm(o.rim_element_size), 3) +
-            " mm) are capped to keep the rim band under about " + Num(kAutoRimMaxVertices) +
-            " vertices; this fabric's turn-down length (" + Num(units::MToMm(turn_down), 2) +
-            " mm) asks for " +
-            Num(units::MToMm(std::max(turn_down / (o.rim_extrapolation ? 2.0 : 3.0), 5e-4)), 3) +
-            " mm: give that as --rim-mm for the finer mesh (far slower)";
-  }
-  AtomicFileSet outputs;
-  AtomicFile& result_file = outputs.Add(a.out);
-  AtomicFile& outline_file = outputs.Add(outline_path);
-  AtomicFile* png_file = a.png.empty() ? nullptr : &outputs.Add(a.png);
-  if (png_file) {
-    CheckOutputExtension("--png", a.png, {".png"});
-    image_codecs::Load();  // opened now: a missing library fails before the drape
-  }
-  AtomicFile* obj_file = a.obj.empty() ? nullptr : &outputs.Add(a.obj);
-  AtomicFile* ply_file = a.ply.empty() ? nullptr : &outputs.Add(a.ply);
-
-  // Progress lines (the mesh, each seed's solves) only on a terminal or with --progress: a
-  // failed run's stderr holds its one error line (docs/spec/cli.md).
-  o.progress = [progress = a.progress](const std::string& line) {
-    Progress("drape: " + line, progress);
-  };
-  DrapeResult r;
-  try {
-    r = SimulateDrape(m, o);
-  } catch (const InputError& e) {
-    throw InputError(a.material + ": " + e.what());
-  }
-  if (!r.converged)
-    throw ComputeError("drape: not converged (" + r.message + "); no drape coefficient");
-
-  // A resting fabric that left part of the disk's top bare slid off it or, with contact on the
-  // nodes only, passed through it (docs/drapemeter.md, "Fabric through the support"): the
-  // support's own shadow keeps the DC ≥ 0, but the drape needs a look.
-  double bare = 0.0;
-  for (const DrapeSeedResult& seed : r.per_seed)
-    bare = std::max(bare, seed.shadow.bare_support_area);
-  if (bare > 0.02 * r.support_area) {  // a coarse rim polygon leaves slivers of up to ~1 %
-    char percent[32];
-    std::snprintf(percent, sizeof percent, "%.0f", 100.0 * bare / r.support_area);
-    note += std::string(note.empty() ? "" : "; ") + "the fabric left " + percent +
-            " % of the support's top bare: it slid off the disk or, as contact holds the nodes "
-            "only, passed through it (a coarse mesh); look at the mesh (--obj) before trusting "
-            "this DC";
-  }
-  // The resting contact's penalty lets the skirt sink into the disk's side under the rim's load.
-  // Past 0.3 mm (0.25 mm cost the Fig. 8 fabric's DC about 0.006, 1 mm about 0.03 on the default
-  // mesh; docs/drapemeter.md, "Contact stiffness") the run says so; which way the DC moves with a
-  // stiffer contact is the mesh's affair (on a 12 mm mesh it went up, then down).
-  double sink = 0.0;
-  for (const DrapeSeedResult& seed : r.per_seed) sink = std::max(sink, seed.max_penetration);
-  if (sink > 3e-4) {
-    note += std::string(note.empty() ? "" : "; ") + "the skirt sank up to " +
-            Num(units::MToMm(sink), 2) +
-            " mm into the support under the rim's load (--contact-sink-mm " +
-            Num(units::MToMm(o.contact_sink)) +
-            "); on the default mesh 1 mm cost the Fig. 8 fabric's DC about 0.03 "
-            "(docs/drapemeter.md, \"Contact stiffness\")";
-  }
-  // The extrapolation assumes the DC converges from below as the rim is refined; a split rim
-  // with a lower DC than the base's reverses the bracket (docs/drapemeter.md, "Extrapolated DC").
-  std::string reversed;
-  for (const DrapeSeedResult& seed : r.per_seed)
-    if (seed.extrapolation_reversed)
-      reversed += (reversed.empty() ? "" : ", ") + std::to_string(seed.seed);
-  if (!reversed.empty()) {
-    note += std::string(note.empty() ? "" : "; ") + "seed" +
-            (reversed.find(',') == std::string::npos ? " " : "s ") + reversed +
-            ": the split rim's DC is below the base's (a reversed bracket): the DC did not "
-            "converge from below as the extrapolation assumes; a finer --rim-mm or "
-            "--resolution-mm should agree before this DC is trusted";
-  }
-  const DrapeSeedResult& first = r.per_seed.front();
-  nlohmann::json j = ResultJson(r, o, m, a, turn_down);
-  j["note"] = note.empty() ? nlohmann::json() : nlohmann::json(note);
-  j["outline_csv"] = outline_file.path();
-  outline_file.Write(OutlineCsv(first));
-  if (png_file) {
-    if (!image_codecs::Write(png_file->temp_path(), ShadowImage(r, first, o)))
-      throw InputError("--png: cannot write " + a.png);
-    j["png"] = a.png;
-  }
-  if (obj_file) {
-    TriangleMesh draped = r.mesh;
-    draped.vertices = first.positions;
-    obj_file->Write(ObjText(draped));
-    j["obj"] = a.obj;
-  }
-  if (ply_file) {
-    ply_file->Write(DrapedPly(r, first));
-    j["ply"] = a.ply;
-  }
-  result_file.Write(j.dump(2) + "\n");
-  outputs.Commit();
-
-  if (a.json) {
-    j["output"] = a.out;
-    PrintJson(j);
-    return;
-  }
+// The result as text on stdout (the JSON's figures, rounded for people).
+void PrintText(const DrapeResult& r, const DrapeOptions& o, const Material& m, const DrapeArgs& a,
+               const std::string& outline_path) {
+  const std::string note = JoinNoteTexts(r.notes, "; ");
   std::cout << "material: " << (m.name.empty() ? a.material : m.name) << "  [" << a.material << "]"
             << (m.compression_ratio < 1.0
                     ? "; membrane soft in compression (ratio " + Num(m.compression_ratio) + ")"
@@ -602,10 +402,85 @@ void Run(const DrapeArgs& a) {
   }
   if (!note.empty()) std::cout << "\nnote: " << note;
   std::cout << "\ntime: " << Num(r.seconds, 3) << " s\nresult: " << a.out
-            << "\noutline: " << outline_file.path() << "\n";
+            << "\noutline: " << outline_path << "\n";
   if (!a.png.empty()) std::cout << "shadow: " << a.png << "\n";
   if (!a.obj.empty()) std::cout << "mesh: " << a.obj << "\n";
   if (!a.ply.empty()) std::cout << "mesh (PLY): " << a.ply << "\n";
+}
+
+void Run(const DrapeArgs& a) {
+  DrapeOptions o = Options(a);
+  if (a.compression_ratio &&
+      !(*a.compression_ratio >= kMinCompressionRatio && *a.compression_ratio <= 1.0))
+    throw InputError("--compression-ratio: must be between " + Num(kMinCompressionRatio) +
+                     " and 1 (1: as stiff in compression as in tension)");
+  // Check the outputs before reading or computing (an output must not be an input): distinct files
+  // in usable folders. They appear together at the end, or none of them.
+  const std::string outline_path = OutlinePath(a.out);
+  CheckDistinctOutputs({{"-o", a.out},
+                        {"the outline (next to -o)", outline_path},
+                        {"--png", a.png},
+                        {"--obj", a.obj},
+                        {"--ply", a.ply}},
+                       {{"--material", a.material}, {"--seam-file", a.seam_file}});
+  Material m = ReadMaterial(a.material);
+  if (a.compression_ratio) m.compression_ratio = *a.compression_ratio;
+  ChooseDrapeRim(m, a.rim_mm == "auto",
+                 a.extrapolate      ? DrapeExtrapolation::kOn
+                 : a.no_extrapolate ? DrapeExtrapolation::kOff
+                                    : DrapeExtrapolation::kDefault,
+                 &o);
+  if (std::string why; !o.Check(&why)) throw InputError("drape: " + why);
+  AtomicFileSet outputs;
+  AtomicFile& result_file = outputs.Add(a.out);
+  AtomicFile& outline_file = outputs.Add(outline_path);
+  AtomicFile* png_file = a.png.empty() ? nullptr : &outputs.Add(a.png);
+  if (png_file) CheckOutputExtension("--png", a.png, {".png"});
+  AtomicFile* obj_file = a.obj.empty() ? nullptr : &outputs.Add(a.obj);
+  AtomicFile* ply_file = a.ply.empty() ? nullptr : &outputs.Add(a.ply);
+
+  // Progress lines (the mesh, each seed's solves) only on a terminal or with --progress: a
+  // failed run's stderr holds its one error line (docs/spec/cli.md).
+  o.progress = [progress = a.progress](const std::string& line) {
+    Progress("drape: " + line, progress);
+  };
+  DrapeResult r;
+  try {
+    r = SimulateDrape(m, o);
+  } catch (const InputError& e) {
+    throw InputError(a.material + ": " + e.what());
+  }
+  if (!r.converged)
+    throw ComputeError("drape: not converged (" + r.message + "); no drape coefficient");
+
+  const DrapeSeedResult& first = r.per_seed.front();
+  nlohmann::json j = ResultJson(r, o, m, a);
+  j["outline_csv"] = outline_file.path();
+  outline_file.Write(OutlineCsv(first));
+  if (png_file) {
+    if (!WriteDrapeShadowPng(r, first, o, png_file->temp_path()))
+      throw InputError("--png: cannot write " + a.png);
+    j["png"] = a.png;
+  }
+  if (obj_file) {
+    TriangleMesh draped = r.mesh;
+    draped.vertices = first.positions;
+    obj_file->Write(ObjText(draped));
+    j["obj"] = a.obj;
+  }
+  if (ply_file) {
+    ply_file->Write(DrapedPly(r, first));
+    j["ply"] = a.ply;
+  }
+  result_file.Write(j.dump(2) + "\n");
+  outputs.Commit();
+
+  if (a.json) {
+    j["output"] = a.out;
+    PrintJson(j);
+    return;
+  }
+  PrintText(r, o, m, a, outline_file.path());
 }
 
 }  // namespace

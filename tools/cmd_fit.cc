@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "common/atomic_file.h"
-#include "common/chart.h"
+#include "common/chart_file.h"
 #include "common/cli.h"
 #include "common/profile_inputs.h"
 #include "textile/fit/clapp.h"

@@ -8,7 +8,7 @@
 #include <optional>
 
 #include "common/atomic_file.h"
-#include "common/chart.h"
+#include "common/chart_file.h"
 #include "common/cli.h"
 #include "textile/fit/moment_curve.h"
 #include "textile/sim/error.h"

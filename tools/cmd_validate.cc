@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "common/atomic_file.h"
-#include "common/chart.h"
+#include "common/chart_file.h"
 #include "common/cli.h"
 #include "common/profile_inputs.h"
 #include "textile/fit/direct_fit.h"

@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 
+#include "drape_stages.h"
 #include "textile/sim/cloth_problem.h"
 #include "textile/sim/contact.h"
 #include "textile/sim/error.h"
@@ -354,6 +355,150 @@ bool DrapeOptions::Check(std::string* why) const {
   return true;
 }
 
+namespace {
+
+std::uint8_t& ShadowCell(DrapeShadow* s, int i, int j) {
+  return s->mask[static_cast<size_t>(j) * s->width + i];
+}
+
+// Shadow stage 1: the empty grid over the projection and the support, with two empty cells of
+// margin on every side, so the border is outside the shadow.
+DrapeShadow ShadowGrid(const Vertices& x, double cell, double support_radius) {
+  DrapeShadow s;
+  s.cell = cell;
+  const double lo_x = std::min(x.col(0).minCoeff(), -support_radius);
+  const double hi_x = std::max(x.col(0).maxCoeff(), support_radius);
+  const double lo_y = std::min(x.col(1).minCoeff(), -support_radius);
+  const double hi_y = std::max(x.col(1).maxCoeff(), support_radius);
+  const double cells_x = (hi_x - lo_x) / cell, cells_y = (hi_y - lo_y) / cell;
+  if (cells_x * cells_y > 1e8)
+    throw InputError("shadow: the projection spans over 1e8 raster cells");
+  s.width = static_cast<int>(std::ceil(cells_x)) + 5;
+  s.height = static_cast<int>(std::ceil(cells_y)) + 5;
+  s.origin_x = lo_x - 2.0 * cell;
+  s.origin_y = lo_y - 2.0 * cell;
+  s.mask.assign(static_cast<size_t>(s.width) * s.height, 0);
+  return s;
+}
+
+// Shadow stage 2: the cells whose centres a projected triangle covers.
+void RasteriseTriangle(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                       DrapeShadow* s) {
+  const double area2 = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+  if (area2 == 0.0) return;  // seen edge-on: its neighbours cover its line
+  const double sign = area2 > 0.0 ? 1.0 : -1.0;
+  const double cell = s->cell;
+  const int i0 = std::max(
+      0, static_cast<int>(std::floor((std::min({a.x(), b.x(), c.x()}) - s->origin_x) / cell)));
+  const int i1 = std::min(
+      s->width - 1,
+      static_cast<int>(std::ceil((std::max({a.x(), b.x(), c.x()}) - s->origin_x) / cell)));
+  const int j0 = std::max(
+      0, static_cast<int>(std::floor((std::min({a.y(), b.y(), c.y()}) - s->origin_y) / cell)));
+  const int j1 = std::min(
+      s->height - 1,
+      static_cast<int>(std::ceil((std::max({a.y(), b.y(), c.y()}) - s->origin_y) / cell)));
+  // Edge functions, inclusive (a cell centre on a shared edge belongs to both triangles).
+  auto edge = [sign](const Eigen::Vector2d& p, const Eigen::Vector2d& q, double px, double py) {
+    return sign * ((q.x() - p.x()) * (py - p.y()) - (q.y() - p.y()) * (px - p.x()));
+  };
+  for (int j = j0; j <= j1; ++j) {
+    const double py = s->origin_y + j * cell;
+    for (int i = i0; i <= i1; ++i) {
+      const double px = s->origin_x + i * cell;
+      if (edge(a, b, px, py) >= 0.0 && edge(b, c, px, py) >= 0.0 && edge(c, a, px, py) >= 0.0)
+        ShadowCell(s, i, j) = 1;
+    }
+  }
+}
+
+// Shadow stage 3: the support casts its own shadow (the drapemeter's disk is opaque): a
+// specimen that leaves part of it bare (a resting fabric that passed through it, drape.h) still
+// shades all of it, so A_shadow ≥ A_support and the DC ≥ 0.
+void AddSupportShadow(double support_radius, DrapeShadow* s) {
+  if (!(support_radius > 0.0)) return;
+  const double r2 = support_radius * support_radius;
+  for (int j = 0; j < s->height; ++j) {
+    const double py = s->origin_y + j * s->cell;
+    for (int i = 0; i < s->width; ++i) {
+      const double px = s->origin_x + i * s->cell;
+      if (px * px + py * py > r2) continue;
+      if (ShadowCell(s, i, j) == 0) s->bare_support_area += s->cell * s->cell;
+      ShadowCell(s, i, j) = 1;
+    }
+  }
+}
+
+// Shadow stage 4: holes filled: the empty cells flooded from the border (marked 2); what the
+// flood does not reach is shadow.
+void FloodFromBorder(DrapeShadow* s) {
+  std::deque<std::pair<int, int>> queue;
+  auto seed = [&](int i, int j) {
+    if (ShadowCell(s, i, j) == 0) {
+      ShadowCell(s, i, j) = 2;
+      queue.emplace_back(i, j);
+    }
+  };
+  for (int i = 0; i < s->width; ++i) seed(i, 0), seed(i, s->height - 1);
+  for (int j = 0; j < s->height; ++j) seed(0, j), seed(s->width - 1, j);
+  while (!queue.empty()) {
+    const auto [i, j] = queue.front();
+    queue.pop_front();
+    if (i > 0) seed(i - 1, j);
+    if (i + 1 < s->width) seed(i + 1, j);
+    if (j > 0) seed(i, j - 1);
+    if (j + 1 < s->height) seed(i, j + 1);
+  }
+}
+
+// Shadow stage 5: the mask made 0/1 (flooded cells are outside), the area, and each angle bin's
+// largest radius of a shadow cell centre (-1 where none falls).
+void MeasureOutline(int bins, DrapeShadow* s) {
+  long count = 0;
+  s->angles.resize(bins);
+  s->radii = Eigen::VectorXd::Constant(bins, -1.0);
+  for (int b = 0; b < bins; ++b) s->angles(b) = (b + 0.5) * 2.0 * kPi / bins;
+  for (int j = 0; j < s->height; ++j) {
+    for (int i = 0; i < s->width; ++i) {
+      std::uint8_t& m = ShadowCell(s, i, j);
+      m = m == 2 ? 0 : 1;
+      if (!m) continue;
+      ++count;
+      const double px = s->origin_x + i * s->cell, py = s->origin_y + j * s->cell;
+      double theta = std::atan2(py, px);
+      if (theta < 0.0) theta += 2.0 * kPi;
+      const int b = std::min(bins - 1, static_cast<int>(theta / (2.0 * kPi) * bins));
+      s->radii(b) = std::max(s->radii(b), std::hypot(px, py));
+    }
+  }
+  s->area = static_cast<double>(count) * s->cell * s->cell;
+}
+
+// Shadow stage 6: bins no cell centre reached (a tiny shadow, or fine bins near the centre)
+// interpolated between the nearest filled bins on either side, circularly.
+void FillEmptyBins(Eigen::VectorXd* radii) {
+  const int bins = static_cast<int>(radii->size());
+  std::vector<int> filled;
+  for (int b = 0; b < bins; ++b)
+    if ((*radii)(b) >= 0.0) filled.push_back(b);
+  if (filled.empty()) {
+    radii->setZero();
+    return;
+  }
+  if (static_cast<int>(filled.size()) == bins) return;
+  const Eigen::VectorXd raw = *radii;
+  for (size_t k = 0; k < filled.size(); ++k) {
+    const int from = filled[k], to = filled[(k + 1) % filled.size()];
+    const int gap = (to - from + bins) % bins == 0 ? bins : (to - from + bins) % bins;
+    for (int g = 1; g < gap; ++g) {
+      const double t = static_cast<double>(g) / gap;
+      (*radii)((from + g) % bins) = (1.0 - t) * raw(from) + t * raw(to);
+    }
+  }
+}
+
+}  // namespace
+
 DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double cell, int bins,
                           double support_radius) {
   if (!(cell > 0.0) || !Finite(cell)) throw InputError("shadow: raster cell must be > 0");
@@ -364,124 +509,15 @@ DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double 
   if (!x.allFinite()) throw InputError("shadow: non-finite vertex positions");
   if (triangles.minCoeff() < 0 || triangles.maxCoeff() >= x.rows())
     throw InputError("shadow: triangle index out of range");
-  DrapeShadow s;
-  s.cell = cell;
-  const double lo_x = std::min(x.col(0).minCoeff(), -support_radius);
-  const double hi_x = std::max(x.col(0).maxCoeff(), support_radius);
-  const double lo_y = std::min(x.col(1).minCoeff(), -support_radius);
-  const double hi_y = std::max(x.col(1).maxCoeff(), support_radius);
-  const double cells_x = (hi_x - lo_x) / cell, cells_y = (hi_y - lo_y) / cell;
-  if (cells_x * cells_y > 1e8)
-    throw InputError("shadow: the projection spans over 1e8 raster cells");
-  // Two empty cells of margin on every side, so the border is outside the shadow.
-  s.width = static_cast<int>(std::ceil(cells_x)) + 5;
-  s.height = static_cast<int>(std::ceil(cells_y)) + 5;
-  s.origin_x = lo_x - 2.0 * cell;
-  s.origin_y = lo_y - 2.0 * cell;
-  s.mask.assign(static_cast<size_t>(s.width) * s.height, 0);
-  auto at = [&](int i, int j) -> std::uint8_t& {
-    return s.mask[static_cast<size_t>(j) * s.width + i];
-  };
-
-  for (int f = 0; f < triangles.rows(); ++f) {
-    const Eigen::Vector2d a = x.row(triangles(f, 0)).head<2>().transpose();
-    const Eigen::Vector2d b = x.row(triangles(f, 1)).head<2>().transpose();
-    const Eigen::Vector2d c = x.row(triangles(f, 2)).head<2>().transpose();
-    const double area2 = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-    if (area2 == 0.0) continue;  // seen edge-on: its neighbours cover its line
-    const double sign = area2 > 0.0 ? 1.0 : -1.0;
-    const int i0 = std::max(
-        0, static_cast<int>(std::floor((std::min({a.x(), b.x(), c.x()}) - s.origin_x) / cell)));
-    const int i1 = std::min(
-        s.width - 1,
-        static_cast<int>(std::ceil((std::max({a.x(), b.x(), c.x()}) - s.origin_x) / cell)));
-    const int j0 = std::max(
-        0, static_cast<int>(std::floor((std::min({a.y(), b.y(), c.y()}) - s.origin_y) / cell)));
-    const int j1 = std::min(
-        s.height - 1,
-        static_cast<int>(std::ceil((std::max({a.y(), b.y(), c.y()}) - s.origin_y) / cell)));
-    // Edge functions, inclusive (a cell centre on a shared edge belongs to both triangles).
-    auto edge = [sign](const Eigen::Vector2d& p, const Eigen::Vector2d& q, double px, double py) {
-      return sign * ((q.x() - p.x()) * (py - p.y()) - (q.y() - p.y()) * (px - p.x()));
-    };
-    for (int j = j0; j <= j1; ++j) {
-      const double py = s.origin_y + j * cell;
-      for (int i = i0; i <= i1; ++i) {
-        const double px = s.origin_x + i * cell;
-        if (edge(a, b, px, py) >= 0.0 && edge(b, c, px, py) >= 0.0 && edge(c, a, px, py) >= 0.0)
-          at(i, j) = 1;
-      }
-    }
-  }
-  // The support casts its own shadow (the drapemeter's disk is opaque): a specimen that leaves
-  // part of it bare (a resting fabric that passed through it, drape.h) still shades all of it, so
-  // A_shadow ≥ A_support and the DC ≥ 0.
-  if (support_radius > 0.0) {
-    const double r2 = support_radius * support_radius;
-    for (int j = 0; j < s.height; ++j) {
-      const double py = s.origin_y + j * cell;
-      for (int i = 0; i < s.width; ++i) {
-        const double px = s.origin_x + i * cell;
-        if (px * px + py * py > r2) continue;
-        if (at(i, j) == 0) s.bare_support_area += cell * cell;
-        at(i, j) = 1;
-      }
-    }
-  }
-  // Holes filled: flood the empty cells from the border; what the flood does not reach is shadow.
-  std::deque<std::pair<int, int>> queue;
-  auto seed = [&](int i, int j) {
-    if (at(i, j) == 0) {
-      at(i, j) = 2;
-      queue.emplace_back(i, j);
-    }
-  };
-  for (int i = 0; i < s.width; ++i) seed(i, 0), seed(i, s.height - 1);
-  for (int j = 0; j < s.height; ++j) seed(0, j), seed(s.width - 1, j);
-  while (!queue.empty()) {
-    const auto [i, j] = queue.front();
-    queue.pop_front();
-    if (i > 0) seed(i - 1, j);
-    if (i + 1 < s.width) seed(i + 1, j);
-    if (j > 0) seed(i, j - 1);
-    if (j + 1 < s.height) seed(i, j + 1);
-  }
-  long count = 0;
-  s.angles.resize(bins);
-  s.radii = Eigen::VectorXd::Constant(bins, -1.0);
-  for (int b = 0; b < bins; ++b) s.angles(b) = (b + 0.5) * 2.0 * kPi / bins;
-  for (int j = 0; j < s.height; ++j) {
-    for (int i = 0; i < s.width; ++i) {
-      std::uint8_t& m = at(i, j);
-      m = m == 2 ? 0 : 1;
-      if (!m) continue;
-      ++count;
-      const double px = s.origin_x + i * cell, py = s.origin_y + j * cell;
-      double theta = std::atan2(py, px);
-      if (theta < 0.0) theta += 2.0 * kPi;
-      const int b = std::min(bins - 1, static_cast<int>(theta / (2.0 * kPi) * bins));
-      s.radii(b) = std::max(s.radii(b), std::hypot(px, py));
-    }
-  }
-  s.area = static_cast<double>(count) * cell * cell;
-  // Bins no cell centre reached (a tiny shadow, or fine bins near the centre): interpolate
-  // between the nearest filled bins on either side, circularly.
-  std::vector<int> filled;
-  for (int b = 0; b < bins; ++b)
-    if (s.radii(b) >= 0.0) filled.push_back(b);
-  if (filled.empty()) {
-    s.radii.setZero();
-  } else if (static_cast<int>(filled.size()) < bins) {
-    const Eigen::VectorXd raw = s.radii;
-    for (size_t k = 0; k < filled.size(); ++k) {
-      const int from = filled[k], to = filled[(k + 1) % filled.size()];
-      const int gap = (to - from + bins) % bins == 0 ? bins : (to - from + bins) % bins;
-      for (int g = 1; g < gap; ++g) {
-        const double t = static_cast<double>(g) / gap;
-        s.radii((from + g) % bins) = (1.0 - t) * raw(from) + t * raw(to);
-      }
-    }
-  }
+  DrapeShadow s = ShadowGrid(x, cell, support_radius);
+  for (int f = 0; f < triangles.rows(); ++f)
+    RasteriseTriangle(x.row(triangles(f, 0)).head<2>().transpose(),
+                      x.row(triangles(f, 1)).head<2>().transpose(),
+                      x.row(triangles(f, 2)).head<2>().transpose(), &s);
+  AddSupportShadow(support_radius, &s);
+  FloodFromBorder(&s);
+  MeasureOutline(bins, &s);
+  FillEmptyBins(&s.radii);
   return s;
 }
 
@@ -589,170 +625,255 @@ double AutoRimElementSize(const Material& material, const DrapeOptions& o, bool 
   return std::min(std::max(wanted, smallest), o.element_size);
 }
 
-DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
-  const auto start = std::chrono::steady_clock::now();
-  std::string why;
-  if (!o.Check(&why)) throw InputError("drape options: " + why);
-  DrapeResult result;
-  std::vector<Seam> seams;
-  result.seam_lines = DrapeSeamLines(o);
-  for (const SeamLine& line : result.seam_lines) seams.push_back(Seam{o.seam_profile, line});
+void ChooseDrapeRim(const Material& material, bool rim_auto, DrapeExtrapolation extrapolation,
+                    DrapeOptions* o) {
+  RimTurnDownLength(material, *o);  // throws for a material or scene without one
+  // `--rim-mm auto` meshes the rim with ℓ/2 when extrapolating (within 0.01 of the converged
+  // DC in about 5 s), else ℓ/3 (an expected shortfall over 0.02 gets a note); at least 0.5 mm,
+  // at most the element size (which may itself be under 0.5 mm when the overhang is tiny).
+  const double rim_if_extrapolating =
+      rim_auto ? AutoRimElementSize(material, *o, true) : o->rim_element_size;
+  const bool possible = o->mount == DrapeMount::kClamped && rim_if_extrapolating > 0.0 &&
+                        o->rim_band >= rim_if_extrapolating;
+  o->rim_extrapolation = extrapolation == DrapeExtrapolation::kOn ||
+                         (extrapolation == DrapeExtrapolation::kDefault && possible);
+  o->rim_auto = rim_auto;
+  if (rim_auto) o->rim_element_size = AutoRimElementSize(material, *o, o->rim_extrapolation);
+}
 
-  auto say = [&o](const std::string& line) {
-    if (o.progress) o.progress(line);
-  };
-  const Pattern fine = MeshPattern(o, seams, 1.0);
-  std::unique_ptr<Pattern> coarse;
+namespace {
+
+void Say(const DrapeOptions& o, const std::string& line) {
+  if (o.progress) o.progress(line);
+}
+
+// The meshes of a run: the fine pattern, the coarse one of a cascade, the split rim's.
+struct DrapeScene {
+  std::vector<Seam> seams;
+  Pattern fine;
+  std::unique_ptr<Pattern> coarse;  // coarse_to_fine only
+  std::unique_ptr<Pattern> split;   // rim_extrapolation only
+  RefinedMesh refined;              // fine → split
+  const Pattern& last() const { return split ? *split : fine; }
+};
+
+// Stage 1: the seams, the meshes and the result's scene figures.
+DrapeScene BuildScene(const DrapeOptions& o, DrapeResult* result) {
+  DrapeScene scene;
+  result->seam_lines = DrapeSeamLines(o);
+  for (const SeamLine& line : result->seam_lines)
+    scene.seams.push_back(Seam{o.seam_profile, line});
+  scene.fine = MeshPattern(o, scene.seams, 1.0);
   if (o.coarse_to_fine) {
-    coarse = std::make_unique<Pattern>(MeshPattern(o, seams, o.coarse_factor));
-    result.coarse_vertices = coarse->pm.mesh.num_vertices();
+    scene.coarse = std::make_unique<Pattern>(MeshPattern(o, scene.seams, o.coarse_factor));
+    result->coarse_vertices = scene.coarse->pm.mesh.num_vertices();
   }
-  std::unique_ptr<Pattern> split;
-  RefinedMesh refined;
-  if (o.rim_extrapolation) split = std::make_unique<Pattern>(SplitRim(fine, o, &refined));
-  const Pattern& last = split ? *split : fine;
-  result.base_vertices = fine.pm.mesh.num_vertices();
-  result.mesh = last.pm.mesh;
-  result.seam_paths = last.pm.seam_paths;
-  result.seam_paths.pop_back();  // the support circle is not a seam
-  result.specimen_area = TriangleAreas(fine.pm.mesh).sum();
-  result.support_area = kPi * o.support_radius * o.support_radius;
+  if (o.rim_extrapolation)
+    scene.split = std::make_unique<Pattern>(SplitRim(scene.fine, o, &scene.refined));
+  result->base_vertices = scene.fine.pm.mesh.num_vertices();
+  result->mesh = scene.last().pm.mesh;
+  result->seam_paths = scene.last().pm.seam_paths;
+  result->seam_paths.pop_back();  // the support circle is not a seam
+  result->specimen_area = TriangleAreas(scene.fine.pm.mesh).sum();
+  result->support_area = kPi * o.support_radius * o.support_radius;
+  return scene;
+}
+
+std::string SceneReport(const DrapeScene& scene, const DrapeResult& result) {
+  const TriangleMesh& fine = scene.fine.pm.mesh;
+  std::ostringstream line;
+  line << "mesh: " << fine.num_vertices() << " vertices, " << fine.num_triangles() << " triangles"
+       << (scene.coarse ? " (coarse " + std::to_string(result.coarse_vertices) + " vertices)" : "")
+       << ", " << scene.fine.clamp.size() << " on the support";
+  if (scene.split)
+    line << "; split at the rim: " << scene.split->pm.mesh.num_vertices() << " vertices, "
+         << scene.split->pm.mesh.num_triangles() << " triangles";
+  return line.str();
+}
+
+// One seed on its way through the stages.
+struct SeedState {
+  DrapeSeedResult seed;
+  std::unique_ptr<ClothProblem> fine_problem;  // the split's friction anchors come from it
+  std::string failure;                         // why this seed has no DC
+};
+
+// The shadow of x on `mesh` into *shadow, and its DC.
+double MeasureDrape(const Vertices& x, const TriangleMesh& mesh, const DrapeOptions& o,
+                    const DrapeResult& result, DrapeShadow* shadow) {
+  *shadow = MeasureShadow(x, mesh.triangles, o.raster_cell, o.outline_bins, o.support_radius);
+  return DrapeCoefficient(shadow->area, result.specimen_area, result.support_area);
+}
+
+// Stage 2: the seeded start settled on the fine mesh (through the coarse one when cascadic).
+SeedState SettleBase(const Material& material, const DrapeOptions& o, const DrapeScene& scene,
+                     unsigned seed_number, DrapeResult* result) {
+  SeedState st;
+  DrapeSeedResult& seed = st.seed;
+  seed.seed = seed_number;
+  st.fine_problem = MakeProblem(scene.fine, material, scene.seams, o);
+  result->mass = st.fine_problem->total_mass();
+  if (scene.coarse) {
+    auto coarse_problem = MakeProblem(*scene.coarse, material, scene.seams, o);
+    Vertices xc = StartState(scene.coarse->pm.mesh, o, seed.seed);
+    seed.summary = SolveCascadic(coarse_problem.get(), st.fine_problem.get(), &xc,
+                                 &seed.positions, o.solver);
+  } else {
+    seed.positions = StartState(scene.fine.pm.mesh, o, seed.seed);
+    seed.summary = SolveStatic(st.fine_problem.get(), &seed.positions, o.solver);
+  }
+  seed.converged = seed.summary.converged;
+  seed.drape_coefficient = seed.base_drape_coefficient = seed.split_drape_coefficient = kNaN;
+  seed.extrapolation_bound = kNaN;
+  st.failure = seed.summary.message;
+  // #V of the split mesh (a failed coarse level of a cascade leaves no positions).
+  if (scene.split && !seed.converged &&
+      seed.positions.rows() == scene.fine.pm.mesh.num_vertices())
+    seed.positions = scene.refined.Prolong(seed.positions);
+  return st;
+}
+
+// Stage 3 (rim extrapolation): the base equilibrium measured, carried over to the split mesh
+// (the same surface) and settled there.
+void SettleSplit(const Material& material, const DrapeOptions& o, const DrapeScene& scene,
+                 const DrapeResult& result, SeedState* st) {
+  DrapeSeedResult& seed = st->seed;
+  if (!scene.split || !seed.converged) return;
+  seed.base_drape_coefficient =
+      MeasureDrape(seed.positions, scene.fine.pm.mesh, o, result, &seed.shadow);
   {
     std::ostringstream line;
-    line << "mesh: " << fine.pm.mesh.num_vertices() << " vertices, " << fine.pm.mesh.num_triangles()
-         << " triangles"
-         << (coarse ? " (coarse " + std::to_string(result.coarse_vertices) + " vertices)" : "")
-         << ", " << fine.clamp.size() << " on the support";
-    if (split)
-      line << "; split at the rim: " << split->pm.mesh.num_vertices() << " vertices, "
-           << split->pm.mesh.num_triangles() << " triangles";
-    say(line.str());
+    line << "seed " << seed.seed << ": base " << seed.summary.BriefReport() << "; DC "
+         << seed.base_drape_coefficient;
+    Say(o, line.str());
   }
+  auto split_problem = MakeProblem(*scene.split, material, scene.seams, o);
+  seed.positions = scene.refined.Prolong(seed.positions);
+  // Resting: the friction goes on from where each node landed on the base mesh.
+  if (o.mount == DrapeMount::kResting)
+    split_problem->CarryAnchorsFrom(*st->fine_problem, scene.refined.parents);
+  // The carried-over drape is near the split mesh's equilibrium: the exact Hessian from the
+  // first step (taken where it is positive definite) halved the steps (seed 2 of the Fig. 8
+  // fabric: 104 → 52; docs/drapemeter.md, "Extrapolated DC").
+  SolveOptions split_solver = o.solver;
+  if (split_solver.exact_below > 0.0) split_solver.exact_below = kInf;
+  seed.split_summary = SolveStatic(split_problem.get(), &seed.positions, split_solver);
+  seed.converged = seed.split_summary.converged;
+  if (!seed.converged) {
+    st->failure = "rim split: " + seed.split_summary.message;
+    seed.shadow = DrapeShadow{};
+    seed.base_drape_coefficient = kNaN;
+  }
+}
 
+// How deep the deepest node lies inside the resting mount's disk [m].
+double MaxPenetration(const Vertices& x, const DrapeOptions& o) {
+  const Support disk = RestingSupport(o);
+  double deepest = 0.0;
+  for (int i = 0; i < x.rows(); ++i)
+    deepest = std::max(deepest, -disk.SignedDistance(x.row(i).transpose(), nullptr));
+  return deepest;
+}
+
+// Stage 4: a converged seed's DC (extrapolated with a split rim), nodes and outline figures.
+void MeasureSeed(const DrapeOptions& o, const DrapeScene& scene, const DrapeResult& result,
+                 DrapeSeedResult* seed) {
+  if (!seed->converged) return;
+  seed->drape_coefficient =
+      MeasureDrape(seed->positions, scene.last().pm.mesh, o, result, &seed->shadow);
+  if (scene.split) {
+    // Between the split rim's DC and its first-order extrapolation: the middle, and half
+    // the bracket as the bound (docs/drapemeter.md, "Extrapolated DC").
+    seed->split_drape_coefficient = seed->drape_coefficient;
+    const RimExtrapolation e =
+        ExtrapolateRim(seed->base_drape_coefficient, seed->split_drape_coefficient);
+    seed->drape_coefficient = e.drape_coefficient;
+    seed->extrapolation_bound = e.bound;
+    seed->extrapolation_reversed = e.reversed;
+  }
+  seed->nodes = FindNodes(seed->shadow.radii, o.smoothing_bins, o.node_prominence,
+                          o.node_prominence_relative);
+  if (o.mount == DrapeMount::kResting) seed->max_penetration = MaxPenetration(seed->positions, o);
+  seed->min_radius = seed->shadow.radii.minCoeff();
+  seed->max_radius = seed->shadow.radii.maxCoeff();
+  seed->mean_radius = seed->shadow.radii.mean();
+}
+
+std::string SeedReport(const DrapeSeedResult& seed, bool split) {
+  std::ostringstream line;
+  line << "seed " << seed.seed << ": "
+       << (split && seed.summary.converged ? "split " + seed.split_summary.BriefReport()
+                                           : seed.summary.BriefReport());
+  if (seed.converged) {
+    if (split)
+      line << "; split DC " << seed.split_drape_coefficient << "; extrapolated";
+    else
+      line << ";";
+    line << " DC " << seed.drape_coefficient << ", " << seed.nodes.angles.size() << " nodes";
+  }
+  return line.str();
+}
+
+}  // namespace
+
+namespace drape_internal {
+
+void SummariseSeeds(DrapeResult* result) {
+  result->message.clear();
   std::vector<double> dcs, node_counts, mins, maxs, means;
+  for (const DrapeSeedResult& seed : result->per_seed) {
+    if (!seed.converged) continue;
+    dcs.push_back(seed.drape_coefficient);
+    node_counts.push_back(static_cast<double>(seed.nodes.angles.size()));
+    mins.push_back(seed.min_radius);
+    maxs.push_back(seed.max_radius);
+    means.push_back(seed.mean_radius);
+  }
+  result->converged = dcs.size() == result->per_seed.size();
+  if (!result->converged) {
+    result->drape_coefficient = result->drape_coefficient_sd = kNaN;
+    result->nodes = result->nodes_sd = kNaN;
+    result->min_radius = result->max_radius = result->mean_radius = kNaN;
+    result->min_radius_sd = result->max_radius_sd = result->mean_radius_sd = kNaN;
+    return;
+  }
+  result->message = "converged";
+  result->drape_coefficient = Mean(dcs);
+  result->drape_coefficient_sd = SampleSd(dcs);
+  result->nodes = Mean(node_counts);
+  result->nodes_sd = SampleSd(node_counts);
+  result->min_radius = Mean(mins);
+  result->max_radius = Mean(maxs);
+  result->mean_radius = Mean(means);
+  result->min_radius_sd = SampleSd(mins);
+  result->max_radius_sd = SampleSd(maxs);
+  result->mean_radius_sd = SampleSd(means);
+}
+
+}  // namespace drape_internal
+
+DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
+  if (std::string why; !o.Check(&why)) throw InputError("drape options: " + why);
+  DrapeResult result;
+  result.rim_turn_down = RimTurnDownLength(material, o);
+  const DrapeScene scene = BuildScene(o, &result);
+  Say(o, SceneReport(scene, result));
+  std::string failure;  // the first failing seed's
   for (int k = 0; k < o.seeds; ++k) {
-    DrapeSeedResult seed;
-    seed.seed = o.first_seed + static_cast<unsigned>(k);
-    auto fine_problem = MakeProblem(fine, material, seams, o);
-    result.mass = fine_problem->total_mass();
-    if (coarse) {
-      auto coarse_problem = MakeProblem(*coarse, material, seams, o);
-      Vertices xc = StartState(coarse->pm.mesh, o, seed.seed);
-      seed.summary =
-          SolveCascadic(coarse_problem.get(), fine_problem.get(), &xc, &seed.positions, o.solver);
-    } else {
-      seed.positions = StartState(fine.pm.mesh, o, seed.seed);
-      seed.summary = SolveStatic(fine_problem.get(), &seed.positions, o.solver);
-    }
-    seed.converged = seed.summary.converged;
-    seed.drape_coefficient = seed.base_drape_coefficient = seed.split_drape_coefficient = kNaN;
-    seed.extrapolation_bound = kNaN;
-    std::string failure = seed.summary.message;  // why this seed has no DC
-    const auto measure = [&](const Vertices& x, const TriangleMesh& mesh) {
-      seed.shadow =
-          MeasureShadow(x, mesh.triangles, o.raster_cell, o.outline_bins, o.support_radius);
-      return DrapeCoefficient(seed.shadow.area, result.specimen_area, result.support_area);
-    };
-    // #V of the split mesh (a failed coarse level of a cascade leaves no positions).
-    if (split && !seed.converged && seed.positions.rows() == fine.pm.mesh.num_vertices())
-      seed.positions = refined.Prolong(seed.positions);
-    if (seed.converged && split) {
-      // The base equilibrium on the split mesh (the same surface), then its own equilibrium.
-      seed.base_drape_coefficient = measure(seed.positions, fine.pm.mesh);
-      {
-        std::ostringstream line;
-        line << "seed " << seed.seed << ": base " << seed.summary.BriefReport() << "; DC "
-             << seed.base_drape_coefficient;
-        say(line.str());
-      }
-      auto split_problem = MakeProblem(*split, material, seams, o);
-      seed.positions = refined.Prolong(seed.positions);
-      // Resting: the friction goes on from where each node landed on the base mesh.
-      if (o.mount == DrapeMount::kResting)
-        split_problem->CarryAnchorsFrom(*fine_problem, refined.parents);
-      // The carried-over drape is near the split mesh's equilibrium: the exact Hessian from the
-      // first step (taken where it is positive definite) halved the steps (seed 2 of the Fig. 8
-      // fabric: 104 → 52; docs/drapemeter.md, "Extrapolated DC").
-      SolveOptions split_solver = o.solver;
-      if (split_solver.exact_below > 0.0) split_solver.exact_below = kInf;
-      seed.split_summary = SolveStatic(split_problem.get(), &seed.positions, split_solver);
-      seed.converged = seed.split_summary.converged;
-      if (!seed.converged) {
-        failure = "rim split: " + seed.split_summary.message;
-        seed.shadow = DrapeShadow{};
-        seed.base_drape_coefficient = kNaN;
-      }
-    }
-    if (seed.converged) {
-      seed.drape_coefficient = measure(seed.positions, last.pm.mesh);
-      if (split) {
-        // Between the split rim's DC and its first-order extrapolation: the middle, and half
-        // the bracket as the bound (docs/drapemeter.md, "Extrapolated DC").
-        seed.split_drape_coefficient = seed.drape_coefficient;
-        const RimExtrapolation e =
-            ExtrapolateRim(seed.base_drape_coefficient, seed.split_drape_coefficient);
-        seed.drape_coefficient = e.drape_coefficient;
-        seed.extrapolation_bound = e.bound;
-        seed.extrapolation_reversed = e.reversed;
-      }
-      seed.nodes = FindNodes(seed.shadow.radii, o.smoothing_bins, o.node_prominence,
-                             o.node_prominence_relative);
-      if (o.mount == DrapeMount::kResting) {
-        const Support disk = RestingSupport(o);
-        for (int i = 0; i < seed.positions.rows(); ++i) {
-          seed.max_penetration =
-              std::max(seed.max_penetration,
-                       -disk.SignedDistance(seed.positions.row(i).transpose(), nullptr));
-        }
-      }
-      seed.min_radius = seed.shadow.radii.minCoeff();
-      seed.max_radius = seed.shadow.radii.maxCoeff();
-      seed.mean_radius = seed.shadow.radii.mean();
-      dcs.push_back(seed.drape_coefficient);
-      node_counts.push_back(static_cast<double>(seed.nodes.angles.size()));
-      mins.push_back(seed.min_radius);
-      maxs.push_back(seed.max_radius);
-      means.push_back(seed.mean_radius);
-    }
-    {
-      std::ostringstream line;
-      line << "seed " << seed.seed << ": "
-           << (split && seed.summary.converged ? "split " + seed.split_summary.BriefReport()
-                                               : seed.summary.BriefReport());
-      if (seed.converged) {
-        if (split) {
-          line << "; split DC " << seed.split_drape_coefficient << "; extrapolated";
-        } else {
-          line << ";";
-        }
-        line << " DC " << seed.drape_coefficient << ", " << seed.nodes.angles.size() << " nodes";
-      }
-      say(line.str());
-    }
-    if (!seed.converged && result.message.empty()) {
-      result.message = "seed " + std::to_string(seed.seed) + ": " + failure;
-    }
-    result.per_seed.push_back(std::move(seed));
+    SeedState st = SettleBase(material, o, scene, o.first_seed + static_cast<unsigned>(k), &result);
+    SettleSplit(material, o, scene, result, &st);
+    MeasureSeed(o, scene, result, &st.seed);
+    Say(o, SeedReport(st.seed, scene.split != nullptr));
+    if (!st.seed.converged && failure.empty())
+      failure = "seed " + std::to_string(st.seed.seed) + ": " + st.failure;
+    result.per_seed.push_back(std::move(st.seed));
   }
-  result.converged = result.message.empty();
-  if (result.converged) {
-    result.message = "converged";
-    result.drape_coefficient = Mean(dcs);
-    result.drape_coefficient_sd = SampleSd(dcs);
-    result.nodes = Mean(node_counts);
-    result.nodes_sd = SampleSd(node_counts);
-    result.min_radius = Mean(mins);
-    result.max_radius = Mean(maxs);
-    result.mean_radius = Mean(means);
-    result.min_radius_sd = SampleSd(mins);
-    result.max_radius_sd = SampleSd(maxs);
-    result.mean_radius_sd = SampleSd(means);
-  } else {
-    result.drape_coefficient = result.drape_coefficient_sd = kNaN;
-    result.nodes = result.nodes_sd = kNaN;
-    result.min_radius = result.max_radius = result.mean_radius = kNaN;
-    result.min_radius_sd = result.max_radius_sd = result.mean_radius_sd = kNaN;
-  }
+  drape_internal::SummariseSeeds(&result);
+  if (!result.converged) result.message = failure;
+  bool rim_capped = false;
+  if (o.rim_auto) AutoRimElementSize(material, o, o.rim_extrapolation, &rim_capped);
+  result.notes = drape_internal::DrapeNotes(o, result, rim_capped);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

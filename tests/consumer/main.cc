@@ -1,10 +1,12 @@
 // Uses the installed headers and libraries: prints the paper's Fig. 8 law at 1/cm, and round-trips
-// a small image through the image codecs libfit opens at run time (textile/fit/image_codecs.h).
+// a small image through the image codecs libfit opens at run time (textile/fit/image_codecs.h),
+// and asks textile::plot for an axis's ticks (textile/sim/chart.h).
 #include <cstdio>
 #include <vector>
 
 #include "textile/fit/image_codecs.h"
 #include "textile/sim/bending_law.h"
+#include "textile/sim/chart.h"
 #include "textile/sim/units.h"
 
 int main() {
@@ -16,5 +18,6 @@ int main() {
   if (!textile::image_codecs::Encode(".png", image, &png)) return 1;
   const cv::Mat back = textile::image_codecs::Decode(cv::Mat(png), cv::IMREAD_GRAYSCALE);
   if (back.size() != image.size() || cv::norm(back, image, cv::NORM_INF) != 0.0) return 1;
+  if (textile::chart::NiceTicks(0.0, 1.0, 6).values.empty()) return 1;
   return m > 0.0 ? 0 : 1;
 }

@@ -1,4 +1,4 @@
-#include "common/chart.h"
+#include "common/chart_file.h"
 
 #include <cairo.h>
 #include <gtest/gtest.h>

@@ -48,6 +48,7 @@
 
 #include "textile/sim/material.h"
 #include "textile/sim/mesh.h"
+#include "textile/sim/note.h"
 #include "textile/sim/seam.h"
 #include "textile/sim/static_solver.h"
 
@@ -121,6 +122,9 @@ struct DrapeOptions {
   // orders near 1): the DC reported is its middle, DC_split + (DC_split − DC_base)/2, and the
   // bound its half-width.
   bool rim_extrapolation = false;
+  // rim_element_size is AutoRimElementSize's (`--rim-mm auto`, ChooseDrapeRim): the result's
+  // notes then say when its vertex cap decided (rim_auto_capped).
+  bool rim_auto = false;
   // Coarse → fine: solve on a mesh coarse_factor × element_size first and prolong (cascadic).
   // Off by default: the folds of the coarse solution are not the fine mesh's, and the fine level
   // spent more Newton steps re-folding than a cold start needs (8 mm: 236 steps and 13 CPU s
@@ -252,7 +256,16 @@ struct DrapeResult {
   double specimen_area = 0.0;                // meshed pattern area [m²]
   double support_area = 0.0;                 // π R_s² [m²]
   double mass = 0.0;                         // total mass incl. seam bands [kg]
+  double rim_turn_down = 0.0;                // RimTurnDownLength of the scene [m]
   double seconds = 0.0;                      // wall time, meshing included [s]
+  // What to know before trusting the DC, in this order (docs/drapemeter.md):
+  //   rim_shortfall      clamped, no extrapolation: the rim's elements are coarse against the
+  //                      turn-down length (first-order shortfall 0.1 e/ℓ over 0.02)
+  //   rim_auto_capped    rim_auto: the vertex cap, not ℓ, chose the rim's elements
+  //   bare_support       the fabric left over 2 % of the support's top bare
+  //   skirt_sink         resting: the skirt sank over 0.3 mm into the support
+  //   reversed_bracket   rim extrapolation: a seed's split rim gave a lower DC than its base
+  std::vector<Note> notes;
 };
 
 // The largest |seam_shift| [m] a shifted seam may have: one element (element_size) inside the
@@ -280,9 +293,21 @@ inline constexpr double kAutoRimMaxVertices = 10000.0;
 double AutoRimElementSize(const Material& material, const DrapeOptions& options, bool extrapolate,
                           bool* capped = nullptr);
 
+// How a caller asks for the rim extrapolation (`--extrapolate`, `--no-extrapolate` or neither).
+enum class DrapeExtrapolation { kDefault, kOn, kOff };
+
+// Settles the rim of a run in *options: rim_extrapolation (kDefault: wherever it applies, a
+// clamped specimen with a rim band at least one rim element wide; docs/drapemeter.md,
+// "Extrapolated DC") and, with rim_auto, rim_element_size = AutoRimElementSize (ℓ/2 when
+// extrapolating, else ℓ/3) and options->rim_auto. Throws as RimTurnDownLength; does not Check
+// the options it leaves.
+void ChooseDrapeRim(const Material& material, bool rim_auto, DrapeExtrapolation extrapolation,
+                    DrapeOptions* options);
+
 // Runs the drapemeter. Throws InputError for bad options or material (a specimen not larger
 // than the support, ...) and ComputeError when meshing fails; a solve that does not converge is
-// reported in the result (converged = false), never as a DC.
+// reported in the result (converged = false), never as a DC. The result's notes say what
+// to check before trusting the DC.
 DrapeResult SimulateDrape(const Material& material, const DrapeOptions& options);
 
 }  // namespace textile

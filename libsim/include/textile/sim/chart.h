@@ -1,7 +1,8 @@
-#ifndef TEXTILE_TOOLS_COMMON_CHART_H_
-#define TEXTILE_TOOLS_COMMON_CHART_H_
+#ifndef TEXTILE_SIM_CHART_H_
+#define TEXTILE_SIM_CHART_H_
 
-// Declarative line/scatter charts rendered to PNG with Cairo: the CLI's plots of
+// Declarative line/scatter charts rendered to PNG with Cairo (target textile::plot, apart from
+// textile::sim so that the physics does not need Cairo): the CLI's plots of
 // moment-curvature and stiffness curves, measured vs fitted profiles and benchmark curves.
 // Describe what to show; ranges, ticks, legend placement and layout are automatic.
 //
@@ -14,7 +15,7 @@
 //   chart::Panel profile{.title = "Profile", .x_label = "x [mm]", .y_label = "z [mm]",
 //                        .equal_aspect = true};
 //   ...
-//   chart::WritePng({.title = "Sample 3", .columns = 2, .panels = {mk, profile}}, "fit.png");
+//   chart::RenderPng({.title = "Sample 3", .columns = 2, .panels = {mk, profile}}, "fit.png");
 //
 // Points that cannot be drawn (NaN/inf, or ≤ 0 on a log axis) are skipped and break the
 // line there; a series with no drawable point is left out (also from the legend), and a
@@ -23,10 +24,6 @@
 #include <optional>
 #include <string>
 #include <vector>
-
-namespace textile {
-class AtomicFile;
-}  // namespace textile
 
 namespace textile::chart {
 
@@ -81,13 +78,10 @@ struct Figure {
   bool Check(std::string* why) const;
 };
 
-// Renders the figure to a PNG file at path (extension .png), atomically: on failure no
-// file is left and an existing one is untouched. Throws InputError naming the path if it
-// cannot be written or the figure fails Check().
-void WritePng(const Figure& figure, const std::string& path);
-// The same into an output staged in an AtomicFileSet (or an AtomicFile the caller commits):
-// the picture goes to out.temp_path(); out.path() must end in .png.
-void WritePng(const Figure& figure, AtomicFile& out);
+// Renders the figure and writes it as PNG to `file`, as it is (the CLI stages it in an
+// AtomicFile: tools/common/chart_file.h). Errors name shown_path (default: file): InputError if
+// it does not end in .png, the figure fails Check() or the file cannot be written.
+void RenderPng(const Figure& figure, const std::string& file, const std::string& shown_path = "");
 // Throws InputError naming the path unless it ends in .png (any case): callers that stage a
 // chart check its name before the work.
 void CheckPngPath(const std::string& path);
@@ -110,4 +104,4 @@ Ticks LogTicks(double lo, double hi, int max_count);
 
 }  // namespace textile::chart
 
-#endif  // TEXTILE_TOOLS_COMMON_CHART_H_
+#endif  // TEXTILE_SIM_CHART_H_

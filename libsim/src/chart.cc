@@ -1,4 +1,4 @@
-#include "common/chart.h"
+#include "textile/sim/chart.h"
 
 #include <cairo.h>
 
@@ -10,7 +10,6 @@
 #include <memory>
 #include <tuple>
 
-#include "common/atomic_file.h"
 #include "textile/sim/error.h"
 
 namespace textile::chart {
@@ -862,8 +861,8 @@ void CheckPngPath(const std::string& path) {
   if (extension != ".png") throw InputError(path + ": a chart is written as PNG; use a .png name");
 }
 
-void WritePng(const Figure& figure, AtomicFile& out) {
-  const std::string& path = out.path();
+void RenderPng(const Figure& figure, const std::string& file, const std::string& shown_path) {
+  const std::string& path = shown_path.empty() ? file : shown_path;
   CheckPngPath(path);
   std::string why;
   if (!figure.Check(&why)) throw InputError(path + ": cannot draw the chart: " + why);
@@ -877,18 +876,10 @@ void WritePng(const Figure& figure, AtomicFile& out) {
         path + ": drawing the chart failed: " + cairo_status_to_string(cairo_status(cr.get())));
   }
   cairo_surface_flush(surface.get());
-  const cairo_status_t written = cairo_surface_write_to_png(surface.get(), out.temp_path().c_str());
+  const cairo_status_t written = cairo_surface_write_to_png(surface.get(), file.c_str());
   if (written != CAIRO_STATUS_SUCCESS) {
     throw InputError(path + ": cannot write PNG: " + cairo_status_to_string(written));
   }
-  out.CheckWritten();
-}
-
-void WritePng(const Figure& figure, const std::string& path) {
-  CheckPngPath(path);
-  AtomicFile out(path);  // checks the folder before any drawing work
-  WritePng(figure, out);
-  out.Commit();
 }
 
 }  // namespace textile::chart

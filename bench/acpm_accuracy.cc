@@ -4,7 +4,7 @@
 // side-profile RMS against run time (a Pareto curve), with the elastica's own time as the reference
 // row. Three shell variants: the curvature-tensor bending with one push (first-order convergence),
 // the same extrapolated from e and e/2 (the default), and the paper's hinges (biased short by
-// their bending-twist coupling, docs/statics.md).
+// their bending-twist coupling, docs/methods/statics.md).
 
 #include <chrono>
 #include <cmath>
@@ -14,8 +14,8 @@
 #include "bench/bench.h"
 #include "common/chart_file.h"
 #include "common/cli.h"
-#include "textile/sim/acpm_shell.h"
-#include "textile/sim/elastica.h"
+#include "textile/sim/scenes/acpm_shell.h"
+#include "textile/sim/elastica/elastica.h"
 
 namespace textile::bench {
 

@@ -7,7 +7,7 @@
 #include "bench/bench.h"
 #include "common/atomic_file.h"
 #include "common/cli.h"
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile::cli {
 namespace {

@@ -17,7 +17,7 @@
 
 #include "bench/bench.h"
 #include "common/chart_file.h"
-#include "textile/sim/bending_element.h"
+#include "textile/sim/elements/bending_element.h"
 
 namespace textile::bench {
 namespace {

@@ -15,7 +15,7 @@
 
 #include "bench/bench.h"
 #include "common/chart_file.h"
-#include "textile/sim/drape.h"
+#include "textile/sim/scenes/drape.h"
 
 namespace textile::bench {
 
@@ -92,7 +92,7 @@ Benchmark DrapeConvergenceBenchmark() {
         const std::vector<double> tolerances =
             ctx.quick ? std::vector<double>{1e-3, 1e-4} : std::vector<double>{1e-3, 1e-4, 1e-5, 1e-6};
         // The finer band along the support's rim (DrapeOptions::rim_element_size) on the default
-        // mesh: the drape's error is mostly there (docs/drapemeter.md, "Resolution").
+        // mesh: the drape's error is mostly there (docs/methods/drapemeter.md, "Resolution").
         const std::vector<double> rims_mm =
             ctx.quick ? std::vector<double>{6} : std::vector<double>{6, 4, 3, 2};
         const double default_h = DrapeOptions{}.element_size;
@@ -155,7 +155,7 @@ Benchmark DrapeConvergenceBenchmark() {
           add(DrapeSeams::kWeft, 0.004, std::min(half_rim, 0.004), default_tol, false, true);
         }
 
-        // A membrane soft in compression (docs/drapemeter.md, "Compression ratio"): the CLI's
+        // A membrane soft in compression (docs/methods/drapemeter.md, "Compression ratio"): the CLI's
         // default extrapolation and, in the full run, the ℓ/3 base's split (about 10k vertices),
         // whose warm-started solve settles in about 12 steps where the stiff membrane's wanders.
         constexpr double kSoft = 0.01;
@@ -219,7 +219,7 @@ Benchmark DrapeConvergenceBenchmark() {
           sum << line;
         }
         // The second target's figure, read off the extrapolated rows: the split mesh's solve,
-        // warm-started from the base drape carried over (docs/drapemeter.md, "Solver").
+        // warm-started from the base drape carried over (docs/methods/drapemeter.md, "Solver").
         for (const auto& r : res.rows) {
           if (!r["extrapolated"].get<bool>()) continue;
           const double c = r["compression_ratio"].get<double>();

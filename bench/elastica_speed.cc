@@ -7,8 +7,8 @@
 
 #include "bench/bench.h"
 #include "common/chart_file.h"
-#include "textile/sim/elastica.h"
-#include "textile/sim/units.h"
+#include "textile/sim/elastica/elastica.h"
+#include "textile/sim/core/units.h"
 
 namespace textile::bench {
 

@@ -17,10 +17,10 @@
 
 #include "bench/bench.h"
 #include "common/chart_file.h"
-#include "textile/fit/extract.h"
-#include "textile/fit/image_codecs.h"
-#include "textile/fit/render_photo.h"
-#include "textile/sim/bending_law.h"
+#include "textile/photo/extract.h"
+#include "textile/photo/image_codecs.h"
+#include "textile/photo/render_photo.h"
+#include "textile/sim/law/bending_law.h"
 
 namespace textile::bench {
 namespace {

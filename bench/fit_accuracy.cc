@@ -17,9 +17,9 @@
 #include "textile/fit/law_error.h"
 #include "textile/fit/profile_compare.h"
 #include "textile/fit/synthetic_profile.h"
-#include "textile/sim/elastica.h"
-#include "textile/sim/error.h"
-#include "textile/sim/units.h"
+#include "textile/sim/elastica/elastica.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile::bench {
 namespace {

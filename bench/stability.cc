@@ -9,7 +9,7 @@
 // random low-frequency displacement waves of up to 5 cm that vanish at the held edge. Starts
 // with tangles (every vertex thrown independently) have folded equilibria of their own: without
 // self-contact a sheet folded through itself stays folded, so "the same energy from every start"
-// can only be asked of starts in one basin (docs/statics.md).
+// can only be asked of starts in one basin (docs/methods/statics.md).
 
 #include <algorithm>
 #include <chrono>
@@ -20,7 +20,7 @@
 
 #include "bench/bench.h"
 #include "common/chart_file.h"
-#include "textile/sim/static_solver.h"
+#include "textile/sim/solve/static_solver.h"
 
 namespace textile::bench {
 

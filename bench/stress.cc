@@ -13,8 +13,8 @@
 #include "bench/bench.h"
 #include "common/chart_file.h"
 #include "common/cli.h"
-#include "textile/sim/error.h"
-#include "textile/sim/static_solver.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/solve/static_solver.h"
 
 namespace textile::bench {
 

@@ -12,12 +12,12 @@
 #include "common/atomic_file.h"
 #include "common/chart_file.h"
 #include "common/cli.h"
-#include "textile/sim/acpm.h"
-#include "textile/sim/error.h"
-#include "textile/sim/material.h"
-#include "textile/sim/mesh_io.h"
-#include "textile/sim/seam.h"
-#include "textile/sim/units.h"
+#include "textile/sim/scenes/acpm.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/law/material.h"
+#include "textile/sim/io/mesh_io.h"
+#include "textile/sim/law/seam.h"
+#include "textile/sim/core/units.h"
 
 namespace textile::cli {
 namespace {

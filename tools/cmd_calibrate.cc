@@ -9,10 +9,10 @@
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
-#include "textile/fit/calibrate.h"
-#include "textile/fit/extract.h"
-#include "textile/fit/image_codecs.h"
-#include "textile/sim/error.h"
+#include "textile/photo/calibrate.h"
+#include "textile/photo/extract.h"
+#include "textile/photo/image_codecs.h"
+#include "textile/sim/core/error.h"
 
 namespace textile::cli {
 namespace {

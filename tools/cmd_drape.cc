@@ -15,12 +15,12 @@
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
-#include "textile/sim/drape.h"
-#include "textile/sim/drape_picture.h"
-#include "textile/sim/error.h"
-#include "textile/sim/material.h"
-#include "textile/sim/mesh_io.h"
-#include "textile/sim/units.h"
+#include "textile/sim/scenes/drape.h"
+#include "textile/sim/plot/drape_picture.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/law/material.h"
+#include "textile/sim/io/mesh_io.h"
+#include "textile/sim/core/units.h"
 
 namespace textile::cli {
 namespace {
@@ -502,7 +502,7 @@ void RegisterDrape(CLI::App& app) {
                   "Seam JSON file (from fit-seam) instead of --seam-type");
   sub->add_option("--seam-rib", a->seam_rib,
                   "Lengthwise stiffness of the seam band as a factor on S (>= 1; default the "
-                  "seam file's rib_factor, 1 for the presets: the paper's model; docs/seams.md)");
+                  "seam file's rib_factor, 1 for the presets: the paper's model; docs/methods/seams.md)");
   sub->add_option(
       "--mount", a->mount,
       "clamped (default: held between two disks) or resting (lies on the disk, "
@@ -515,7 +515,7 @@ void RegisterDrape(CLI::App& app) {
       "--rim-mm", a->rim_mm,
       "Element size along the support's rim [mm]; auto (the default): half the fabric's "
       "turn-down length when extrapolating, else a third; 0: no finer rim and no "
-      "extrapolation (10x faster; clamped: DC about 0.1 low; docs/drapemeter.md)");
+      "extrapolation (10x faster; clamped: DC about 0.1 low; docs/methods/drapemeter.md)");
   sub->add_option("--rim-band-mm", a->rim_band_mm,
                   "Width of that finer band beyond the rim [mm] (default 20, or a third of an "
                   "overhang under 60 mm)");
@@ -523,18 +523,18 @@ void RegisterDrape(CLI::App& app) {
                   "Resting mount: the contact's stiffness, as how far a node sinks into the "
                   "support under its own weight [mm] (1e-6 to 0.03, default 0.01; 0.001 sinks "
                   "the skirt a quarter as deep, takes twice the time and may not settle; "
-                  "docs/drapemeter.md, \"Contact stiffness\")");
+                  "docs/methods/drapemeter.md, \"Contact stiffness\")");
   sub->add_option("--compression-ratio", a->compression_ratio,
                   "The membrane's stiffness against compression as a fraction of its stretch "
                   "stiffness (0.001 to 1; default the material's stretch.compression_ratio, 1: "
                   "as stiff as in tension); fabric buckles far more easily, and the DC drops with "
-                  "it (docs/drapemeter.md, \"Compression ratio\")");
+                  "it (docs/methods/drapemeter.md, \"Compression ratio\")");
   sub->add_option("--specimen-mm", a->specimen_mm, "Specimen radius [mm] (default 150)");
   sub->add_option("--support-mm", a->support_mm, "Support radius [mm] (default 90)");
   sub->add_option(
       "--seam-refine-mm", a->seam_refine_mm,
       "Refine the mesh within this distance of the seam lines [mm]: element area / ceil(S(d)) "
-      "(Pabst 4.3; default 0: off; docs/drapemeter.md, \"Seam refinement\")");
+      "(Pabst 4.3; default 0: off; docs/methods/drapemeter.md, \"Seam refinement\")");
   sub->add_option("--shift-mm", a->shift_mm,
                   "Offset of the shifted seam from the centre [mm] (default 50)");
   sub->add_option("--perturbation-mm", a->perturbation_mm,

@@ -11,11 +11,11 @@
 #include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/profile_inputs.h"
-#include "textile/fit/extract.h"
-#include "textile/fit/image_codecs.h"
+#include "textile/photo/extract.h"
+#include "textile/photo/image_codecs.h"
 #include "textile/fit/profile.h"
-#include "textile/fit/rig.h"
-#include "textile/sim/error.h"
+#include "textile/photo/rig.h"
+#include "textile/sim/core/error.h"
 
 namespace textile::cli {
 namespace {

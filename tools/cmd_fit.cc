@@ -16,9 +16,9 @@
 #include "textile/fit/fit_report.h"
 #include "textile/fit/profile.h"
 #include "textile/fit/profile_compare.h"
-#include "textile/sim/error.h"
-#include "textile/sim/material.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/law/material.h"
+#include "textile/sim/core/units.h"
 
 namespace textile::cli {
 namespace {

@@ -12,7 +12,7 @@
 #include "common/atomic_file.h"
 #include "common/cli.h"
 #include "textile/fit/seam_fit.h"
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile::cli {
 namespace {

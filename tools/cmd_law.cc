@@ -11,9 +11,9 @@
 #include "common/chart_file.h"
 #include "common/cli.h"
 #include "textile/fit/moment_curve.h"
-#include "textile/sim/error.h"
-#include "textile/sim/material.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/law/material.h"
+#include "textile/sim/core/units.h"
 
 namespace textile::cli {
 namespace {

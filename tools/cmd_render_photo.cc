@@ -10,10 +10,10 @@
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
-#include "textile/fit/image_codecs.h"
-#include "textile/fit/render_photo.h"
-#include "textile/sim/error.h"
-#include "textile/sim/material.h"
+#include "textile/photo/image_codecs.h"
+#include "textile/photo/render_photo.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/law/material.h"
 
 namespace textile::cli {
 namespace {

@@ -10,9 +10,9 @@
 #include "common/atomic_file.h"
 #include "common/cli.h"
 #include "textile/fit/synthetic_profile.h"
-#include "textile/sim/error.h"
-#include "textile/sim/material.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/law/material.h"
+#include "textile/sim/core/units.h"
 
 namespace textile::cli {
 namespace {

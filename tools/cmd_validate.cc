@@ -1,6 +1,6 @@
 // textile validate: photos or profiles -> direct fit -> the same cantilevers simulated with the
 // fitted law at the photographed overhangs, by the elastica and by the shell model -> measured vs
-// simulated (docs/validation.md): the goodness of fit, and with two or more profiles each one
+// simulated (docs/guide/validate.md): the goodness of fit, and with two or more profiles each one
 // predicted by the law fitted to the others (leave-one-out). RMS and maximum deviation, tip
 // difference, verdicts against a stated tolerance, a report JSON and a picture with all curves.
 // The work is libfit's ValidateFit (validate.h); this file parses, prints and writes.
@@ -21,10 +21,10 @@
 #include "textile/fit/fit_report.h"
 #include "textile/fit/profile_compare.h"
 #include "textile/fit/validate.h"
-#include "textile/sim/error.h"
-#include "textile/sim/material.h"
-#include "textile/sim/note.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/law/material.h"
+#include "textile/sim/core/note.h"
+#include "textile/sim/core/units.h"
 
 namespace textile::cli {
 namespace {
@@ -289,7 +289,7 @@ nlohmann::json ReportJson(const ValidateArgs& a, const ValidationSummary& v,
           {"holdout_method",
            "leave-one-out: each profile predicted at its fitted overhang by the law, offset and "
            "rotation fitted to the other profiles, graded by the tolerance; sigma: that fit's "
-           "covariance through the elastica's sensitivities (docs/validation.md)"},
+           "covariance through the elastica's sensitivities (docs/guide/validate.md)"},
           {"holdout", HoldoutJson(v)},
           {"holdout_verdict", HoldoutVerdictName(v.holdout_verdict)},
           {"note", note.empty() ? nlohmann::json() : nlohmann::json(note)},

@@ -15,8 +15,8 @@
 #include "cost_functions/clapp_law_cost.h"
 #include "deadline.h"
 #include "law_parameters.h"
-#include "textile/sim/error.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

@@ -19,9 +19,9 @@
 #include "direct_fit_stages.h"
 #include "textile/fit/clapp.h"
 #include "law_parameters.h"
-#include "textile/sim/error.h"
-#include "textile/sim/textile_range.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/law/textile_range.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

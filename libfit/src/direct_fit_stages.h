@@ -18,7 +18,7 @@
 
 #include "textile/fit/direct_fit.h"
 #include "textile/fit/profile.h"
-#include "textile/sim/bending_law.h"
+#include "textile/sim/law/bending_law.h"
 
 namespace textile::internal {
 

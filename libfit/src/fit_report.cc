@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "textile/sim/cantilever_outputs.h"
-#include "textile/sim/units.h"
+#include "textile/sim/elastica/cantilever_outputs.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

@@ -7,7 +7,7 @@
 #include <sstream>
 #include <vector>
 
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 

@@ -12,7 +12,7 @@
 #include <cassert>
 #include <cmath>
 
-#include "textile/sim/bending_law.h"
+#include "textile/sim/law/bending_law.h"
 
 namespace textile::internal {
 

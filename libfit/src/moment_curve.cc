@@ -6,8 +6,8 @@
 #include <sstream>
 
 #include "csv_text.h"
-#include "textile/sim/error.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "csv_text.h"
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

@@ -7,9 +7,9 @@
 
 #include "cost_functions/profile_model.h"
 #include "law_parameters.h"
-#include "textile/sim/elastica.h"
-#include "textile/sim/error.h"
-#include "textile/sim/polyline.h"
+#include "textile/sim/elastica/elastica.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/polyline.h"
 
 namespace textile {
 

@@ -14,9 +14,9 @@
 #include <sstream>
 
 #include "seam_fit_stages.h"
-#include "textile/sim/error.h"
-#include "textile/sim/json_text.h"
-#include "textile/sim/number_text.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/io/json_text.h"
+#include "textile/sim/core/number_text.h"
 
 namespace textile {
 namespace {

@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "textile/fit/direct_fit.h"
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

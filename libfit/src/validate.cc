@@ -8,9 +8,9 @@
 #include <utility>
 
 #include "textile/fit/fit_report.h"
-#include "textile/sim/error.h"
-#include "textile/sim/polyline.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/polyline.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

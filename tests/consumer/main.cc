@@ -1,13 +1,13 @@
 // Uses the installed headers and libraries: prints the paper's Fig. 8 law at 1/cm, and round-trips
-// a small image through the image codecs libfit opens at run time (textile/fit/image_codecs.h),
-// and asks textile::plot for an axis's ticks (textile/sim/chart.h).
+// a small image through the image codecs libfit opens at run time (textile/photo/image_codecs.h),
+// and asks textile::plot for an axis's ticks (textile/sim/plot/chart.h).
 #include <cstdio>
 #include <vector>
 
-#include "textile/fit/image_codecs.h"
-#include "textile/sim/bending_law.h"
-#include "textile/sim/chart.h"
-#include "textile/sim/units.h"
+#include "textile/photo/image_codecs.h"
+#include "textile/sim/law/bending_law.h"
+#include "textile/sim/plot/chart.h"
+#include "textile/sim/core/units.h"
 
 int main() {
   const auto law = textile::BendingLaw::FromKes(0.1, 0.0892, -0.0092);

@@ -1,4 +1,4 @@
-#include "calibrate_stages.h"
+#include "photo/calibrate_stages.h"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 // shift), a profile extracted with the calibrated rig matches the truth, and boards that are
 // not there, wrong corner counts and bad options are refused.
 
-#include "textile/fit/calibrate.h"
+#include "textile/photo/calibrate.h"
 
 #include <gtest/gtest.h>
 
@@ -16,9 +16,9 @@
 #include <utility>
 #include <vector>
 
-#include "textile/fit/extract.h"
-#include "textile/fit/render_photo.h"
-#include "textile/sim/error.h"
+#include "textile/photo/extract.h"
+#include "textile/photo/render_photo.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

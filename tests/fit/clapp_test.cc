@@ -11,9 +11,9 @@
 
 #include "textile/fit/law_error.h"
 #include "textile/fit/synthetic_profile.h"
-#include "textile/sim/elastica.h"
-#include "textile/sim/error.h"
-#include "textile/sim/units.h"
+#include "textile/sim/elastica/elastica.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {
@@ -190,7 +190,7 @@ TEST(ClappFit, PaperFig8NoiseFree) {
 }
 
 TEST(ClappFit, PixelNoiseDegradesTheMomentCurve) {
-  // σ = 0.1 mm on 100 points per profile, 12 seeds. Over 100 seeds (docs/clapp.md) the
+  // σ = 0.1 mm on 100 points per profile, 12 seeds. Over 100 seeds (docs/methods/clapp.md) the
   // error had median 2.7 % and worst 10.5 %; these bounds leave room for 12 draws.
   const BendingLaw law = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
   const double kappa_max = TrueKappaMax(law);
@@ -213,7 +213,7 @@ TEST(ClappFit, PixelNoiseDegradesTheMomentCurve) {
 
 TEST(ClappFit, NeverReturnsAnInvalidLaw) {
   // Uniform weights with every point near the edge kept: σ / r angle noise wrecks the
-  // polynomials (docs/clapp.md). Whatever comes out is a valid law or an explicit failure.
+  // polynomials (docs/methods/clapp.md). Whatever comes out is a valid law or an explicit failure.
   const BendingLaw law = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
   ClappOptions o;
   o.min_radius = 0.0;

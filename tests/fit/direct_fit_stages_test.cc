@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "textile/sim/error.h"
-#include "textile/sim/textile_range.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/law/textile_range.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

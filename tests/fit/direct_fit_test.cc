@@ -10,9 +10,9 @@
 #include "cost_functions/profile_model.h"
 #include "law_parameters.h"
 #include "textile/fit/law_error.h"
-#include "textile/sim/elastica.h"
-#include "textile/sim/error.h"
-#include "textile/sim/units.h"
+#include "textile/sim/elastica/elastica.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

@@ -1,4 +1,4 @@
-// The stages of ExtractProfile (libfit/src/extract_internal.h), one by one on synthetic photos
+// The stages of ExtractProfile (libfit/src/photo/extract_internal.h), one by one on synthetic photos
 // with a known truth (tests/fit/synthetic_photo.h): what each stage adds to the state, and the
 // failure or warning it owns. ExtractProfile itself is tested whole in extract_test.cc.
 
@@ -10,12 +10,12 @@
 #include <string>
 #include <vector>
 
-#include "extract_internal.h"
+#include "photo/extract_internal.h"
 #include "synthetic_photo.h"
-#include "textile/fit/extract.h"
-#include "textile/fit/rig.h"
-#include "textile/sim/error.h"
-#include "textile/sim/note.h"
+#include "textile/photo/extract.h"
+#include "textile/photo/rig.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/note.h"
 
 namespace textile {
 namespace {

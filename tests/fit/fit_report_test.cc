@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "textile/fit/synthetic_profile.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

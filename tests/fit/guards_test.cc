@@ -12,8 +12,8 @@
 #include "textile/fit/clapp.h"
 #include "textile/fit/direct_fit.h"
 #include "textile/fit/synthetic_profile.h"
-#include "textile/sim/error.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

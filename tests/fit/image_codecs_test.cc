@@ -1,8 +1,8 @@
-// OpenCV's image codecs are opened at run time (textile/fit/image_codecs.h): what the loader says
+// OpenCV's image codecs are opened at run time (textile/photo/image_codecs.h): what the loader says
 // when the library is missing or is not the codecs, and that the installed one round-trips images
 // through the functions it resolved.
 
-#include "textile/fit/image_codecs.h"
+#include "textile/photo/image_codecs.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

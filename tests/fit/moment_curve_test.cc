@@ -7,8 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "textile/sim/error.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

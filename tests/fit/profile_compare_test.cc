@@ -6,8 +6,8 @@
 #include <numbers>
 #include <vector>
 
-#include "textile/sim/elastica.h"
-#include "textile/sim/error.h"
+#include "textile/sim/elastica/elastica.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

@@ -1,4 +1,4 @@
-#include "render_photo_stages.h"
+#include "photo/render_photo_stages.h"
 
 #include <gtest/gtest.h>
 

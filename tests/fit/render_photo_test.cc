@@ -3,16 +3,16 @@
 // are checked, and the extractor recovers the truth from its photos (easy and medium levels)
 // through the true rig.
 
-#include "textile/fit/render_photo.h"
+#include "textile/photo/render_photo.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "textile/fit/extract.h"
-#include "textile/sim/elastica.h"
-#include "textile/sim/error.h"
-#include "textile/sim/units.h"
+#include "textile/photo/extract.h"
+#include "textile/sim/elastica/elastica.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

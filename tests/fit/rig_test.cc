@@ -1,7 +1,7 @@
 // Rig files: plain scale and homography (with or without a lens model), their mapping, their
 // round trip through JSON, and every way a rig file can be wrong.
 
-#include "textile/fit/rig.h"
+#include "textile/photo/rig.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

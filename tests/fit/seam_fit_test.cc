@@ -8,7 +8,7 @@
 #include <cmath>
 #include <random>
 
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

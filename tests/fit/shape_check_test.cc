@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "textile/sim/bending_law.h"
-#include "textile/sim/elastica.h"
+#include "textile/sim/law/bending_law.h"
+#include "textile/sim/elastica/elastica.h"
 
 namespace textile {
 namespace {

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <string>
 
-#include "textile/sim/elastica.h"
-#include "textile/sim/error.h"
+#include "textile/sim/elastica/elastica.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

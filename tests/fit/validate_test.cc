@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "textile/fit/synthetic_profile.h"
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {
@@ -167,7 +167,7 @@ TEST(ValidateFit, OneProfileHoldsNothingOut) {
 }
 
 // The shell predicts a held-out profile as the elastica does (its curve lies within 0.05 mm of
-// the exact one, docs/validation.md), with the same σ; in-sample both ran too.
+// the exact one, docs/guide/validate.md), with the same σ; in-sample both ran too.
 TEST(ValidateFit, TheShellPredictsLikeTheElastica) {
   ValidationOptions o;
   o.tolerance = 2.0 * kNoise;

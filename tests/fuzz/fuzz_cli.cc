@@ -35,7 +35,7 @@
 #include <vector>
 
 #include "common/cli.h"
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace fs = std::filesystem;
 

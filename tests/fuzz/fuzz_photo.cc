@@ -19,10 +19,10 @@
 #include <fstream>
 #include <string>
 
-#include "textile/fit/extract.h"
+#include "textile/photo/extract.h"
 #include "textile/fit/profile.h"
-#include "textile/fit/rig.h"
-#include "textile/sim/error.h"
+#include "textile/photo/rig.h"
+#include "textile/sim/core/error.h"
 
 namespace {
 

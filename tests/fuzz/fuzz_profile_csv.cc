@@ -6,7 +6,7 @@
 #include <string>
 
 #include "textile/fit/profile.h"
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

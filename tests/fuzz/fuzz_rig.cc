@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <string>
 
-#include "textile/fit/rig.h"
-#include "textile/sim/error.h"
+#include "textile/photo/rig.h"
+#include "textile/sim/core/error.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <string>
 
-#include "textile/sim/error.h"
-#include "textile/sim/seam.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/law/seam.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "textile/fit/seam_fit.h"
-#include "textile/sim/error.h"
-#include "textile/sim/json_text.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/io/json_text.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

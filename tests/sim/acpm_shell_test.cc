@@ -1,4 +1,4 @@
-#include "textile/sim/acpm_shell.h"
+#include "textile/sim/scenes/acpm_shell.h"
 
 #include <gtest/gtest.h>
 
@@ -6,12 +6,12 @@
 #include <cmath>
 #include <limits>
 
-#include "textile/sim/acpm.h"
-#include "textile/sim/cantilever_outputs.h"
-#include "textile/sim/elastica.h"
-#include "textile/sim/error.h"
-#include "textile/sim/polyline.h"
-#include "textile/sim/seam.h"
+#include "textile/sim/scenes/acpm.h"
+#include "textile/sim/elastica/cantilever_outputs.h"
+#include "textile/sim/elastica/elastica.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/polyline.h"
+#include "textile/sim/law/seam.h"
 
 namespace textile {
 namespace {
@@ -69,7 +69,7 @@ TEST(AcpmShell, ExtrapolatedPlainSampleAgreesWithTheElastica) {
 }
 
 TEST(AcpmShell, HingeBendingIsTooSoftForAFreeStrip) {
-  // The paper's hinge energies couple bend with twist on a triangle grid (docs/statics.md):
+  // The paper's hinge energies couple bend with twist on a triangle grid (docs/methods/statics.md):
   // the plain strip crosses 20-25 % short of the elastica at any resolution. Kept as a check
   // that the tensor model is what fixed it.
   const Material m = Fabric(0.1, 0.0892, -0.0092, 200);
@@ -100,7 +100,7 @@ TEST(AcpmShell, SeamAlongThePushStiffensTheRaysNearItSymmetrically) {
   ASSERT_TRUE(shell.converged) << shell.message;
   ASSERT_TRUE(std::isfinite(shell.plain_overhang));
   // The rays near the seam are cut later than the edges; left and right alike. (The plate
-  // couples the width: the front is nearly flat over the middle, docs/acpm.md.)
+  // couples the width: the front is nearly flat over the middle, docs/methods/acpm.md.)
   EXPECT_GT(shell.overhang[2], shell.overhang[0]);
   EXPECT_GT(shell.overhang[1], shell.overhang[0]);
   // Mirror rays agree to 0.5 % of L: the uniform diagonals tilt the front at first order in
@@ -133,7 +133,7 @@ TEST(AcpmShell, AcrossSeamBehindTheEdgeStiffensTheOverhang) {
   AcpmOptions options = OneRayAcrossCPlainSeam(0.1);
   options.model = AcpmModelKind::kElastica;
   const AcpmResult elastica = RunAcpm(m, options);
-  ASSERT_GT(elastica.rays[0].overhang, 0.055);  // docs/acpm.md: 61.7 mm
+  ASSERT_GT(elastica.rays[0].overhang, 0.055);  // docs/methods/acpm.md: 61.7 mm
   const AcpmCrossings shell = ShellAcpmCrossings(m, options, options.RayPositions());
   ASSERT_TRUE(shell.converged) << shell.message;
   EXPECT_NEAR(shell.overhang[0] / elastica.rays[0].overhang, 1.0, 0.03);
@@ -156,7 +156,7 @@ TEST(AcpmShell, AcrossSeamFarBehindTheEdgeChangesNothing) {
 }
 
 TEST(AcpmShell, SeamAlongOnASideEdgeIsMirroredByTheOtherEdge) {
-  // docs/acpm.md refuses only z_s outside [0, W]: a seam on either side edge runs along that
+  // docs/methods/acpm.md refuses only z_s outside [0, W]: a seam on either side edge runs along that
   // edge's grid line (it used to move an inner line onto the edge: a degenerate triangle).
   // The two are mirror images: ray i of one is ray n-1-i of the other, and the rays next to
   // the seam are cut later than those far from it.

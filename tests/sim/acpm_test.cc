@@ -1,15 +1,15 @@
 // The virtual ACPM200 (acpm.h) and the elastica's strip variation (elastica.h) that answers a
 // seam across the push direction.
 
-#include "textile/sim/acpm.h"
+#include "textile/sim/scenes/acpm.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "textile/sim/elastica.h"
-#include "textile/sim/error.h"
-#include "textile/sim/units.h"
+#include "textile/sim/elastica/elastica.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {
@@ -35,7 +35,7 @@ std::string ErrorOf(Fn fn) {
 
 // ---- The strip variation of the elastica ----
 
-// The reference solutions have rel_tol 1e-10 (docs/cantilever-facts.md: positions to ~1e-12 L);
+// The reference solutions have rel_tol 1e-10 (docs/methods/cantilever-facts.md: positions to ~1e-12 L);
 // two different integrations of the same strip agree to 1e-9 L.
 constexpr double kSameStrip = 1e-9;
 
@@ -235,7 +235,7 @@ TEST(Acpm, SeamAlongIsAnsweredByTheShellModel) {
   EXPECT_EQ(r.model, AcpmModelKind::kShell);
   ASSERT_EQ(r.rays.size(), 3u);
   // The seam's ray (the centre) is stiffer than the plain fabric; the factor is taken against
-  // the shell's own plain crossing at the same resolution (docs/statics.md).
+  // the shell's own plain crossing at the same resolution (docs/methods/statics.md).
   EXPECT_GT(r.rays[1].factor, 1.5);
   EXPECT_NEAR(r.rays[0].factor, r.rays[2].factor, 1e-2 * r.rays[0].factor);
   o.model = AcpmModelKind::kElastica;

@@ -1,4 +1,4 @@
-#include "textile/sim/bending_element.h"
+#include "textile/sim/elements/bending_element.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <optional>
 #include <random>
 
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

@@ -1,4 +1,4 @@
-#include "textile/sim/bending_law.h"
+#include "textile/sim/law/bending_law.h"
 
 #include <gtest/gtest.h>
 
@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "textile/sim/error.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

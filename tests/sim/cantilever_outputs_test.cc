@@ -1,4 +1,4 @@
-#include "textile/sim/cantilever_outputs.h"
+#include "textile/sim/elastica/cantilever_outputs.h"
 
 #include <gtest/gtest.h>
 
@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "textile/sim/error.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

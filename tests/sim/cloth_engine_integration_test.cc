@@ -6,10 +6,10 @@
 
 #include <cmath>
 
-#include "textile/sim/bending_element.h"
-#include "textile/sim/pattern_mesh.h"
-#include "textile/sim/seam.h"
-#include "textile/sim/units.h"
+#include "textile/sim/elements/bending_element.h"
+#include "textile/sim/mesh/pattern_mesh.h"
+#include "textile/sim/law/seam.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

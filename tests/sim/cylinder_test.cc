@@ -2,7 +2,7 @@
 // on a cylinder of radius R must have a bending energy per area that converges to Ψ(1/R) under
 // refinement. Pabst et al.'s "resolution independence" (section 3.3, Fig. 3), measured.
 //
-// What holds and what does not (docs/bending.md, "Cylinder test"): a hinge energy sees only
+// What holds and what does not (docs/methods/bending.md, "Cylinder test"): a hinge energy sees only
 // bend angles across edges, so its limit depends on how the mesh's edges sit relative to the
 // cylinder axis. With the area weight A_h = |ē| h̄e it is exact for grids whose edges run
 // along and across the axis (regular grids wrapped in x or y, whatever the law) and, for a
@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "textile/sim/bending_element.h"
+#include "textile/sim/elements/bending_element.h"
 
 namespace textile {
 namespace {
@@ -162,7 +162,7 @@ const BendingLaw& LawNamed(const std::string& name) {
 }
 
 TEST(CylinderTest, PrintsTheErrorTable) {
-  // The table of docs/bending.md: relative error of the energy per area against Ψ(1/R).
+  // The table of docs/methods/bending.md: relative error of the energy per area against Ψ(1/R).
   std::printf("| mesh | wrap | law | R [mm] |");
   for (int n : kLevels) std::printf(" n = %d |", n);
   std::printf("\n|---|---|---|---|");
@@ -196,7 +196,7 @@ TEST(CylinderTest, RegularGridsConvergeToPsiForEveryLawAlongBothAxes) {
 }
 
 // Equilateral meshes with a linear law: exact in the interior at every orientation
-// (docs/bending.md derives Σ κ² = c² per pair of triangles), O(1/n) from the boundary.
+// (docs/methods/bending.md derives Σ κ² = c² per pair of triangles), O(1/n) from the boundary.
 constexpr double kEquilateralLinearBoundAtFinest = 0.012;
 
 TEST(CylinderTest, EquilateralMeshesConvergeToPsiForALinearLaw) {

@@ -1,14 +1,14 @@
-// The policy stages of SimulateDrape (libsim/src/drape_stages.h): the trust checks a drape
+// The policy stages of SimulateDrape (libsim/src/scenes/drape_stages.h): the trust checks a drape
 // result carries as notes, the figures over its seeds, and the rim a run is given.
-#include "drape_stages.h"
+#include "scenes/drape_stages.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 
-#include "textile/sim/drape.h"
-#include "textile/sim/error.h"
+#include "textile/sim/scenes/drape.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

@@ -1,4 +1,4 @@
-#include "textile/sim/drape.h"
+#include "textile/sim/scenes/drape.h"
 
 #include <gtest/gtest.h>
 
@@ -7,9 +7,9 @@
 #include <random>
 
 #include "ring_area.h"
-#include "textile/sim/contact.h"
-#include "textile/sim/error.h"
-#include "textile/sim/pattern_mesh.h"
+#include "textile/sim/elements/contact.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/mesh/pattern_mesh.h"
 
 namespace textile {
 namespace {
@@ -25,7 +25,7 @@ Material Fig8() {
 }
 
 // Coarse scenes keep the tests fast; the figures they check are orderings and bounds that hold
-// at any resolution (docs/drapemeter.md has the converged numbers).
+// at any resolution (docs/methods/drapemeter.md has the converged numbers).
 DrapeOptions Coarse() {
   DrapeOptions o;
   o.element_size = 0.015;
@@ -217,7 +217,7 @@ TEST(Drape, RimBandOptionsAreCheckedByName) {
 }
 
 TEST(Drape, RimExtrapolationBoundIsHalfTheBracketEitherWay) {
-  // docs/drapemeter.md, "Extrapolated DC": the middle of [DC_split, 2 DC_split - DC_base] and
+  // docs/methods/drapemeter.md, "Extrapolated DC": the middle of [DC_split, 2 DC_split - DC_base] and
   // half its width; a split DC below the base's is a reversed bracket, said as such, and its
   // bound is still >= 0 (it was printed as "DC ± -0.0038").
   const RimExtrapolation up = ExtrapolateRim(0.80, 0.84);
@@ -323,7 +323,7 @@ TEST(Drape, RimTurnDownLengthIsTheClampedStripsBoundaryLayer) {
 }
 
 // The overhang turns down at the rim over a few millimetres; a mesh too coarse there lets it
-// fold along one row of edges and the drape comes out low (docs/drapemeter.md, "Resolution").
+// fold along one row of edges and the drape comes out low (docs/methods/drapemeter.md, "Resolution").
 TEST(Drape, RimBandRefinesTheRimAndRaisesTheDrape) {
   DrapeOptions o = Coarse();
   o.rim_element_size = 0.005;
@@ -424,7 +424,7 @@ TEST(Drape, RimExtrapolationSplitsTheRimAndExtrapolates) {
 // seed 1: DC 0.532 (μ = 0.3, 118 steps, outline from 104.5 mm), 0.383 (μ = 0.1, from 95.8 mm),
 // 0.560 (μ = 3); clamped 0.509. Slip
 // between converged stretches (lagged_slip) settled here only with μ = 3 (DC 0.491, 621 steps)
-// and per-step stick/slip switching never (docs/drapemeter.md, "Limits").
+// and per-step stick/slip switching never (docs/methods/drapemeter.md, "Limits").
 TEST(Drape, RestingSpecimenSettlesWithTheSamplesFrictionAndLessFrictionLetsItSlideOut) {
   DrapeOptions o = Coarse();
   o.mount = DrapeMount::kResting;
@@ -447,7 +447,7 @@ TEST(Drape, RestingSpecimenSettlesWithTheSamplesFrictionAndLessFrictionLetsItSli
 
 // The resting mount's contact stiffness (DrapeOptions::contact_sink): the rim carries the hanging
 // overhang, many times a node's own weight, so the penalty lets the skirt sink into the disk's
-// side (1 mm on the CLI's default mesh, the DC about 0.03 low; docs/drapemeter.md, "Contact
+// side (1 mm on the CLI's default mesh, the DC about 0.03 low; docs/methods/drapemeter.md, "Contact
 // stiffness"), and a stiffer one less. max_penetration reports the deepest node. Measured on
 // this mesh, seed 1: the deepest node 0.49 mm at 1e-5 m (DC 0.532), 0.18 mm at 3e-6 m (0.579).
 TEST(Drape, AStifferRestingContactSinksTheSkirtLess) {
@@ -589,7 +589,7 @@ TEST(Drape, StifferFabricDrapesLess) {
 
 // A membrane soft in compression (Material::compression_ratio) takes up the skirt's excess
 // circumference by compressing where the stabilised StVK has to fold, so the skirt hangs lower
-// (docs/drapemeter.md, "Compression ratio"). Measured on this 15 mm mesh: 0.509 → 0.372 at 0.01.
+// (docs/methods/drapemeter.md, "Compression ratio"). Measured on this 15 mm mesh: 0.509 → 0.372 at 0.01.
 TEST(Drape, AMembraneSoftInCompressionDrapesLower) {
   Material soft = Fig8();
   soft.compression_ratio = 0.01;

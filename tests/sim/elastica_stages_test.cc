@@ -1,4 +1,4 @@
-#include "elastica_stages.h"
+#include "elastica/elastica_stages.h"
 
 #include <gtest/gtest.h>
 

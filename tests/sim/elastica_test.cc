@@ -1,4 +1,4 @@
-#include "textile/sim/elastica.h"
+#include "textile/sim/elastica/elastica.h"
 
 #include <gtest/gtest.h>
 
@@ -9,8 +9,8 @@
 #include <utility>
 #include <vector>
 
-#include "textile/sim/error.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

@@ -1,13 +1,13 @@
-// Gmsh is loaded at run time (libsim/src/gmsh_api.h): what the loader says when the library is
+// Gmsh is loaded at run time (libsim/src/mesh/gmsh_api.h): what the loader says when the library is
 // missing or is not Gmsh, and that the installed one has every function the mesher calls.
 
-#include "gmsh_api.h"
+#include "mesh/gmsh_api.h"
 
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

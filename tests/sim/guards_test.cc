@@ -8,10 +8,10 @@
 #include <limits>
 #include <string>
 
-#include "textile/sim/bending_law.h"
-#include "textile/sim/elastica.h"
-#include "textile/sim/error.h"
-#include "textile/sim/units.h"
+#include "textile/sim/law/bending_law.h"
+#include "textile/sim/elastica/elastica.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

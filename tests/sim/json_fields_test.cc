@@ -1,4 +1,4 @@
-#include "textile/sim/json_fields.h"
+#include "textile/sim/io/json_fields.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "textile/sim/material.h"
+#include "textile/sim/law/material.h"
 
 #include <gtest/gtest.h>
 
@@ -6,8 +6,8 @@
 #include <utility>
 #include <vector>
 
-#include "textile/sim/error.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

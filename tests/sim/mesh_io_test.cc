@@ -1,4 +1,4 @@
-#include "textile/sim/mesh_io.h"
+#include "textile/sim/io/mesh_io.h"
 
 #include <gtest/gtest.h>
 
@@ -8,9 +8,9 @@
 #include <random>
 #include <sstream>
 
-#include "textile/sim/error.h"
-#include "textile/sim/mesh.h"
-#include "textile/sim/pattern_mesh.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/mesh/mesh.h"
+#include "textile/sim/mesh/pattern_mesh.h"
 
 namespace textile {
 namespace {

@@ -1,11 +1,11 @@
-#include "textile/sim/mesh.h"
+#include "textile/sim/mesh/mesh.h"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <set>
 
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

@@ -1,11 +1,11 @@
-#include "textile/sim/note.h"
+#include "textile/sim/core/note.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 
-#include "textile/sim/number_text.h"
+#include "textile/sim/core/number_text.h"
 
 namespace textile {
 namespace {

@@ -1,4 +1,4 @@
-#include "textile/sim/pattern_mesh.h"
+#include "textile/sim/mesh/pattern_mesh.h"
 
 #include <gtest/gtest.h>
 
@@ -8,8 +8,8 @@
 #include <set>
 #include <thread>
 
-#include "textile/sim/error.h"
-#include "textile/sim/mesh.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/mesh/mesh.h"
 
 #include "ring_area.h"
 

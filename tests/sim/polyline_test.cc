@@ -1,4 +1,4 @@
-#include "textile/sim/polyline.h"
+#include "textile/sim/core/polyline.h"
 
 #include <gtest/gtest.h>
 

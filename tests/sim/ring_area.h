@@ -6,7 +6,7 @@
 #include <Eigen/Core>
 #include <limits>
 
-#include "textile/sim/mesh.h"
+#include "textile/sim/mesh/mesh.h"
 
 namespace textile {
 

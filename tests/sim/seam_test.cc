@@ -1,4 +1,4 @@
-#include "textile/sim/seam.h"
+#include "textile/sim/law/seam.h"
 
 #include <gtest/gtest.h>
 
@@ -7,9 +7,9 @@
 #include <random>
 #include <string>
 
-#include "textile/sim/error.h"
-#include "textile/sim/json_text.h"
-#include "textile/sim/material.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/io/json_text.h"
+#include "textile/sim/law/material.h"
 
 namespace textile {
 namespace {

@@ -1,4 +1,4 @@
-#include "serial_openmp.h"
+#include "solve/serial_openmp.h"
 
 #include <dlfcn.h>
 #include <gtest/gtest.h>

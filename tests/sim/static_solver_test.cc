@@ -1,4 +1,4 @@
-#include "textile/sim/static_solver.h"
+#include "textile/sim/solve/static_solver.h"
 
 #include <gtest/gtest.h>
 
@@ -8,10 +8,10 @@
 #include <limits>
 #include <random>
 
-#include "textile/sim/cloth_problem.h"
-#include "textile/sim/error.h"
-#include "textile/sim/seam.h"
-#include "textile/sim/units.h"
+#include "textile/sim/solve/cloth_problem.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/law/seam.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

@@ -1,4 +1,4 @@
-#include "textile/sim/tensor_bending.h"
+#include "textile/sim/elements/tensor_bending.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <random>
 #include <set>
 
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {
@@ -95,7 +95,7 @@ TEST(TensorBending, ReproducesAConstantCurvatureTensorOnEveryMesh) {
 
 TEST(TensorBending, BendAndTwistAreSeparate) {
   // On a 2:1 grid a pure bend along x costs A Ψ(κ) and nothing else; a pure twist costs
-  // A 2Ψ(κ). The hinge energies mix the two (docs/statics.md); this one does not.
+  // A 2Ψ(κ). The hinge energies mix the two (docs/methods/statics.md); this one does not.
   const TriangleMesh mesh = RegularGridMesh(0.04, 0.04, 32, 16);
   const std::vector<Hinge> hinges = BuildHinges(mesh);
   const BendingLaw law = Linear(1e-5);

@@ -1,4 +1,4 @@
-#include "textile/sim/units.h"
+#include "textile/sim/core/units.h"
 
 #include <gtest/gtest.h>
 

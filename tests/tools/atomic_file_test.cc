@@ -15,7 +15,7 @@
 #include <utility>
 #include <vector>
 
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace fs = std::filesystem;
 

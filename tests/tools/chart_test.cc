@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "common/atomic_file.h"
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace fs = std::filesystem;
 

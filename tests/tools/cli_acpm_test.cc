@@ -10,8 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "run_cli.h"
-#include "textile/sim/bending_law.h"
-#include "textile/sim/units.h"
+#include "textile/sim/law/bending_law.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "run_cli.h"
-#include "textile/fit/rig.h"
+#include "textile/photo/rig.h"
 
 namespace textile {
 namespace {

@@ -1,5 +1,5 @@
 // `textile drape` through the real executable (coarse meshes: the figures are checked for
-// consistency and bounds, docs/drapemeter.md has the converged numbers).
+// consistency and bounds, docs/methods/drapemeter.md has the converged numbers).
 
 #include <gtest/gtest.h>
 
@@ -212,7 +212,7 @@ TEST(CliDrape, LengthwiseStiffSeamsPutTheNodesOnTheSeamLines) {
   // Default settings (the fold pattern needs the rim band). The paper's scalar seam (rib 1)
   // puts the four nodes of weft + warp seams on the diagonals (measured 45°, 134°, 224°, 316°);
   // a seam band 16 times stiffer against bending its own line puts them on the seam lines
-  // (measured 92°, 176°, 266°, 358° for seeds 1-4). docs/seams.md, "Lengthwise stiffness".
+  // (measured 92°, 176°, 266°, 358° for seeds 1-4). docs/methods/seams.md, "Lengthwise stiffness".
   const auto dir = Scratch("CliDrape.Rib");
   const auto paper = Textile("drape " + kFig8 + " --seams weft+warp -o " + (dir / "paper.json").string() +
                              " --json");
@@ -256,7 +256,7 @@ TEST(CliDrape, RimBandIsMeshedReportedAndRecorded) {
 }
 
 // --seam-refine-mm: the mesh refined near the seam lines only (Pabst 4.3), recorded in the scene;
-// the DC moves little (docs/drapemeter.md, "Seam refinement": at most 0.003 on the default mesh).
+// the DC moves little (docs/methods/drapemeter.md, "Seam refinement": at most 0.003 on the default mesh).
 TEST(CliDrape, SeamRefinementMeshesTheSeamBandFinerAndKeepsTheDrape) {
   const auto dir = Scratch("CliDrape.SeamRefine");
   const std::string weft = "drape " + kFig8 + kCoarse + " --seams weft -o ";
@@ -405,7 +405,7 @@ TEST(CliDrape, AFabricThroughTheSupportGetsAWarningAndNoNegativeDc) {
 
 // The resting contact's penalty lets the skirt sink into the disk's side under the rim's load:
 // past 0.3 mm the run says how deep and what that cost on the default mesh; a stiffer contact
-// (--contact-sink-mm) sinks it less, and says nothing (docs/drapemeter.md, "Contact stiffness").
+// (--contact-sink-mm) sinks it less, and says nothing (docs/methods/drapemeter.md, "Contact stiffness").
 // Measured on this mesh, seed 1: 0.57 mm at the default 0.01 (DC 0.517), 0.11 mm at 0.001 (0.544).
 TEST(CliDrape, ASkirtSunkIntoTheSupportGetsANoteAndAStifferContactSinksItLess) {
   const auto dir = Scratch("CliDrape.Sink");
@@ -436,7 +436,7 @@ TEST(CliDrape, ASkirtSunkIntoTheSupportGetsANoteAndAStifferContactSinksItLess) {
 
 // --compression-ratio overrides the material's stretch.compression_ratio: the report names
 // it, the result's material carries it, and the skirt hangs lower than with the sample's
-// default 1 (docs/drapemeter.md, "Compression ratio").
+// default 1 (docs/methods/drapemeter.md, "Compression ratio").
 TEST(CliDrape, CompressionRatioSoftensTheMembraneAndIsReported) {
   const auto dir = Scratch("CliDrape.Compression");
   const auto soft = Textile("drape " + kFig8 + kCoarse + " --compression-ratio 0.01 -o " +
@@ -487,7 +487,7 @@ TEST(CliDrape, RestingMountSettlesAndACutShortRunFailsCleanly) {
   EXPECT_EQ(banded.err.find("split at the rim"), std::string::npos) << banded.err;
 }
 
-// Gmsh is loaded when a mesh is needed, not at start-up (libsim/src/gmsh_api.h): without it a
+// Gmsh is loaded when a mesh is needed, not at start-up (libsim/src/mesh/gmsh_api.h): without it a
 // drape fails with one clear line and no files, and a command that meshes nothing still runs.
 TEST(CliDrape, WithoutGmshIsExit3WithOneLineAndNoFiles) {
   const auto dir = Scratch("CliDrape.NoGmsh");

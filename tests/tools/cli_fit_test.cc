@@ -20,7 +20,7 @@
 #include "../fit/synthetic_photo.h"
 #include "run_cli.h"
 #include "textile/fit/law_error.h"
-#include "textile/sim/material.h"
+#include "textile/sim/law/material.h"
 
 namespace textile {
 namespace {

@@ -309,7 +309,7 @@ TEST(CliBench, ExtractAccuracySummaryPrintsNoNan) {
   EXPECT_EQ(lower.find("nan"), std::string::npos) << r.out;
 }
 
-// Sensitive Couture Fig. 6 (docs/benchmarks.md, "stability"): every start converges to one
+// Sensitive Couture Fig. 6 (docs/methods/benchmarks.md, "stability"): every start converges to one
 // energy, and the run-time-against-error rows carry their errors against the reference (a
 // reference solve that stalled above its tolerance used to leave them empty after 60 s).
 TEST(CliBench, StabilityQuickConvergesAndMeasuresItsErrors) {
@@ -327,7 +327,7 @@ TEST(CliBench, StabilityQuickConvergesAndMeasuresItsErrors) {
   EXPECT_EQ(tolerance_rows, 3);
 }
 
-// Pabst Fig. 10 (docs/bending.md, "hinge-curve"): one curve per fabric and model, and the shapes
+// Pabst Fig. 10 (docs/methods/bending.md, "hinge-curve"): one curve per fabric and model, and the shapes
 // the paper describes. Physics only: no timing.
 TEST(CliBench, HingeCurveQuickWritesPabstFig10Curves) {
   Csv csv;
@@ -391,7 +391,7 @@ TEST(CliBench, HingeCurveQuickWritesPabstFig10Curves) {
   }
 }
 
-// The bend-force CSV: the columns docs/benchmarks.md reads, one row per model and thread count
+// The bend-force CSV: the columns docs/methods/benchmarks.md reads, one row per model and thread count
 // (1, and all hardware threads when there are more), every time positive and finite. No
 // thresholds on the times: they belong to the benchmark.
 TEST(CliBench, BendForceQuickWritesOneRowPerModelAndThreadCount) {

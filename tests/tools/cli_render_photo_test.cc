@@ -12,7 +12,7 @@
 
 #include "run_cli.h"
 #include "textile/fit/profile.h"
-#include "textile/fit/rig.h"
+#include "textile/photo/rig.h"
 
 namespace textile {
 namespace {

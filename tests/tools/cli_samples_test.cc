@@ -6,7 +6,7 @@
 
 #include "run_cli.h"
 #include "textile/fit/law_error.h"
-#include "textile/sim/material.h"
+#include "textile/sim/law/material.h"
 
 namespace textile {
 namespace {

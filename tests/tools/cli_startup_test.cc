@@ -1,5 +1,5 @@
 // What `textile` loads at start-up: neither Gmsh nor OpenCV's image codecs, each of which brings
-// dozens of libraries of its own (textile/sim/shared_library.h); a command opens them when it
+// dozens of libraries of its own (textile/sim/core/shared_library.h); a command opens them when it
 // needs them, and without them fails with one line and no files while the rest still run.
 
 #include <gtest/gtest.h>
@@ -73,7 +73,7 @@ TEST(CliStartup, WithoutTheImageCodecsTheOtherCommandsRun) {
       "fit samples/profiles/pabst-fig8_L0*.profile.csv --gsm 200 -o " + (dir / "fit.json").string(),
       kNoCodecs);
   EXPECT_EQ(fit.exit_code, 0) << fit.err;
-  // The drape's picture is Cairo's (textile/sim/drape_picture.h), not OpenCV's.
+  // The drape's picture is Cairo's (textile/sim/plot/drape_picture.h), not OpenCV's.
   const auto drape = Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "d.json").string() +
                                  " --png " + (dir / "d.png").string(),
                              kNoCodecs);

@@ -1,6 +1,6 @@
-// The drapemeter's shadow picture (textile/sim/drape_picture.h, textile::plot): drawn from the
+// The drapemeter's shadow picture (textile/sim/plot/drape_picture.h, textile::plot): drawn from the
 // result's raster, read back here with Cairo.
-#include "textile/sim/drape_picture.h"
+#include "textile/sim/plot/drape_picture.h"
 
 #include <cairo.h>
 #include <gtest/gtest.h>

@@ -14,7 +14,7 @@
 
 #include "../fit/synthetic_photo.h"
 #include "run_cli.h"
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile {
 namespace {

@@ -13,7 +13,7 @@
 #include "common/blas_kernels.h"
 #include "common/cli.h"
 #include "common/forward_command.h"
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile::cli {
 namespace {

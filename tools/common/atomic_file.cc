@@ -16,7 +16,7 @@
 #include <fstream>
 #include <random>
 
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace fs = std::filesystem;
 

@@ -1,7 +1,7 @@
 #ifndef TEXTILE_TOOLS_COMMON_CHART_FILE_H_
 #define TEXTILE_TOOLS_COMMON_CHART_FILE_H_
 
-// The CLI's charts as files: textile::chart's drawing (textile/sim/chart.h) written through an
+// The CLI's charts as files: textile::chart's drawing (textile/sim/plot/chart.h) written through an
 // AtomicFile, so that a failed run leaves no chart and never half of one.
 //
 //   chart::WritePng({.title = "Sample 3", .panels = {mk}}, "fit.png");    // on its own
@@ -9,7 +9,7 @@
 
 #include <string>
 
-#include "textile/sim/chart.h"
+#include "textile/sim/plot/chart.h"
 
 namespace textile {
 class AtomicFile;

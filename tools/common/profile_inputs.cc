@@ -10,7 +10,7 @@
 #include <system_error>
 
 #include "common/cli.h"
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile::cli {
 namespace {

@@ -3,7 +3,7 @@
 
 // Inputs of the subcommands that consume profiles (fit, validate): each path is either a
 // profile CSV (s_mm,x_mm,y_mm) or a photo of the cantilever, which is extracted on the fly
-// with the rig given by --rig RIG.json or --mm-per-px S (docs/extraction.md).
+// with the rig given by --rig RIG.json or --mm-per-px S (docs/methods/extraction.md).
 //
 //   auto flags = std::make_shared<textile::cli::PhotoFlags>();
 //   textile::cli::AddPhotoFlags(sub, flags.get());          // --rig, --mm-per-px, --trace, ...
@@ -25,9 +25,9 @@
 #include <string>
 #include <vector>
 
-#include "textile/fit/extract.h"
+#include "textile/photo/extract.h"
 #include "textile/fit/profile.h"
-#include "textile/fit/rig.h"
+#include "textile/photo/rig.h"
 
 namespace textile::cli {
 

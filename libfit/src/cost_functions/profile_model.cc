@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "law_parameters.h"
-#include "textile/sim/error.h"
+#include "textile/sim/core/error.h"
 
 namespace textile::internal {
 namespace {
@@ -150,7 +150,7 @@ bool ProfileModel::Update(const double* p, const double* length, const double* r
     }
     // d/dL at fixed s from the scaling law of the elastica: a strip of length L with constants
     // (b1, b2, c1) is, in units of L, the strip of length L0 with (λ³b1, λ³b2, λ⁴c1), λ = L0/L.
-    // Differentiating at λ = 1 (docs/fitting.md):
+    // Differentiating at λ = 1 (docs/methods/fitting.md):
     //   ∂x/∂L = -(1/L) [-x + s cos θ + 3 b1 ∂x/∂b1 + 3 b2 ∂x/∂b2 + 4 c1 ∂x/∂c1], same for y,
     //   ∂θ/∂L = -(1/L) [s κ + 3 b1 ∂θ/∂b1 + 3 b2 ∂θ/∂b2 + 4 c1 ∂θ/∂c1].
     const double x = (1 - w) * e.x[k] + w * e.x[k1], y = (1 - w) * e.y[k] + w * e.y[k1];

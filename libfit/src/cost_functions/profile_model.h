@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "textile/fit/profile.h"
-#include "textile/sim/elastica.h"
+#include "textile/sim/elastica/elastica.h"
 
 namespace textile::internal {
 

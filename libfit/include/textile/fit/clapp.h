@@ -3,7 +3,7 @@
 
 // The moment-curvature law from cantilever profiles by the method of Clapp, Peng, Ghosh and
 // Eischen (1990), as summarised by Pabst et al. section 3.1: the baseline that the direct
-// elastica fit (direct_fit.h) must beat on the same data. See docs/clapp.md.
+// elastica fit (direct_fit.h) must beat on the same data. See docs/methods/clapp.md.
 //
 //   std::vector<textile::Profile> profiles = {textile::ReadProfileCsv("strip_40mm.csv"),
 //                                             textile::ReadProfileCsv("strip_60mm.csv")};
@@ -28,7 +28,7 @@
 #include <vector>
 
 #include "textile/fit/profile.h"
-#include "textile/sim/bending_law.h"
+#include "textile/sim/law/bending_law.h"
 
 namespace textile {
 
@@ -57,7 +57,7 @@ struct ClappOptions {
   // Digitised points closer to the edge than this are not used for the polynomial [m], ≥ 0.
   // The polar angle is undefined at r = 0 (such points are always dropped), and a position
   // error σ becomes an angle error σ / r near the edge: with uniform weights, 0.1 mm of noise
-  // on points within 1 mm of the edge ruins the whole fit (docs/clapp.md). A hand digitiser
+  // on points within 1 mm of the edge ruins the whole fit (docs/methods/clapp.md). A hand digitiser
   // would not pick points there either; 3 and 5 mm did best of 0-5 mm in our study.
   double min_radius = 3e-3;
   // Robust loss on the (scaled) moment residuals, and its scale as a fraction of the largest

@@ -17,7 +17,7 @@
 // thickness above the edge) and optionally a small rotation. Residuals are the normal distances
 // of the measured points to the model curve, each under a robust loss, plus the tip position.
 // Derivatives are analytic: the elastica's variational equations give d/d{b1, b2, c1}, and the
-// scaling law of the elastica gives d/dL from those (see docs/fitting.md). Only M/ρ is
+// scaling law of the elastica gives d/dL from those (see docs/methods/fitting.md). Only M/ρ is
 // identifiable from shape, so the areal density must be given.
 
 #include <optional>
@@ -27,7 +27,7 @@
 #include <Eigen/Core>
 
 #include "textile/fit/profile.h"
-#include "textile/sim/bending_law.h"
+#include "textile/sim/law/bending_law.h"
 
 namespace textile {
 
@@ -117,7 +117,7 @@ DirectFitSummary FitDirect(const std::vector<Profile>& profiles, double areal_de
 
 // FitDirect as the commands run it (fit, validate). With options.fit_rotation false it also fits
 // a rig rotation and returns that fit when the data show a tilt: a likelihood-ratio test on the
-// objective both minimise at three sd and a tilt of at least 0.1° (docs/fitting.md, "A rig that
+// objective both minimise at three sd and a tilt of at least 0.1° (docs/methods/fitting.md, "A rig that
 // is not level"). `notes` (may be null) receives what a user should know of a fit that
 // succeeded: a tilt found, one the data do not show clearly but that would move b1 or b2 by more
 // than two sd, a fitted offset that is no half thickness. `used` (may be null) receives the

@@ -23,8 +23,8 @@
 #include "textile/fit/direct_fit.h"
 #include "textile/fit/profile.h"
 #include "textile/fit/profile_compare.h"
-#include "textile/sim/bending_law.h"
-#include "textile/sim/material.h"
+#include "textile/sim/law/bending_law.h"
+#include "textile/sim/law/material.h"
 
 namespace textile {
 

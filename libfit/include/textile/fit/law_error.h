@@ -13,7 +13,7 @@
 //   textile::BendingLaw truth = textile::BendingLaw::FromKes(0.1, 0.0892, -0.0092);
 //   double e = textile::MomentCurveError(fitted, truth, 120.0);  // 0.01 = 1 %
 
-#include "textile/sim/bending_law.h"
+#include "textile/sim/law/bending_law.h"
 
 namespace textile {
 

@@ -14,8 +14,8 @@
 
 #include <Eigen/Core>
 
-#include "textile/sim/bending_law.h"
-#include "textile/sim/material.h"
+#include "textile/sim/law/bending_law.h"
+#include "textile/sim/law/material.h"
 
 namespace textile {
 

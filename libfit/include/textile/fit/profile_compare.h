@@ -13,7 +13,7 @@
 #include <Eigen/Core>
 
 #include "textile/fit/profile.h"
-#include "textile/sim/bending_law.h"
+#include "textile/sim/law/bending_law.h"
 
 namespace textile {
 
@@ -47,7 +47,7 @@ ProfileComparison CompareWithCurve(const Profile& measured, const std::vector<do
 // How far the simulated curve of CompareWithElastica moves when the law moves within a
 // covariance of {b1, b2, c1} [SI] (DirectFitSummary::covariance), the overhang, offset and
 // rotation held. Linear propagation through the elastica's variational equations (the direct
-// fit's own analytic derivatives, docs/fitting.md): J_j = ∂(normal distance of point j)/∂(b1,
+// fit's own analytic derivatives, docs/methods/fitting.md): J_j = ∂(normal distance of point j)/∂(b1,
 // b2, c1), and the curve's normal displacement at point j has variance σ_j² = J_j C J_jᵀ; the
 // tip's 2×2 covariance is J_tip C J_tipᵀ. Each figure bounds how far the comparison's own
 // figure can move when the curve moves by it (rms: triangle inequality; max; tip distance).

@@ -37,8 +37,8 @@
 #include <string>
 #include <vector>
 
-#include "textile/sim/note.h"
-#include "textile/sim/seam.h"
+#include "textile/sim/core/note.h"
+#include "textile/sim/law/seam.h"
 
 namespace textile {
 

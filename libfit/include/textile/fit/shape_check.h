@@ -19,7 +19,7 @@
 namespace textile {
 
 // RMS distance above which a profile is no heavy cantilever within the extraction's stated
-// accuracy [m] (docs/extraction.md: an exit-0 profile is within 1 mm RMS of the strip).
+// accuracy [m] (docs/methods/extraction.md: an exit-0 profile is within 1 mm RMS of the strip).
 inline constexpr double kShapeCheckMaxRms = 1e-3;
 
 struct ShapeCheck {

@@ -21,7 +21,7 @@
 #include <string>
 
 #include "textile/fit/profile.h"
-#include "textile/sim/bending_law.h"
+#include "textile/sim/law/bending_law.h"
 
 namespace textile {
 

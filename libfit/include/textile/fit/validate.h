@@ -1,7 +1,7 @@
 #ifndef TEXTILE_FIT_VALIDATE_H_
 #define TEXTILE_FIT_VALIDATE_H_
 
-// Validation of a fitted bending law against cantilever profiles (docs/validation.md): the
+// Validation of a fitted bending law against cantilever profiles (docs/guide/validate.md): the
 // direct fit on all profiles, then two questions.
 //
 //   std::vector<textile::Profile> profiles = ...;         // one strip at 40, 60, 80 mm
@@ -36,10 +36,10 @@
 #include "textile/fit/direct_fit.h"
 #include "textile/fit/profile.h"
 #include "textile/fit/profile_compare.h"
-#include "textile/sim/acpm_shell.h"
-#include "textile/sim/bending_law.h"
-#include "textile/sim/material.h"
-#include "textile/sim/note.h"
+#include "textile/sim/scenes/acpm_shell.h"
+#include "textile/sim/law/bending_law.h"
+#include "textile/sim/law/material.h"
+#include "textile/sim/core/note.h"
 
 namespace textile {
 
@@ -50,7 +50,7 @@ inline constexpr double kMaxOverRms = 3.0;
 struct ValidationOptions {
   // RMS normal distance a simulated curve may miss a profile by [m], in (0, 0.05]; the largest
   // distance and the tip distance may reach kMaxOverRms times it. 0.5 mm: more than the whole
-  // error budget of a photographed profile (docs/validation.md, "Verdicts").
+  // error budget of a photographed profile (docs/guide/validate.md, "Verdicts").
   double tolerance = 0.5e-3;
   // Which models simulate the cantilevers (at least one).
   bool run_elastica = true;
@@ -61,7 +61,7 @@ struct ValidationOptions {
   bool hold_out = true;
   // The shell also predicts each held-out profile (one more shell solve per profile). The
   // elastica alone answers the question the held-out part asks, whether the law predicts; the
-  // shell's prediction adds its own discretisation to that (docs/validation.md, "Speed").
+  // shell's prediction adds its own discretisation to that (docs/guide/validate.md, "Speed").
   bool hold_out_shell = true;
   // Options of every direct fit (the full fit and each leave-one-out fit).
   DirectFitOptions fit;

@@ -1,0 +1,25 @@
+#ifndef TEXTILE_SIM_PLOT_DRAPE_PICTURE_H_
+#define TEXTILE_SIM_PLOT_DRAPE_PICTURE_H_
+
+// The drapemeter's photo (target textile::plot, drawn with Cairo): one seed's shadow seen from
+// above, the support's and the flat specimen's circles, the seams as they lie on the draped
+// cloth and the nodes, with a caption.
+//
+//   const textile::DrapeResult r = textile::SimulateDrape(material, options);
+//   if (!textile::WriteDrapeShadowPng(r, r.per_seed.front(), options, "shadow.png")) ...
+
+#include <string>
+
+#include "textile/sim/scenes/drape.h"
+
+namespace textile {
+
+// Writes the picture of `seed` (one of result.per_seed, converged) of a drape run with `options`
+// as an 800×800 PNG to `file`; the view spans 1.08 specimen radii from the centre. False when
+// the file cannot be written.
+bool WriteDrapeShadowPng(const DrapeResult& result, const DrapeSeedResult& seed,
+                         const DrapeOptions& options, const std::string& file);
+
+}  // namespace textile
+
+#endif  // TEXTILE_SIM_PLOT_DRAPE_PICTURE_H_

@@ -1,0 +1,116 @@
+#include "textile/sim/plot/drape_picture.h"
+
+#include <cairo.h>
+
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <numbers>
+#include <sstream>
+
+namespace textile {
+namespace {
+
+constexpr int kSize = 800;  // [px] square
+
+struct SurfaceDeleter {
+  void operator()(cairo_surface_t* s) const { cairo_surface_destroy(s); }
+};
+struct ContextDeleter {
+  void operator()(cairo_t* c) const { cairo_destroy(c); }
+};
+
+// Pixels of the picture: x to the right, y up, the specimen's centre in the middle.
+struct View {
+  double half = 0.0;      // [m] from the centre to the image edge
+  double px_per_m = 0.0;  // [px/m]
+  double U(double x) const { return (x + half) * px_per_m; }
+  double V(double y) const { return (half - y) * px_per_m; }
+};
+
+void SetRgb(cairo_t* cr, int r, int g, int b) {
+  cairo_set_source_rgb(cr, r / 255.0, g / 255.0, b / 255.0);
+}
+
+// The shadow's raster, sampled at each pixel's centre, painted straight into the surface.
+void PaintShadow(cairo_surface_t* surface, const DrapeShadow& sh, const View& view) {
+  cairo_surface_flush(surface);
+  unsigned char* data = cairo_image_surface_get_data(surface);
+  const int stride = cairo_image_surface_get_stride(surface);
+  constexpr std::uint32_t kShadow = 0x00323c46;  // RGB (50, 60, 70)
+  for (int v = 0; v < kSize; ++v) {
+    auto* row = reinterpret_cast<std::uint32_t*>(data + static_cast<std::ptrdiff_t>(v) * stride);
+    for (int u = 0; u < kSize; ++u) {
+      const double x = u / view.px_per_m - view.half, y = view.half - v / view.px_per_m;
+      const long i = std::lround((x - sh.origin_x) / sh.cell);
+      const long j = std::lround((y - sh.origin_y) / sh.cell);
+      if (i < 0 || j < 0 || i >= sh.width || j >= sh.height) continue;
+      if (sh.mask[static_cast<size_t>(j) * sh.width + i]) row[u] = kShadow;
+    }
+  }
+  cairo_surface_mark_dirty(surface);
+}
+
+void Circle(cairo_t* cr, const View& view, double x, double y, double radius_px, double width) {
+  cairo_new_path(cr);
+  cairo_arc(cr, view.U(x), view.V(y), radius_px, 0.0, 2.0 * std::numbers::pi);
+  cairo_set_line_width(cr, width);
+  cairo_stroke(cr);
+}
+
+// The seams as they lie on the draped cloth: their vertex paths at the seed's positions.
+void DrawSeams(cairo_t* cr, const View& view, const DrapeResult& r, const DrapeSeedResult& s) {
+  SetRgb(cr, 230, 80, 80);
+  cairo_set_line_width(cr, 2.0);
+  for (const std::vector<int>& path : r.seam_paths) {
+    cairo_new_path(cr);
+    for (size_t k = 0; k < path.size(); ++k)
+      cairo_line_to(cr, view.U(s.positions(path[k], 0)), view.V(s.positions(path[k], 1)));
+    cairo_stroke(cr);
+  }
+}
+
+void DrawCaption(cairo_t* cr, const DrapeSeedResult& s, const DrapeOptions& o) {
+  std::ostringstream caption;
+  caption.precision(3);
+  caption << "DC " << s.drape_coefficient << ", " << s.nodes.angles.size() << " nodes, seams "
+          << DrapeSeamsName(o.seams) << ", seed " << s.seed;
+  cairo_select_font_face(cr, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_BOLD);
+  cairo_set_font_size(cr, 20.0);
+  SetRgb(cr, 30, 30, 30);
+  cairo_move_to(cr, 12.0, 28.0);
+  cairo_show_text(cr, caption.str().c_str());
+}
+
+}  // namespace
+
+bool WriteDrapeShadowPng(const DrapeResult& r, const DrapeSeedResult& s, const DrapeOptions& o,
+                         const std::string& file) {
+  const double half = 1.08 * o.specimen_radius;
+  const View view{.half = half, .px_per_m = kSize / (2.0 * half)};
+  const std::unique_ptr<cairo_surface_t, SurfaceDeleter> surface(
+      cairo_image_surface_create(CAIRO_FORMAT_RGB24, kSize, kSize));
+  const std::unique_ptr<cairo_t, ContextDeleter> cr(cairo_create(surface.get()));
+  SetRgb(cr.get(), 250, 250, 250);
+  cairo_paint(cr.get());
+  PaintShadow(surface.get(), s.shadow, view);
+  // Pixel centres sit at half-pixel coordinates in Cairo.
+  cairo_translate(cr.get(), 0.5, 0.5);
+  SetRgb(cr.get(), 160, 160, 160);
+  Circle(cr.get(), view, 0.0, 0.0, std::floor(o.specimen_radius * view.px_per_m), 1.0);
+  SetRgb(cr.get(), 240, 160, 60);
+  Circle(cr.get(), view, 0.0, 0.0, std::floor(o.support_radius * view.px_per_m), 2.0);
+  DrawSeams(cr.get(), view, r, s);
+  SetRgb(cr.get(), 40, 200, 40);
+  for (size_t k = 0; k < s.nodes.angles.size(); ++k) {
+    const double t = s.nodes.angles[k], radius = s.nodes.radii[k];
+    Circle(cr.get(), view, radius * std::cos(t), radius * std::sin(t), 6.0, 2.0);
+  }
+  cairo_identity_matrix(cr.get());
+  DrawCaption(cr.get(), s, o);
+  if (cairo_status(cr.get()) != CAIRO_STATUS_SUCCESS) return false;
+  cairo_surface_flush(surface.get());
+  return cairo_surface_write_to_png(surface.get(), file.c_str()) == CAIRO_STATUS_SUCCESS;
+}
+
+}  // namespace textile

@@ -1,0 +1,41 @@
+#ifndef TEXTILE_SIM_SRC_DRAPE_STAGES_H_
+#define TEXTILE_SIM_SRC_DRAPE_STAGES_H_
+
+// The stages of SimulateDrape that carry policy, for tests: the figures over the seeds and the
+// trust checks (DrapeResult::notes, one function per check, so that a test can build a result
+// and see which code comes out; drape_notes.cc). The others (the scene's meshes, each seed's
+// settling and measurement) are drape.cc's own.
+
+#include <optional>
+#include <vector>
+
+#include "textile/sim/scenes/drape.h"
+#include "textile/sim/core/note.h"
+
+namespace textile::drape_internal {
+
+// rim_shortfall: clamped without extrapolation, the first-order shortfall 0.1 e/ℓ of the rim's
+// element e against the turn-down length ℓ (result.rim_turn_down) is over 0.02.
+std::optional<Note> RimShortfallNote(const DrapeOptions& options, const DrapeResult& result);
+// rim_auto_capped: `--rim-mm auto`'s vertex cap chose the rim's elements (rim_capped, from
+// AutoRimElementSize).
+std::optional<Note> RimAutoCappedNote(const DrapeOptions& options, const DrapeResult& result,
+                                      bool rim_capped);
+// bare_support: a seed's fabric left over 2 % of the support's top bare.
+std::optional<Note> BareSupportNote(const DrapeResult& result);
+// skirt_sink: a seed's skirt sank over 0.3 mm into the support (resting contact's penalty).
+std::optional<Note> SkirtSinkNote(const DrapeOptions& options, const DrapeResult& result);
+// reversed_bracket: a seed's split rim gave a lower DC than its base mesh.
+std::optional<Note> ReversedBracketNote(const DrapeResult& result);
+
+// All of them, in the order above (DrapeResult::notes).
+std::vector<Note> DrapeNotes(const DrapeOptions& options, const DrapeResult& result,
+                             bool rim_capped);
+
+// Over the converged seeds of result->per_seed: converged (all of them), message ("converged",
+// else cleared for the caller's) and the means and sample sds (NaN unless converged).
+void SummariseSeeds(DrapeResult* result);
+
+}  // namespace textile::drape_internal
+
+#endif  // TEXTILE_SIM_SRC_DRAPE_STAGES_H_

@@ -291,6 +291,11 @@ TEST(MaterialCheck, NamesTheFieldAndTheRange) {
             "bending.b1: suspicious magnitude 200000 gf·cm, outside the textile range 1e-05 .. "
             "100000 gf·cm (units: kes)");
   EXPECT_FALSE(m.Check(nullptr));  // why is optional
+  // A bound's refusal quotes the value, as JsonFields words it for a file.
+  m.bending = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+  m.poisson = 0.5;
+  ASSERT_FALSE(m.Check(&why));
+  EXPECT_EQ(why, "stretch.poisson: must lie in [0, 0.5), got 0.5");
 }
 
 TEST(MaterialCheck, AcceptsTheSamplesAndTheDefaults) {

@@ -1,16 +1,16 @@
-#include "textile/sim/law/material.h"
+#include "textile/sim/material.h"
 
 #include <cmath>
 #include <fstream>
-#include <set>
 #include <sstream>
 #include <utility>
 #include <vector>
 
-#include "textile/sim/core/error.h"
-#include "textile/sim/io/json_text.h"
-#include "textile/sim/law/textile_range.h"
-#include "textile/sim/core/units.h"
+#include "textile/sim/error.h"
+#include "textile/sim/json_fields.h"
+#include "textile/sim/json_text.h"
+#include "textile/sim/textile_range.h"
+#include "textile/sim/units.h"
 
 namespace textile {
 namespace {
@@ -19,18 +19,12 @@ using nlohmann::json;
 
 // Plausibility bounds. Outside them a value is far more likely a unit mix-up (an "si" file
 // written in KES numbers, mm for m) than a fabric, so the file is refused with a hint.
-// The ranges are textile_range.h's (docs/methods/materials.md).
+// The ranges are textile_range.h's (docs/materials.md).
 using range::kMaxGsm;
 using range::kMinGsm;
 constexpr double kMinBKes = range::kMinStiffnessKes, kMaxBKes = range::kMaxStiffnessKes;
 constexpr double kMaxAbsC1Kes = range::kMaxAbsQuadraticKes;
 constexpr double kMinBeta = 1e-3, kMaxBeta = 1e3;  // [-]
-
-// The text of a JSON value in a message, cut to 40 characters.
-std::string Brief(const json& v) {
-  std::string s = v.dump();
-  return s.size() > 40 ? s.substr(0, 37) + "..." : s;
-}
 
 // The field checks below are shared by the parser, which quotes a value as the file writes it
 // (`got`), and by Material::Check, which quotes it as MaterialToJson would write it. Each returns
@@ -117,194 +111,158 @@ std::string BetaProblem(double beta, const std::string& got) {
   return "";
 }
 
-std::string StretchStiffnessProblem(double k) {
-  if (k <= 0.0) return "must be > 0 N/m";
+std::string StretchStiffnessProblem(double k, const std::string& got) {
+  if (k <= 0.0) return "must be > 0 N/m, got " + got;
   if (k > 1e7) return "suspicious magnitude, above 1e7 N/m";
   return "";
 }
 
-std::string PoissonProblem(double nu) {
-  return nu < 0.0 || nu >= 0.5 ? "must lie in [0, 0.5)" : "";
+std::string PoissonProblem(double nu, const std::string& got) {
+  return nu < 0.0 || nu >= 0.5 ? "must lie in [0, 0.5), got " + got : "";
 }
 
-std::string CompressionRatioProblem(double r) {
+std::string CompressionRatioProblem(double r, const std::string& got) {
   return r >= kMinCompressionRatio && r <= 1.0
              ? ""
-             : "must lie in [0.001, 1] (1: as stiff as in tension)";
+             : "must lie in [0.001, 1] (1: as stiff as in tension), got " + got;
 }
 
-std::string FrictionProblem(double mu) {
-  return mu < 0.0 || mu > 10.0 ? "must lie in [0, 10]" : "";
+std::string FrictionProblem(double mu, const std::string& got) {
+  return mu < 0.0 || mu > 10.0 ? "must lie in [0, 10], got " + got : "";
 }
 
-class Reader {
- public:
-  explicit Reader(std::string source) : source_(std::move(source)) {}
+// A field's problem (from the checks above) refused as "<source>: <field>: <problem>"; nothing
+// when there is none.
+void Refuse(const JsonFields& f, const std::string& field, const std::string& problem) {
+  if (!problem.empty()) f.Fail(field, problem);
+}
 
-  [[noreturn]] void Fail(const std::string& field, const std::string& problem) const {
-    throw InputError(source_ + ": " + field + ": " + problem);
+// A law's problem, which starts with its field, refused as "<source>: <problem>".
+void RefuseLaw(const JsonFields& f, const std::string& problem) {
+  if (!problem.empty()) throw InputError(f.source() + ": " + problem);
+}
+
+// The "units" field of a law object: true for "kes", false for "si".
+bool LawUnits(const JsonFields& f, const json& b, const std::string& key, const char* kes_units,
+              const char* si_units) {
+  const json& v = b.at("units");
+  if (!v.is_string()) f.Must(key + ".units", "be \"kes\" or \"si\"", v);
+  const std::string units = v.get<std::string>();
+  if (units != "kes" && units != "si") {
+    f.Unknown(key + ".units", "units", units,
+              std::string("\"kes\": ") + kes_units + "; or \"si\": " + si_units);
   }
+  return units == "kes";
+}
 
-  double Number(const json& obj, const std::string& key, const std::string& field) const {
-    const json& v = obj.at(key);
-    if (!v.is_number()) Fail(field, "must be a number, got " + Brief(v));
-    const double d = v.get<double>();
-    if (!std::isfinite(d)) Fail(field, "must be finite, got " + Brief(v));
-    return d;
+// {"law": "spline", "units", "kappa", "moment"[, "moment_sd"]}: knots in 1/cm and gf·cm/cm
+// ("kes") or 1/m and N ("si").
+BendingLaw SplineLaw(const JsonFields& f, const json& b, const std::string& key) {
+  f.CheckKeys(b, key, {"law", "units", "kappa", "moment", "moment_sd"});
+  for (const char* k : {"units", "kappa", "moment"}) {
+    f.Require(b, k, "a spline law is {\"law\": \"spline\", \"units\", \"kappa\", \"moment\"}",
+              key + "." + k);
   }
+  const bool kes =
+      LawUnits(f, b, key, "kappa in 1/cm, moment in gf·cm/cm", "kappa in 1/m, moment in N");
+  std::vector<double> kappa = f.Numbers(b.at("kappa"), key + ".kappa");
+  std::vector<double> moment = f.Numbers(b.at("moment"), key + ".moment");
+  std::vector<double> sd;
+  if (b.contains("moment_sd")) sd = f.Numbers(b.at("moment_sd"), key + ".moment_sd");
+  RefuseLaw(f, SplineLawProblem(kappa, moment, sd, key, kes));
+  if (kes) return BendingLaw::FromSplineKes(std::move(kappa), std::move(moment), std::move(sd));
+  return BendingLaw::FromSpline(std::move(kappa), std::move(moment), std::move(sd));
+}
 
-  void CheckKeys(const json& obj, const std::string& where, const std::set<std::string>& known) const {
-    for (const auto& [key, value] : obj.items()) {
-      if (!known.count(key)) {
-        std::string list;
-        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-        Fail(where.empty() ? key : where + "." + key, "unknown field (known: " + list + ")");
-      }
+// root[key]: a Pabst law {"units", "b1", "b2", "c1"} or a spline law.
+BendingLaw Law(const JsonFields& f, const json& root, const std::string& key) {
+  const json& b = f.Object(root.at(key), key,
+                           "{\"units\", \"b1\", \"b2\", \"c1\"} or {\"law\": \"spline\", "
+                           "\"units\", \"kappa\", \"moment\"}");
+  std::string law = "pabst";
+  if (b.contains("law")) {
+    if (!b.at("law").is_string()) f.Must(key + ".law", "be \"pabst\" or \"spline\"", b.at("law"));
+    law = b.at("law").get<std::string>();
+    if (law != "pabst" && law != "spline") {
+      f.Unknown(key + ".law", "law", law,
+                "\"pabst\": b1, b2, c1; or \"spline\": kappa, moment");
     }
   }
+  if (law == "spline") return SplineLaw(f, b, key);
+  f.CheckKeys(b, key, {"law", "units", "b1", "b2", "c1"});
+  for (const char* k : {"units", "b1", "b2", "c1"}) f.Require(b, k, "", key + "." + k);
+  const bool kes = LawUnits(f, b, key, "gf·cm, gf·cm²", "N·m, N·m²");
+  double v[3];
+  const char* names[3] = {"b1", "b2", "c1"};
+  for (int i = 0; i < 3; ++i) v[i] = f.Number(b.at(names[i]), key + "." + names[i]);
+  // Everything below in KES, which is how people read these numbers.
+  const double b1 = kes ? v[0] : units::SiStiffnessToKes(v[0]);
+  const double b2 = kes ? v[1] : units::SiStiffnessToKes(v[1]);
+  const double c1 = kes ? v[2] : units::SiQuadraticToKes(v[2]);
+  const std::string unit_hint = kes ? " (units: kes)" : " (units: si; is this file in kes?)";
+  const std::string got_b[2] = {JsonFields::Brief(b.at("b1")), JsonFields::Brief(b.at("b2"))};
+  RefuseLaw(f, PabstLawProblem(b1, b2, c1, key, got_b, unit_hint));
+  const double sb1 = units::KesStiffnessToSi(b1), sb2 = units::KesStiffnessToSi(b2);
+  const double sc1 = units::KesQuadraticToSi(c1);
+  return BendingLaw::FromSi(sb1, sb2, sc1);
+}
 
-  BendingLaw Law(const json& root, const std::string& key) const {
-    const json& b = root.at(key);
-    if (!b.is_object()) {
-      Fail(key,
-           "must be an object {\"units\", \"b1\", \"b2\", \"c1\"} or {\"law\": \"spline\", "
-           "\"units\", \"kappa\", \"moment\"}");
-    }
-    std::string law = "pabst";
-    if (b.contains("law")) {
-      if (!b.at("law").is_string()) Fail(key + ".law", "must be \"pabst\" or \"spline\"");
-      law = b.at("law").get<std::string>();
-      if (law != "pabst" && law != "spline") {
-        Fail(key + ".law",
-             "unknown law '" + law + "' (use \"pabst\": b1, b2, c1; or \"spline\": kappa, moment)");
-      }
-    }
-    if (law == "spline") return SplineLaw(b, key);
-    CheckKeys(b, key, {"law", "units", "b1", "b2", "c1"});
-    for (const char* k : {"units", "b1", "b2", "c1"}) {
-      if (!b.contains(k)) Fail(key + "." + k, "missing");
-    }
-    const bool kes = Units(b, key, "gf·cm, gf·cm²", "N·m, N·m²");
-    double v[3];
-    const char* names[3] = {"b1", "b2", "c1"};
-    for (int i = 0; i < 3; ++i) v[i] = Number(b, names[i], key + "." + names[i]);
-    // Everything below in KES, which is how people read these numbers.
-    const double b1 = kes ? v[0] : units::SiStiffnessToKes(v[0]);
-    const double b2 = kes ? v[1] : units::SiStiffnessToKes(v[1]);
-    const double c1 = kes ? v[2] : units::SiQuadraticToKes(v[2]);
-    const std::string unit_hint = kes ? " (units: kes)" : " (units: si; is this file in kes?)";
-    const std::string got_b[2] = {Brief(b.at("b1")), Brief(b.at("b2"))};
-    if (std::string p = PabstLawProblem(b1, b2, c1, key, got_b, unit_hint); !p.empty())
-      throw InputError(source_ + ": " + p);
-    const double sb1 = units::KesStiffnessToSi(b1), sb2 = units::KesStiffnessToSi(b2);
-    const double sc1 = units::KesQuadraticToSi(c1);
-    return BendingLaw::FromSi(sb1, sb2, sc1);
+// {"stiffness_N_per_m", "poisson", "compression_ratio"}, each optional, into m.
+void ReadStretch(const JsonFields& f, const json& root, Material* m) {
+  const json& st = f.Object(root["stretch"], "stretch",
+                            "{\"stiffness_N_per_m\", \"poisson\", \"compression_ratio\"}");
+  f.CheckKeys(st, "stretch", {"stiffness_N_per_m", "poisson", "compression_ratio"});
+  if (st.contains("stiffness_N_per_m")) {
+    const json& v = st["stiffness_N_per_m"];
+    m->stretch_stiffness = f.Number(v, "stretch.stiffness_N_per_m");
+    Refuse(f, "stretch.stiffness_N_per_m",
+           StretchStiffnessProblem(m->stretch_stiffness, JsonFields::Brief(v)));
   }
-
-  // The "units" field of a law object: true for "kes", false for "si".
-  bool Units(const json& b, const std::string& key, const char* kes_units,
-             const char* si_units) const {
-    if (!b.at("units").is_string()) Fail(key + ".units", "must be \"kes\" or \"si\"");
-    const std::string units = b.at("units").get<std::string>();
-    if (units != "kes" && units != "si") {
-      Fail(key + ".units", "unknown units '" + units + "' (use \"kes\": " + kes_units +
-                               "; or \"si\": " + si_units + ")");
-    }
-    return units == "kes";
+  if (st.contains("poisson")) {
+    const json& v = st["poisson"];
+    m->poisson = f.Number(v, "stretch.poisson");
+    Refuse(f, "stretch.poisson", PoissonProblem(m->poisson, JsonFields::Brief(v)));
   }
-
-  std::vector<double> Numbers(const json& obj, const std::string& key,
-                              const std::string& field) const {
-    const json& v = obj.at(key);
-    if (!v.is_array()) Fail(field, "must be an array of numbers, got " + Brief(v));
-    std::vector<double> out;
-    for (size_t i = 0; i < v.size(); ++i) {
-      if (!v[i].is_number())
-        Fail(field + "[" + std::to_string(i) + "]", "must be a number, got " + Brief(v[i]));
-      out.push_back(v[i].get<double>());
-    }
-    return out;
+  if (st.contains("compression_ratio")) {
+    const json& v = st["compression_ratio"];
+    m->compression_ratio = f.Number(v, "stretch.compression_ratio");
+    Refuse(f, "stretch.compression_ratio",
+           CompressionRatioProblem(m->compression_ratio, JsonFields::Brief(v)));
   }
+}
 
-  // {"law": "spline", "units", "kappa", "moment"[, "moment_sd"]}: knots in 1/cm and gf·cm/cm
-  // ("kes") or 1/m and N ("si").
-  BendingLaw SplineLaw(const json& b, const std::string& key) const {
-    CheckKeys(b, key, {"law", "units", "kappa", "moment", "moment_sd"});
-    for (const char* k : {"units", "kappa", "moment"}) {
-      if (!b.contains(k))
-        Fail(key + "." + k,
-             "missing (a spline law is {\"law\": \"spline\", \"units\", \"kappa\", \"moment\"})");
-    }
-    const bool kes =
-        Units(b, key, "kappa in 1/cm, moment in gf·cm/cm", "kappa in 1/m, moment in N");
-    std::vector<double> kappa = Numbers(b, "kappa", key + ".kappa");
-    std::vector<double> moment = Numbers(b, "moment", key + ".moment");
-    std::vector<double> sd;
-    if (b.contains("moment_sd")) sd = Numbers(b, "moment_sd", key + ".moment_sd");
-    if (std::string p = SplineLawProblem(kappa, moment, sd, key, kes); !p.empty())
-      throw InputError(source_ + ": " + p);
-    if (kes) return BendingLaw::FromSplineKes(std::move(kappa), std::move(moment), std::move(sd));
-    return BendingLaw::FromSpline(std::move(kappa), std::move(moment), std::move(sd));
-  }
-
- private:
-  std::string source_;
-};
+// areal_density_gsm: required, > 0 and within the textile range [kg/m² returned].
+double ReadArealDensity(const JsonFields& f, const json& root) {
+  const json& v = f.Require(root, "areal_density_gsm", "g/m², required");
+  const double gsm = f.Number(v, "areal_density_gsm");
+  Refuse(f, "areal_density_gsm", ArealDensityProblem(gsm, JsonFields::Brief(v)));
+  return units::GsmToSi(gsm);
+}
 
 }  // namespace
 
 Material ParseMaterialJson(const std::string& text, const std::string& source) {
-  Reader r(source);
+  const JsonFields f(source);
   const json root = ParseJsonText(text, source);
-  if (!root.is_object()) r.Fail("(top level)", "must be a JSON object");
-  r.CheckKeys(root, "", {"name", "areal_density_gsm", "bending", "bending_weft", "beta", "stretch",
+  f.RequireObject(root);
+  f.CheckKeys(root, "", {"name", "areal_density_gsm", "bending", "bending_weft", "beta", "stretch",
                          "friction", "fit", "notes", "assumptions", "source"});
   Material m;
-  if (root.contains("name")) {
-    if (!root["name"].is_string()) r.Fail("name", "must be a string");
-    m.name = root["name"].get<std::string>();
-  }
-  if (!root.contains("areal_density_gsm")) r.Fail("areal_density_gsm", "missing (g/m², required)");
-  const double gsm = r.Number(root, "areal_density_gsm", "areal_density_gsm");
-  if (std::string p = ArealDensityProblem(gsm, Brief(root["areal_density_gsm"])); !p.empty())
-    r.Fail("areal_density_gsm", p);
-  m.areal_density = units::GsmToSi(gsm);
-  if (!root.contains("bending")) r.Fail("bending", "missing (required: {\"units\", \"b1\", \"b2\", \"c1\"})");
-  m.bending = r.Law(root, "bending");
-  if (root.contains("bending_weft")) m.bending_weft = r.Law(root, "bending_weft");
+  if (root.contains("name")) m.name = f.String(root["name"], "name");
+  m.areal_density = ReadArealDensity(f, root);
+  f.Require(root, "bending", "required: {\"units\", \"b1\", \"b2\", \"c1\"}");
+  m.bending = Law(f, root, "bending");
+  if (root.contains("bending_weft")) m.bending_weft = Law(f, root, "bending_weft");
   if (root.contains("beta")) {
-    m.beta = r.Number(root, "beta", "beta");
-    if (std::string p = BetaProblem(m.beta, Brief(root["beta"])); !p.empty()) r.Fail("beta", p);
+    m.beta = f.Number(root["beta"], "beta");
+    Refuse(f, "beta", BetaProblem(m.beta, JsonFields::Brief(root["beta"])));
   }
-  if (root.contains("stretch")) {
-    const json& st = root["stretch"];
-    if (!st.is_object())
-      r.Fail("stretch",
-             "must be an object {\"stiffness_N_per_m\", \"poisson\", \"compression_ratio\"}");
-    r.CheckKeys(st, "stretch", {"stiffness_N_per_m", "poisson", "compression_ratio"});
-    if (st.contains("stiffness_N_per_m")) {
-      m.stretch_stiffness = r.Number(st, "stiffness_N_per_m", "stretch.stiffness_N_per_m");
-      if (std::string p = StretchStiffnessProblem(m.stretch_stiffness); !p.empty())
-        r.Fail("stretch.stiffness_N_per_m", p);
-    }
-    if (st.contains("poisson")) {
-      m.poisson = r.Number(st, "poisson", "stretch.poisson");
-      if (std::string p = PoissonProblem(m.poisson); !p.empty()) r.Fail("stretch.poisson", p);
-    }
-    if (st.contains("compression_ratio")) {
-      m.compression_ratio = r.Number(st, "compression_ratio", "stretch.compression_ratio");
-      if (std::string p = CompressionRatioProblem(m.compression_ratio); !p.empty())
-        r.Fail("stretch.compression_ratio", p);
-    }
-  }
+  if (root.contains("stretch")) ReadStretch(f, root, &m);
   if (root.contains("friction")) {
-    m.friction = r.Number(root, "friction", "friction");
-    if (std::string p = FrictionProblem(m.friction); !p.empty()) r.Fail("friction", p);
+    m.friction = f.Number(root["friction"], "friction");
+    Refuse(f, "friction", FrictionProblem(m.friction, JsonFields::Brief(root["friction"])));
   }
-  if (root.contains("fit")) {
-    if (!root["fit"].is_object()) r.Fail("fit", "must be an object");
-    m.fit = root["fit"];
-  }
+  if (root.contains("fit")) m.fit = f.Object(root["fit"], "fit");
   for (const char* k : {"notes", "assumptions", "source"}) {
     if (root.contains(k)) m.extra[k] = root[k];
   }
@@ -314,7 +272,7 @@ Material ParseMaterialJson(const std::string& text, const std::string& source) {
 namespace {
 
 // A number as MaterialToJson writes it (JSON has no NaN or infinity: null).
-std::string Written(double v) { return Brief(json(v)); }
+std::string Written(double v) { return JsonFields::Brief(json(v)); }
 
 // A law as Material::Check sees it: in the numbers MaterialToJson writes, checked as the
 // parser checks them. "" or "<key>.<field>: <problem>".
@@ -358,11 +316,13 @@ bool Material::Check(std::string* why) const {
   if (w.empty() && bending_weft) w = LawProblem(*bending_weft, "bending_weft");
   if (number("beta", beta)) field("beta", BetaProblem(beta, Written(beta)));
   if (number("stretch.stiffness_N_per_m", stretch_stiffness))
-    field("stretch.stiffness_N_per_m", StretchStiffnessProblem(stretch_stiffness));
-  if (number("stretch.poisson", poisson)) field("stretch.poisson", PoissonProblem(poisson));
+    field("stretch.stiffness_N_per_m",
+          StretchStiffnessProblem(stretch_stiffness, Written(stretch_stiffness)));
+  if (number("stretch.poisson", poisson)) field("stretch.poisson", PoissonProblem(poisson, Written(poisson)));
   if (number("stretch.compression_ratio", compression_ratio))
-    field("stretch.compression_ratio", CompressionRatioProblem(compression_ratio));
-  if (number("friction", friction)) field("friction", FrictionProblem(friction));
+    field("stretch.compression_ratio",
+          CompressionRatioProblem(compression_ratio, Written(compression_ratio)));
+  if (number("friction", friction)) field("friction", FrictionProblem(friction, Written(friction)));
   if (why) *why = w;
   return w.empty();
 }

@@ -1,4 +1,4 @@
-#include "textile/sim/material.h"
+#include "textile/sim/law/material.h"
 
 #include <cmath>
 #include <fstream>
@@ -6,11 +6,11 @@
 #include <utility>
 #include <vector>
 
-#include "textile/sim/error.h"
-#include "textile/sim/json_fields.h"
-#include "textile/sim/json_text.h"
-#include "textile/sim/textile_range.h"
-#include "textile/sim/units.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/io/json_fields.h"
+#include "textile/sim/io/json_text.h"
+#include "textile/sim/law/textile_range.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {

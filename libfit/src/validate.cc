@@ -9,6 +9,7 @@
 
 #include "textile/fit/fit_report.h"
 #include "textile/sim/core/error.h"
+#include "textile/sim/core/number_text.h"
 #include "textile/sim/core/polyline.h"
 #include "textile/sim/core/units.h"
 
@@ -17,13 +18,7 @@ namespace {
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 
-std::string Num(double v, int digits = 6) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return buf;
-}
-
-std::string Mm(double m, int digits = 3) { return Num(units::MToMm(m), digits); }
+std::string Mm(double m, int digits = 3) { return NumberText(units::MToMm(m), digits); }
 
 void Join(const std::string& part, const char* separator, std::string* text) {
   *text += (text->empty() ? "" : separator) + part;
@@ -44,11 +39,11 @@ void Grade(double tol, ModelComparison* k) {
   const double tip = std::hypot(c.tip_dx, c.tip_dy);
   const double tol_mm = units::MToMm(tol);
   k->why.clear();
-  if (c.rms > tol) Join("rms " + Mm(c.rms) + " mm > " + Num(tol_mm), ", ", &k->why);
+  if (c.rms > tol) Join("rms " + Mm(c.rms) + " mm > " + NumberText(tol_mm), ", ", &k->why);
   if (c.max > kMaxOverRms * tol)
-    Join("max " + Mm(c.max) + " mm > " + Num(kMaxOverRms * tol_mm), ", ", &k->why);
+    Join("max " + Mm(c.max) + " mm > " + NumberText(kMaxOverRms * tol_mm), ", ", &k->why);
   if (tip > kMaxOverRms * tol)
-    Join("tip " + Mm(tip) + " mm > " + Num(kMaxOverRms * tol_mm), ", ", &k->why);
+    Join("tip " + Mm(tip) + " mm > " + NumberText(kMaxOverRms * tol_mm), ", ", &k->why);
   k->pass = k->why.empty();
 }
 
@@ -273,13 +268,13 @@ void PredictEachHeldOut(Validation* v) {
 bool ValidationOptions::Check(std::string* why) const {
   std::string w;
   if (!(tolerance > 0.0) || !(tolerance <= 0.05))
-    w = "tolerance must lie in (0, 50] mm, got " + Num(units::MToMm(tolerance)) + " mm";
+    w = "tolerance must lie in (0, 50] mm, got " + NumberText(units::MToMm(tolerance)) + " mm";
   else if (!run_elastica && !run_shell)
     w = "no model to simulate: run the elastica, the shell or both";
   else if (hold_out && !run_elastica && !hold_out_shell)
     w = "hold-out with the shell alone needs hold_out_shell: no model would predict";
   else if (!(strip_width >= 0.005) || !(strip_width <= 0.2))
-    w = "strip width must lie in [5, 200] mm, got " + Num(units::MToMm(strip_width)) + " mm";
+    w = "strip width must lie in [5, 200] mm, got " + NumberText(units::MToMm(strip_width)) + " mm";
   else if (std::string f; !fit.Check(&f))
     w = "fit: " + f;
   else if (std::string s; !shell.Check(&s))
@@ -320,8 +315,8 @@ std::string ValidationSummary::BriefReport() const {
   if (!completed) return "validation failed: " + message;
   std::ostringstream s;
   const BendingLaw& law = material.bending;
-  s << "law: b1 = " << Num(law.b1_kes(), 5) << " gf·cm, b2 = " << Num(law.b2_kes(), 5)
-    << " gf·cm, c1 = " << Num(law.c1_kes(), 5) << " gf·cm² (fit rms " << Mm(fit.rms) << " mm over "
+  s << "law: b1 = " << NumberText(law.b1_kes(), 5) << " gf·cm, b2 = " << NumberText(law.b2_kes(), 5)
+    << " gf·cm, c1 = " << NumberText(law.c1_kes(), 5) << " gf·cm² (fit rms " << Mm(fit.rms) << " mm over "
     << profiles.size() << " profile(s))\n";
   s << "goodness of fit: " << (pass ? "PASS" : "FAIL");
   for (ModelComparison ProfileValidation::*model :

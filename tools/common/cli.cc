@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include "textile/sim/core/number_text.h"
+
 namespace textile::cli {
 
 CLI::App* AddSubcommand(CLI::App& app, const std::string& name, const std::string& description,
@@ -36,13 +38,7 @@ void PrintJson(const nlohmann::json& j) {
   std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << std::endl;
 }
 
-std::string Num(double v, int digits) {
-  if (std::isnan(v)) return "nan";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return buf;
-}
+std::string Num(double v, int digits) { return NumberText(v, digits); }
 
 void Info(const std::string& line) { std::cerr << line << std::endl; }
 

@@ -24,7 +24,7 @@ CLI::App* AddSubcommand(CLI::App& app, const std::string& name, const std::strin
 // is printed with U+FFFD in place of the bad bytes rather than failing.
 void PrintJson(const nlohmann::json& j);
 
-// Compact number for people: 6 significant digits, no trailing zeros.
+// Compact number for people: 6 significant digits, no trailing zeros (textile::NumberText).
 std::string Num(double v, int digits = 6);
 
 // True if s is valid UTF-8 (JSON output needs it; names and notes from flags are checked).

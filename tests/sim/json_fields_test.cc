@@ -49,6 +49,21 @@ TEST(JsonFields, EachMistakeHasOneWording) {
             "a.json: top.a: unknown field (known: s, x)");
 }
 
+TEST(JsonFields, BriefIsTheStartOfTheCompactText) {
+  const json small = json::parse(R"({"b": [1, 2.5, "x"], "a": null})");
+  EXPECT_EQ(JsonFields::Brief(small), small.dump());
+  const json long_array = json::array({std::string(60, 'x'), 1, 2});
+  EXPECT_EQ(JsonFields::Brief(long_array), long_array.dump().substr(0, 37) + "...");
+}
+
+TEST(JsonFields, BriefOfADeeplyNestedValueIsBounded) {
+  // dump() recurses once per level; this depth overflows its stack under ASan (and near the
+  // default 8 MiB stack without), while the parser takes it.
+  constexpr int kDepth = 200000;
+  const json deep = json::parse(std::string(kDepth, '[') + std::string(kDepth, ']'));
+  EXPECT_EQ(JsonFields::Brief(deep), std::string(37, '[') + "...");
+}
+
 TEST(JsonFields, NonFiniteNumbersAreRefused) {
   // JSON text cannot hold them (ParseJsonText refuses 1e999), but a json built in code can.
   const JsonFields f("a.json");

@@ -20,9 +20,37 @@ void JsonFields::Unknown(const std::string& field, const std::string& what,
   Fail(field, "unknown " + what + " '" + value + "' (use " + choices + ")");
 }
 
+namespace {
+
+// Appends v's compact JSON text (as json::dump() writes it) to *out until *out is longer than
+// `limit`; false once it stopped there. Bounded, unlike dump(): a file nested 20 000 arrays
+// deep overflowed dump()'s recursion (under ASan), and only the first `limit` characters are
+// shown anyway. Each level writes a bracket, so the recursion is at most `limit` deep.
+bool AppendBrief(const json& v, size_t limit, std::string* out) {
+  if (out->size() > limit) return false;
+  if (v.is_array() || v.is_object()) {
+    *out += v.is_array() ? '[' : '{';
+    bool first = true;
+    for (auto it = v.begin(); it != v.end(); ++it) {
+      if (!first) *out += ',';
+      first = false;
+      if (v.is_object()) *out += json(it.key()).dump() + ':';
+      if (!AppendBrief(it.value(), limit, out)) return false;
+    }
+    *out += v.is_array() ? ']' : '}';
+  } else {
+    *out += v.dump();
+  }
+  return out->size() <= limit;
+}
+
+}  // namespace
+
 std::string JsonFields::Brief(const json& v) {
-  std::string s = v.dump();
-  return s.size() > 40 ? s.substr(0, 37) + "..." : s;
+  constexpr size_t kShown = 40;
+  std::string s;
+  AppendBrief(v, kShown, &s);
+  return s.size() > kShown ? s.substr(0, kShown - 3) + "..." : s;
 }
 
 void JsonFields::RequireObject(const json& root) const {

@@ -412,6 +412,10 @@ void RasteriseTriangle(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const
   }
 }
 
+}  // namespace
+
+namespace drape_internal {
+
 // Shadow stage 3: the support casts its own shadow (the drapemeter's disk is opaque): a
 // specimen that leaves part of it bare (a resting fabric that passed through it, drape.h) still
 // shades all of it, so A_shadow ≥ A_support and the DC ≥ 0.
@@ -497,7 +501,12 @@ void FillEmptyBins(Eigen::VectorXd* radii) {
   }
 }
 
-}  // namespace
+}  // namespace drape_internal
+
+using drape_internal::AddSupportShadow;
+using drape_internal::FillEmptyBins;
+using drape_internal::FloodFromBorder;
+using drape_internal::MeasureOutline;
 
 DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double cell, int bins,
                           double support_radius) {

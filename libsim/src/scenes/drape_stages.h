@@ -36,6 +36,16 @@ std::vector<Note> DrapeNotes(const DrapeOptions& options, const DrapeResult& res
 // else cleared for the caller's) and the means and sample sds (NaN unless converged).
 void SummariseSeeds(DrapeResult* result);
 
+// The shadow's stages after rasterising (MeasureShadow; also MeasureDrapeShadow for measured
+// drapes): the support's own disk of support_radius [m] about the grid's origin added (> 0;
+// the bare support cells counted in bare_support_area); holes filled (empty cells not reached
+// from the border marked 2); the mask made 0/1 with the area and each of `bins` angle bins'
+// largest radius (-1 where no cell falls); empty bins interpolated circularly.
+void AddSupportShadow(double support_radius, DrapeShadow* shadow);
+void FloodFromBorder(DrapeShadow* shadow);
+void MeasureOutline(int bins, DrapeShadow* shadow);
+void FillEmptyBins(Eigen::VectorXd* radii);
+
 }  // namespace textile::drape_internal
 
 #endif  // TEXTILE_SIM_SRC_DRAPE_STAGES_H_

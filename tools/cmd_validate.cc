@@ -15,6 +15,7 @@
 
 #include "common/atomic_file.h"
 #include "common/chart_file.h"
+#include "textile/sim/core/polyline.h"
 #include "common/cli.h"
 #include "common/profile_inputs.h"
 #include "textile/fit/direct_fit.h"
@@ -89,6 +90,57 @@ Material FittedMaterial(const ValidationSummary& v, const std::vector<LoadedProf
   fitted.fit["verdict"] = v.pass ? "pass" : "fail";
   fitted.fit["holdout_verdict"] = HoldoutVerdictName(v.holdout_verdict);
   return fitted;
+}
+
+// The held-out predictions: for each left-out profile, each point's distance from the curve the
+// law of the other profiles predicts for it (the first model run; the elastica unless only the
+// shell ran) along the strip, against the tolerance and its kMaxOverRms multiple.
+textile::chart::Panel HeldOutPanel(const ValidationSummary& v, const std::vector<Profile>& profiles,
+                                   const std::vector<std::string>& stems, size_t common) {
+  namespace chart = textile::chart;
+  const double tol_mm = units::MToMm(v.options.tolerance);
+  chart::Panel p{
+      .title = "Held out: distance of each profile from the law fitted to the others",
+      .x_label = "arc length s [mm]",
+      .y_label = "distance from the prediction [mm]"};
+  double s_max = 0.0;
+  for (const HeldOutProfile& h : v.holdout) {
+    const Profile& measured = profiles[h.index];
+    const std::string name = stems[h.index].substr(common);
+    if (!h.predicted) {
+      p.notes.push_back(name + ": not predicted");
+      continue;
+    }
+    const HeldOutModel& m = h.elastica.check.run ? h.elastica : h.shell;
+    const ProfileComparison& c = m.check.comparison;
+    chart::Series d{.label = name + ": rms " + Num(units::MToMm(c.rms), 2) + " ± " +
+                             Num(units::MToMm(m.sigma.rms), 2) + " mm" + (h.ok ? " ok" : " FAIL"),
+                    .style = chart::Series::Style::kLineAndMarkers,
+                    .color = chart::PaletteColor(static_cast<int>(h.index))};
+    for (size_t j = 0; j < measured.size(); ++j) {
+      d.x.push_back(units::MToMm(measured.s[j]));
+      d.y.push_back(units::MToMm(
+          DistanceToPolyline(c.model_x, c.model_y, measured.x[j], measured.y[j])));
+    }
+    s_max = std::max(s_max, d.x.empty() ? 0.0 : d.x.back());
+    p.series.push_back(std::move(d));
+  }
+  for (const double level : {tol_mm, kMaxOverRms * tol_mm})
+    p.series.push_back({.label = level == tol_mm ? "rms tolerance" : "max and tip tolerance",
+                        .x = {0.0, s_max},
+                        .y = {level, level},
+                        .color = chart::Rgb{0.4, 0.4, 0.4},
+                        .line_width = 1.0,
+                        .dashed = true});
+  // Headroom above the largest distance and the max tolerance for the legend and the notes.
+  double top = kMaxOverRms * tol_mm;
+  for (const chart::Series& d : p.series)
+    for (const double y : d.y) top = std::max(top, y);
+  p.y_range = chart::Range{0.0, 1.6 * top};
+  p.notes.push_back(std::string(v.holdout.front().elastica.check.run ? "elastica" : "shell") +
+                    "'s predictions; held out: " +
+                    (v.holdout_verdict == HoldoutVerdict::kPass ? "PASS" : "FAIL"));
+  return p;
 }
 
 void Plot(const ValidationSummary& v, const std::vector<Profile>& profiles, AtomicFile& out) {
@@ -173,7 +225,12 @@ void Plot(const ValidationSummary& v, const std::vector<Profile>& profiles, Atom
                         ? std::string("held out: nothing (one profile)")
                         : "held out: rms " + held + " mm " +
                               (v.holdout_verdict == HoldoutVerdict::kPass ? "PASS" : "FAIL"));
-  chart::WritePng({.title = "textile validate", .width_px = 1100, .height_px = 800, .panels = {p}},
+  std::vector<chart::Panel> panels = {p};
+  if (!v.holdout.empty()) panels.push_back(HeldOutPanel(v, profiles, stems, common));
+  chart::WritePng({.title = "textile validate",
+                   .width_px = 1100,
+                   .height_px = panels.size() == 1 ? 800 : 1400,
+                   .panels = panels},
                   out);
 }
 

@@ -59,6 +59,30 @@ TEST(CliValidate, ShippedProfilesPassWithTheirNoiseLevel) {
   EXPECT_TRUE(fs::exists(dir / "fitted.json"));
 }
 
+// The PNG's height from its IHDR chunk (bytes 20-23, big-endian).
+unsigned PngHeight(const fs::path& png) {
+  const std::string bytes = ReadAll(png);
+  if (bytes.size() < 24) return 0;
+  unsigned h = 0;
+  for (int k = 20; k < 24; ++k) h = (h << 8) | static_cast<unsigned char>(bytes[k]);
+  return h;
+}
+
+// validate.png gains a second panel, the held-out predictions' distances, when anything is held
+// out, and keeps the single panel with one profile.
+TEST(CliValidate, PictureShowsTheHeldOutPanelOnlyWhenSomethingIsHeldOut) {
+  const auto many = Scratch("CliValidate.PictureMany");
+  const auto r = Textile("validate " + kFig8Profiles + " --gsm 200 --model elastica -o " +
+                         many.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto one = Scratch("CliValidate.PictureOne");
+  const auto r1 = Textile("validate samples/profiles/pabst-fig8_L060mm.profile.csv --gsm 200 "
+                          "--model elastica -o " + one.string());
+  ASSERT_EQ(r1.exit_code, 0) << r1.err;
+  EXPECT_EQ(PngHeight(many / "validate.png"), 1400u);
+  EXPECT_EQ(PngHeight(one / "validate.png"), 800u);
+}
+
 // Each shipped profile predicted by the law fitted to the other two: one entry per profile and
 // model, within the samples' 0.1 mm noise (a prediction misses by at least the noise, and by
 // little more: the law of two profiles is close to that of three), with its 1-σ.

@@ -49,6 +49,8 @@ nlohmann::json MachineInfo();
 double Median(std::vector<double> v);
 // Seconds of wall time for one call of f, as the median of `repeats` calls.
 double MedianSeconds(const std::function<void()>& f, int repeats);
+// CPU time of the calling thread [s] (POSIX CLOCK_THREAD_CPUTIME_ID).
+double ThreadCpuSeconds();
 
 }  // namespace textile::bench
 

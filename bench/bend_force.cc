@@ -13,7 +13,6 @@
 #include <numbers>
 #include <sstream>
 #include <thread>
-#include <time.h>
 
 #include "bench/bench.h"
 #include "common/chart_file.h"
@@ -43,12 +42,6 @@ Vertices HangingSheet(const TriangleMesh& flat, double length) {
     x.row(i) << px, y, pz + wave;
   }
   return x;
-}
-
-double ThreadCpuSeconds() {
-  timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 // Seconds per call of f: 1 thread, this thread's CPU time, median over batches of 10 calls

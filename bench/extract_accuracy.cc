@@ -5,7 +5,6 @@
 // with OpenCV single-threaded (the one-core figure, steady on a loaded machine, unlike the wall
 // clock, which is reported too), and the JPEG's decoding is timed apart from the extraction.
 
-#include <time.h>
 
 #include <algorithm>
 #include <chrono>
@@ -36,13 +35,6 @@ struct Size {
   int width, height;
   double mm_per_px;
 };
-
-// CPU time of the calling thread [s].
-double ThreadCpuSeconds() {
-  timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec + 1e-9 * t.tv_nsec;
-}
 
 // Median CPU time of the calling thread over `repeats` calls of f [s].
 double MedianCpuSeconds(const std::function<void()>& f, int repeats) {

@@ -224,7 +224,7 @@ Benchmark StabilityBenchmark() {
           // a support far below (never touched) shows what the contact loops cost.
           auto timed = [&](ClothProblem* problem, const std::string& label) {
             Vertices x = b.mesh.vertices;
-            const SolveSummary s = SolveStatic(problem, &x, {});
+            SolveSummary s = SolveStatic(problem, &x, {});
             nlohmann::json row = Row(label, "newton", 0, s);
             row["triangles"] = b.mesh.num_triangles();
             res.rows.push_back(row);

@@ -295,7 +295,7 @@ ceres::Solver::Options ClappSolverOptions(const ClappOptions& options) {
 
 // The regression of eq. 1 on the pooled pairs from p (in place), within the state's bounds.
 ceres::Solver::Summary SolveClappStart(const ClappFitState& state,
-                                       ceres::Solver::Options solver_options,
+                                       const ceres::Solver::Options& solver_options,
                                        std::array<double, 3>* p) {
   const ClappOptions& options = state.options;
   ceres::Problem problem;
@@ -488,7 +488,7 @@ void ClappCovariance(ClappFitState* state) {
     jtj += residual.v * residual.v.transpose();
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(jtj);
-  const Eigen::Vector3d lambda = eigen.eigenvalues();  // ascending
+  const Eigen::Vector3d& lambda = eigen.eigenvalues();  // ascending
   bool on_bound = false;
   for (int k = 0; k < 3; ++k) {
     on_bound = on_bound || best[k] <= state->lower[k] + 1e-9 || best[k] >= state->upper[k] - 1e-9;

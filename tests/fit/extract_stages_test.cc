@@ -32,11 +32,7 @@ constexpr double kOriginPx = 0.5;
 constexpr double kTipPx = 1.5;
 constexpr double kLineMaxPx = 1.0;
 
-PhotoScene BorderScene() {
-  PhotoScene s;
-  s.root_x = -0.5;  // the strip leaves the photo's left edge
-  return s;
-}
+using testing::BorderScene;
 
 PhotoScene PlatformScene() {
   PhotoScene s;
@@ -238,15 +234,7 @@ TEST(ExtractStages, MeasureSectionsGivesTheSilhouetteWidth) {
 TEST(ExtractStages, MeasureSectionsFailsOnALineMeasuredOnFewSections) {
   // A strip much thicker than its bend radius allows loses its upper edge in most sections
   // (as ExtractFailures.LineMeasuredOnFewSectionsFailsNamingIt).
-  PhotoScene s;
-  s.holder = PhotoScene::Holder::kPlatform;
-  s.root_x = 900.0;
-  s.root_y = 300.0;
-  s.mirror = true;
-  s.thickness = 70.0;
-  s.radius = 120.0;
-  s.straight = 0.0;
-  s.bend_deg = 80.0;
+  const PhotoScene s = testing::ThickBandRoundTheCornerScene();
   ExtractOptions upper;
   upper.trace = TraceLine::kUpper;
   StagedRun run(testing::Render(s).gray, upper);

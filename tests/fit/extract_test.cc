@@ -67,11 +67,7 @@ LineError Compare(const SyntheticPhoto& photo, const ExtractionSummary& r, doubl
   return e;
 }
 
-PhotoScene BorderScene() {
-  PhotoScene s;
-  s.root_x = -0.5;  // the strip leaves the photo's left edge
-  return s;
-}
+using testing::BorderScene;
 
 void ExpectAccurate(const SyntheticPhoto& photo, const ExtractionSummary& r) {
   ASSERT_TRUE(r.success) << r.message;
@@ -607,15 +603,7 @@ TEST(ExtractFailures, ProfileThatFoldsBack) {
 // rendered 8 mm strip whose upper edge was measured nowhere crashed (a NaN smoothing width:
 // "cannot create std::vector larger than max_size()"). It now fails naming the line.
 TEST(ExtractFailures, LineMeasuredOnFewSectionsFailsNamingIt) {
-  PhotoScene s;
-  s.holder = PhotoScene::Holder::kPlatform;
-  s.root_x = 900.0;
-  s.root_y = 300.0;
-  s.mirror = true;
-  s.thickness = 70.0;
-  s.radius = 120.0;
-  s.straight = 0.0;
-  s.bend_deg = 80.0;
+  const PhotoScene s = testing::ThickBandRoundTheCornerScene();
   ExtractOptions upper;
   upper.trace = TraceLine::kUpper;
   const ExtractionSummary r = Extract(testing::Render(s).gray, upper);

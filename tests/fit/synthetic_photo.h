@@ -233,6 +233,28 @@ inline SyntheticPhoto Render(const PhotoScene& s) {
   return photo;
 }
 
+// The strip leaving the photo's left edge (no holder in the frame): the plainest scene.
+inline PhotoScene BorderScene() {
+  PhotoScene s;
+  s.root_x = -0.5;
+  return s;
+}
+
+// A band bent round the platform's corner at a radius not much larger than its thickness (70 px
+// at 120 px): its upper edge is measured on 6 of 168 cross-sections.
+inline PhotoScene ThickBandRoundTheCornerScene() {
+  PhotoScene s;
+  s.holder = PhotoScene::Holder::kPlatform;
+  s.root_x = 900.0;
+  s.root_y = 300.0;
+  s.mirror = true;
+  s.thickness = 70.0;
+  s.radius = 120.0;
+  s.straight = 0.0;
+  s.bend_deg = 80.0;
+  return s;
+}
+
 // Two cantilevers in one photo (two strips side by side or one above the other): both scenes
 // rendered and the darker of the two kept at each pixel, so both must show dark strips on the
 // same background.

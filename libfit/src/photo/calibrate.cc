@@ -163,7 +163,7 @@ BoardDetection DetectChessboard(const cv::Mat& gray, int cols, int rows, const s
   // to give up on a board whose corner count is wrong (adaptive thresholds tried one by one), and
   // the exhaustive search takes as long on a photo without a board.
   const bool found = cv::findChessboardCornersSB(small, pattern, corners, cv::CALIB_CB_NORMALIZE_IMAGE);
-  if (!found || corners.size() != static_cast<size_t>(cols * rows)) return d;
+  if (!found || corners.size() != static_cast<size_t>(cols) * static_cast<size_t>(rows)) return d;
   for (auto& c : corners) {
     // Pixel centres at integers in both images: x_full = (x_small + 0.5) / scale - 0.5.
     c = cv::Point2f(static_cast<float>((c.x + 0.5) / scale - 0.5),

@@ -1667,7 +1667,8 @@ double SagittaUpTo(const std::vector<Vec2>& line, double along) {
   double sagitta = 0.0, run = 0.0;
   size_t end = 1;
   while (end + 1 < line.size() && run < along) run += (line[end] - line[end - 1]).norm(), ++end;
-  const Vec2 a = line.front(), chord = line[end - 1] - a;
+  const Vec2& a = line.front();
+  const Vec2 chord = line[end - 1] - a;
   const double n = chord.norm();
   for (size_t k = 0; k < end && n > 0.0; ++k) {
     const Vec2 d = line[k] - a;

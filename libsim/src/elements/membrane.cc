@@ -198,7 +198,7 @@ Mat6 CorotationalStressDerivative(const MembraneLame& l, const Mat32& f) {
 
 // Clamps negative eigenvalues to zero (Teran et al. 2005; Sensitive Couture section 5).
 Mat6 ProjectPsd(const Mat6& h) {
-  const Mat6 sym = 0.5 * (h + h.transpose());
+  Mat6 sym = 0.5 * (h + h.transpose());
   if (Eigen::LLT<Mat6>(sym).info() == Eigen::Success) return sym;  // positive definite: cheap exit
   Eigen::SelfAdjointEigenSolver<Mat6> eig(sym);
   if (eig.eigenvalues().minCoeff() >= 0) return sym;

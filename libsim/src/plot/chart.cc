@@ -699,7 +699,8 @@ void Draw(cairo_t* cr, const Figure& figure) {
   const int rows = (n + columns - 1) / columns;
   for (int i = 0; i < n; ++i) {
     const double w = area.w / columns, h = area.h / rows;
-    const Rect cell{area.x + (i % columns) * w, area.y + (i / columns) * h, w, h};
+    const int row = i / columns, column = i % columns;  // the panel's place, row by row
+    const Rect cell{area.x + column * w, area.y + row * h, w, h};
     DrawPanel(c, figure.panels[i], cell);
   }
 }

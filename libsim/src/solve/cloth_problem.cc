@@ -255,7 +255,7 @@ void ClothProblem::DropFixedFromPattern() {
   for (int& slot : bending_value_slot_)
     if (slot >= 0) slot = new_slot[slot] >= 0 ? new_slot[slot] : trash;
   for (int& slot : diagonal_block_slot_) slot = new_slot[slot] >= 0 ? new_slot[slot] : trash;
-  hessian_ = std::move(reduced);
+  hessian_.swap(reduced);  // O(1); Eigen 3.4's SparseMatrix has no move assignment
   for (int v : fixed_)
     for (int a = 0; a < 3; ++a)
       fixed_diagonal_slots_.push_back(diagonal_block_slot_[9 * v + 4 * a]);

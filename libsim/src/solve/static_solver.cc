@@ -645,7 +645,7 @@ SolveSummary Cascade(const std::vector<ClothProblem*>& levels, std::vector<Verti
 SolveSummary SolveCascadic(ClothProblem* coarse, ClothProblem* fine, Vertices* x_coarse,
                            Vertices* x_fine, const SolveOptions& options) {
   std::vector<Vertices> states = {*x_coarse};
-  const SolveSummary s = Cascade({coarse, fine}, &states, options);
+  SolveSummary s = Cascade({coarse, fine}, &states, options);
   *x_coarse = states[0];
   if (states[1].rows() > 0) *x_fine = states[1];
   return s;
@@ -654,7 +654,7 @@ SolveSummary SolveCascadic(ClothProblem* coarse, ClothProblem* fine, Vertices* x
 SolveSummary SolveCascadic(const std::vector<ClothProblem*>& levels, Vertices* x,
                            const SolveOptions& options) {
   std::vector<Vertices> states = {*x};
-  const SolveSummary s = Cascade(levels, &states, options);
+  SolveSummary s = Cascade(levels, &states, options);
   if (states.back().rows() > 0) *x = states.back();
   return s;
 }

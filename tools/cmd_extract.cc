@@ -99,6 +99,7 @@ void Run(const ExtractArgs& a) {
                        {"core_width_px", r.core_width_px},
                        {"widening", r.widening},
                        {"rejected_sections", r.rejected_sections},
+                       {"confidence", ConfidenceJson(r.confidence)},
                        {"warnings", r.WarningTexts()},
                        {"seconds", r.seconds}});
     report += r.BriefReport() + "\n  wrote " + csv + " and " + png + "\n";

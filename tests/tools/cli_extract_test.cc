@@ -61,13 +61,44 @@ void ExpectOneLineError(const testing::CliResult& r, int code, const std::string
   EXPECT_NE(r.err.find(words), std::string::npos) << r.err;
 }
 
+// The test strips are a straight run and an arc, no heavy cantilever: the physics check refuses
+// them (exit 3, nothing written) unless told to take the guess, and then says so in the JSON's
+// confidence report and warnings; the shipped rendered photo passes it.
+TEST(CliExtract, PhysicsCheckRefusesAnArcAndAcceptGuessesTakesIt) {
+  const fs::path dir = Scratch("cli_extract_shape");
+  const fs::path png = WritePhoto(dir, "arc.png", Strip());
+  ExpectOneLineError(Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir / "a")),
+                     3, "no heavy cantilever");
+  EXPECT_FALSE(fs::exists(dir / "a"));
+  const auto taken = Textile("extract " + Quote(png) + " --mm-per-px 0.1 --accept-guesses -o " +
+                             Quote(dir / "b") + " --json");
+  ASSERT_EQ(taken.exit_code, 0) << taken.err;
+  const auto j = nlohmann::json::parse(taken.out)["photos"][0];
+  EXPECT_EQ(j["confidence"]["held_end"], "found");
+  EXPECT_EQ(j["confidence"]["shape_plausible"], false);
+  ASSERT_EQ(j["confidence"]["guesses"].size(), 1u);
+  EXPECT_NE(j["warnings"].dump().find("taken (--accept-guesses)"), std::string::npos) << j.dump();
+
+  const auto shipped = Textile(
+      "extract samples/photos/pabst-fig8_L060mm.jpg --rig samples/photos/pabst-fig8.rig-truth.json "
+      "-o " + Quote(dir / "c") + " --json");
+  ASSERT_EQ(shipped.exit_code, 0) << shipped.err;
+  const auto c = nlohmann::json::parse(shipped.out)["photos"][0]["confidence"];
+  EXPECT_EQ(c["held_end"], "found");
+  EXPECT_EQ(c["tip"], "found");
+  EXPECT_EQ(c["shape_plausible"], true);
+  EXPECT_LT(c["shape_rms_mm"].get<double>(), 0.1);
+  EXPECT_GT(c["sections_measured"].get<double>(), 0.9);
+  EXPECT_TRUE(c["guesses"].empty());
+}
+
 TEST(CliExtract, WritesProfileAndOverlayAndAJsonSummary) {
   const fs::path dir = Scratch("cli_extract_ok");
   const testing::SyntheticPhoto photo = testing::Render(Strip());
   const fs::path png = dir / "strip_60mm.png";
   cv::imwrite(png.string(), photo.gray);
-  const auto r =
-      Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir / "out") + " --json");
+  const auto r = Textile("extract " + Quote(png) + " --mm-per-px 0.1 --no-shape-check -o " +
+                         Quote(dir / "out") + " --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j.at("photos").size(), 1u);
@@ -94,7 +125,8 @@ TEST(CliExtract, WritesProfileAndOverlayAndAJsonSummary) {
   EXPECT_EQ(overlay.cols, 1000);
   EXPECT_EQ(overlay.type(), CV_8UC3);
   // Text mode says the same in words.
-  const auto text = Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir / "out"));
+  const auto text = Textile("extract " + Quote(png) + " --mm-per-px 0.1 --no-shape-check -o " +
+                            Quote(dir / "out"));
   EXPECT_EQ(text.exit_code, 0) << text.err;
   EXPECT_NE(text.out.find("clamp rig"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("wrote"), std::string::npos) << text.out;
@@ -106,14 +138,16 @@ TEST(CliExtract, RigFilesGiveTheSameProfileAsThePlainScale) {
   std::ofstream(dir / "scale.json") << R"({"type": "scale", "mm_per_px": 0.1})";
   std::ofstream(dir / "homography.json")
       << R"({"type": "homography", "plane_from_image": [[0, -0.1, 50], [0.1, 0, -20], [0, 0, 1]]})";
-  ASSERT_EQ(Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir / "a")).exit_code,
-            0);
-  ASSERT_EQ(Textile("extract " + Quote(png) + " --rig " + Quote(dir / "scale.json") + " -o " +
-                    Quote(dir / "b"))
+  ASSERT_EQ(
+      Textile("extract " + Quote(png) + " --mm-per-px 0.1 --no-shape-check -o " + Quote(dir / "a"))
+          .exit_code,
+      0);
+  ASSERT_EQ(Textile("extract " + Quote(png) + " --rig " + Quote(dir / "scale.json") +
+                    " --no-shape-check -o " + Quote(dir / "b"))
                 .exit_code,
             0);
-  const auto r = Textile("extract " + Quote(png) + " --rig " + Quote(dir / "homography.json") +
-                         " -o " + Quote(dir / "c"));
+  const auto r = Textile("extract " + Quote(png) + " --no-shape-check --rig " +
+                         Quote(dir / "homography.json") + " -o " + Quote(dir / "c"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const Profile a = ReadProfileCsv((dir / "a" / "strip.profile.csv").string());
   for (const char* other : {"b", "c"}) {
@@ -131,8 +165,8 @@ TEST(CliExtract, OptionsReachTheExtractor) {
   PhotoScene s = Strip();
   s.mirror = true;
   const fs::path png = WritePhoto(dir, "left.png", s);
-  const auto r = Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir) +
-                         " --trace upper --step-mm 1 --level-deg 0.5 --json");
+  const auto r = Textile("extract " + Quote(png) + " --mm-per-px 0.1 --no-shape-check -o " +
+                         Quote(dir) + " --trace upper --step-mm 1 --level-deg 0.5 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto p = nlohmann::json::parse(r.out)["photos"][0];
   EXPECT_EQ(p.at("direction"), "left");
@@ -141,8 +175,8 @@ TEST(CliExtract, OptionsReachTheExtractor) {
   const Profile profile = ReadProfileCsv((dir / "left.profile.csv").string());
   EXPECT_NEAR((profile.s[1] - profile.s[0]) * 1e3, 1.0, 2e-6);  // CSV: 6 decimals of mm
   // A manual edge: the profile starts where the line crosses the vertical through it.
-  const auto e = Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir) +
-                         " --edge-px 900,200 --json");
+  const auto e = Textile("extract " + Quote(png) + " --mm-per-px 0.1 --no-shape-check -o " +
+                         Quote(dir) + " --edge-px 900,200 --json");
   ASSERT_EQ(e.exit_code, 0) << e.err;
   const auto q = nlohmann::json::parse(e.out)["photos"][0];
   EXPECT_DOUBLE_EQ(q.at("origin_px")[0].get<double>(), 900.0);
@@ -248,20 +282,24 @@ TEST(CliExtract, DetectionFailuresExitThreeAndKeepGoodOutputs) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
     const fs::path png = WritePhoto(dir, c.name, c.scene);
-    ExpectOneLineError(
-        Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir / "out") + c.extra), 3,
-        c.name + ": " + c.words);
+    ExpectOneLineError(Textile("extract " + Quote(png) + " --mm-per-px 0.1 --no-shape-check -o " +
+                               Quote(dir / "out") + c.extra),
+                       3, c.name + ": " + c.words);
   }
   EXPECT_TRUE(Listing(dir / "out").empty());
   // A good run, then a failing photo under the same name: the good outputs stay as they were.
   const fs::path png = WritePhoto(dir, "strip.png", Strip());
-  ASSERT_EQ(
-      Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir / "out")).exit_code, 0);
+  ASSERT_EQ(Textile("extract " + Quote(png) + " --mm-per-px 0.1 --no-shape-check -o " +
+                    Quote(dir / "out"))
+                .exit_code,
+            0);
   const std::string csv = ReadAll(dir / "out" / "strip.profile.csv");
   const std::string overlay = ReadAll(dir / "out" / "strip.overlay.png");
   WritePhoto(dir, "strip.png", blank);
-  EXPECT_EQ(
-      Textile("extract " + Quote(png) + " --mm-per-px 0.1 -o " + Quote(dir / "out")).exit_code, 3);
+  EXPECT_EQ(Textile("extract " + Quote(png) + " --mm-per-px 0.1 --no-shape-check -o " +
+                    Quote(dir / "out"))
+                .exit_code,
+            3);
   EXPECT_EQ(ReadAll(dir / "out" / "strip.profile.csv"), csv);
   EXPECT_EQ(ReadAll(dir / "out" / "strip.overlay.png"), overlay);
   EXPECT_EQ(Listing(dir / "out"),
@@ -276,7 +314,7 @@ TEST(CliExtract, SeveralPhotosAreAllOrNothing) {
   PhotoScene blank = Strip();
   blank.strip = blank.background;
   const fs::path b = WritePhoto(dir, "b.png", blank);
-  const std::string out = " --mm-per-px 0.1 -o " + Quote(dir / "out");
+  const std::string out = " --mm-per-px 0.1 --no-shape-check -o " + Quote(dir / "out");
   ExpectOneLineError(Textile("extract " + Quote(a) + " " + Quote(b) + out), 3,
                      "b.png: no strip found");
   EXPECT_TRUE(Listing(dir / "out").empty());

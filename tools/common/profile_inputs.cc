@@ -11,6 +11,7 @@
 
 #include "common/cli.h"
 #include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile::cli {
 namespace {
@@ -117,7 +118,23 @@ nlohmann::json ExtractionJson(const LoadedProfile& in) {
           {"polarity", r.polarity},   {"direction", r.direction},
           {"trace", r.trace},         {"points", r.profile.size()},
           {"length_mm", r.length_mm}, {"tip_mm", {r.tip_mm.x(), r.tip_mm.y()}},
-          {"mm_per_px", r.mm_per_px}, {"warnings", r.WarningTexts()}};
+          {"mm_per_px", r.mm_per_px}, {"confidence", ConfidenceJson(r.confidence)},
+          {"warnings", r.WarningTexts()}};
+}
+
+nlohmann::json ConfidenceJson(const ExtractionConfidence& c) {
+  const auto mm_or_null = [&c](double ShapeCheck::*field) {
+    return c.shape && c.shape->converged ? nlohmann::json(units::MToMm((*c.shape).*field))
+                                         : nlohmann::json();
+  };
+  return {{"held_end", c.held_end},
+          {"held_end_how", c.held_end_how},
+          {"tip", c.tip},
+          {"sections_measured", c.sections_measured},
+          {"shape_rms_mm", mm_or_null(&ShapeCheck::rms)},
+          {"shape_max_mm", mm_or_null(&ShapeCheck::max)},
+          {"shape_plausible", c.shape ? nlohmann::json(c.shape->plausible) : nlohmann::json()},
+          {"guesses", c.guesses}};
 }
 
 PhotoInputOptions PhotoFlags::Options() const {
@@ -139,6 +156,8 @@ PhotoInputOptions PhotoFlags::Options() const {
   if (!edge.empty()) e.edge_px = ParseEdgePx(edge);
   if (level_option && level_option->count() > 0) e.level_deg = level_deg;
   e.step_mm = step_mm;
+  e.accept_guesses = accept_guesses;
+  e.check_shape = !no_shape_check;
   o.progress = progress;
   std::string why;
   if (!e.Check(&why)) {
@@ -172,6 +191,12 @@ void AddPhotoFlags(CLI::App* sub, PhotoFlags* f) {
   sub->add_option("--rig-type", f->rig_type, "auto (default), platform (fail if none is found) or clamp")
       ->check(CLI::IsMember({"auto", "platform", "clamp"}));
   sub->add_option("--step-mm", f->step_mm, "Profile spacing along the arc length [mm] (default 0.5)");
+  sub->add_flag("--accept-guesses", f->accept_guesses,
+                "Take what extraction had to guess (the held end, the tip, a profile failing the "
+                "physics check) instead of failing; each guess becomes a warning");
+  sub->add_flag("--no-shape-check", f->no_shape_check,
+                "Skip the physics check (a strip that is no free cantilever; saves 10-40 ms a "
+                "photo): the profile's confidence then rests on the extraction alone");
   sub->add_flag("--progress", f->progress,
                 "Print the progress lines of photo extraction on stderr even when it is not a "
                 "terminal");

@@ -63,22 +63,28 @@ std::vector<LoadedProfile> LoadProfileInputs(const std::vector<std::string>& pat
                                              const PhotoInputOptions& options);
 
 // What a fit report says of a photo input (fit, validate): photo, rig_type, polarity,
-// direction, trace, points, length_mm, tip_mm, mm_per_px, warnings. in.extraction must be set.
+// direction, trace, points, length_mm, tip_mm, mm_per_px, confidence, warnings. in.extraction
+// must be set.
 nlohmann::json ExtractionJson(const LoadedProfile& in);
+
+// An extraction's confidence report: {held_end, held_end_how, tip, sections_measured,
+// shape_rms_mm, shape_max_mm (null when not checked or no cantilever fits), shape_plausible
+// (null when not checked), guesses}.
+nlohmann::json ConfidenceJson(const ExtractionConfidence& confidence);
 
 // The shared photo flags, as CLI11 binds them (raw strings; Options() validates them).
 struct PhotoFlags {
   std::string rig_file, edge, trace = "mid", rig_type = "auto";
   double mm_per_px = 0.0, level_deg = 0.0, step_mm = 0.5;
-  bool progress = false;
+  bool progress = false, accept_guesses = false, no_shape_check = false;
   CLI::Option *rig_option = nullptr, *scale_option = nullptr, *level_option = nullptr;
 
   // The options these flags give; throws InputError naming the flag ("--edge-px: ...").
   PhotoInputOptions Options() const;
 };
 
-// Adds --rig, --mm-per-px, --trace, --rig-type, --edge-px, --level-deg, --step-mm and
-// --progress to a subcommand, bound to *flags (which must outlive the parse).
+// Adds --rig, --mm-per-px, --trace, --rig-type, --edge-px, --level-deg, --step-mm,
+// --accept-guesses, --no-shape-check and --progress to a subcommand, bound to *flags (which must outlive the parse).
 void AddPhotoFlags(CLI::App* sub, PhotoFlags* flags);
 
 // "X,Y" in pixels (--edge-px); throws InputError.

@@ -16,6 +16,7 @@
 #include "deadline.h"
 #include "extract_internal.h"
 #include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
 
 namespace textile {
 namespace {
@@ -1187,6 +1188,16 @@ std::string ExtractionSummary::BriefReport() const {
   s << "  " << profile.size() << " points, L = " << Fmt(length_mm, 2) << " mm, tip (x, y) = ("
     << Fmt(tip_mm.x(), 2) << ", " << Fmt(tip_mm.y(), 2) << ") mm, " << Fmt(mm_per_px, 5)
     << " mm/px, silhouette " << Fmt(width_px, 1) << " px wide";
+  const ExtractionConfidence& c = confidence;
+  if (!c.held_end.empty()) {
+    s << "\n  confidence: held end " << c.held_end << ", tip " << c.tip << ", "
+      << Fmt(100.0 * c.sections_measured, 0) << " % of sections measured";
+    if (c.shape && c.shape->converged)
+      s << ", heavy cantilever within " << Fmt(units::MToMm(c.shape->rms), 3) << " mm rms"
+        << (c.shape->plausible ? "" : " (FAILS the 1 mm check)");
+    else if (c.shape)
+      s << ", no heavy cantilever fits (FAILS the physics check)";
+  }
   for (const Note& w : warnings) s << "\n  warning: " << w.text;
   return s.str();
 }
@@ -2028,6 +2039,9 @@ ExtractionSummary ExtractProfile(const cv::Mat& gray, const Rig& rig, const Extr
   DiagnoseSilhouette(&s);
   if (StageFailure why = CheckResult(s)) return Failed(std::move(s), *why);
   if (PastCap(&s, "with the profile done")) return std::move(s.summary);
+  s.summary.confidence = AssessConfidence(s);
+  if (StageFailure why = RefuseGuesses(s.summary.confidence, options, &s.summary.warnings))
+    return Failed(std::move(s), *why);
   s.summary.success = true;
   s.summary.seconds = s.deadline.Elapsed();
   return std::move(s.summary);

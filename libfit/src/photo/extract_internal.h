@@ -281,6 +281,16 @@ void DiagnoseSilhouette(ExtractState* s);
 // Fails when the profile has too few points or is not a hanging strip (CheckProfile).
 StageFailure CheckResult(const ExtractState& s);
 
+// The confidence report of a finished profile (extract_confidence.cc): how the held end and
+// the tip were found, the fraction of sections measured, the physics check (with
+// options.check_shape) and the guesses, each naming what settles it.
+ExtractionConfidence AssessConfidence(const ExtractState& s);
+
+// Fails, listing the guesses, unless options.accept_guesses; with it, each guess is added to
+// *warnings (code guess_accepted). Nothing to do without guesses.
+StageFailure RefuseGuesses(const ExtractionConfidence& confidence, const ExtractOptions& options,
+                           std::vector<Note>* warnings);
+
 }  // namespace textile::extract_internal
 
 #endif  // TEXTILE_FIT_SRC_EXTRACT_INTERNAL_H_

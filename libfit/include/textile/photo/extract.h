@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "textile/fit/profile.h"
+#include "textile/fit/shape_check.h"
 #include "textile/photo/rig.h"
 #include "textile/sim/core/note.h"
 
@@ -78,9 +79,35 @@ struct ExtractOptions {
   // Wall-time cap [s], checked between the stages: a run past it fails ("time cap ..."), with
   // no profile. A 12 MP photo takes about 0.1 s; 0 stops every run at the first check.
   double max_seconds = 30.0;
+  // The physics check of the profile (CheckCantileverShape, 10-40 ms): a profile that is no
+  // heavy cantilever within 1 mm RMS fails the run unless accept_guesses.
+  bool check_shape = true;
+  // Where a stage had to guess (the held end, the tip) or the physics check failed, the run
+  // fails naming the flag that settles it (ExtractionConfidence::guesses); true takes the
+  // guesses and reports them as warnings (`--accept-guesses`).
+  bool accept_guesses = false;
 
   // True if every field is usable; otherwise *why says which and why.
   bool Check(std::string* why) const;
+};
+
+// How far an extracted profile can be trusted (docs/methods/extraction.md, "Confidence").
+struct ExtractionConfidence {
+  // "found" (a platform, a clamp or the image border holds the strip), "given" (--edge-px) or
+  // "guessed" (nothing holds it in view: its higher end was taken).
+  std::string held_end;
+  std::string held_end_how;  // for people: the rig's detail ("edge at the platform's ...")
+  // "found" (the strip's contrast falls off at its end) or "inferred" (it does not: the last
+  // measured cross-section was taken as the tip).
+  std::string tip;
+  // Cross-sections from the origin to the tip whose traced line was measured, 0..1.
+  double sections_measured = 0.0;
+  // The physics check (ExtractOptions::check_shape): the best single-overhang heavy elastica
+  // against the profile; empty when not run.
+  std::optional<ShapeCheck> shape;
+  // What the run had to take on trust, one phrase each naming what settles it; empty when
+  // nothing was guessed. Without accept_guesses a non-empty list fails the run.
+  std::vector<std::string> guesses;
 };
 
 // Result of one photo. On failure, success is false and message says why (one line);
@@ -108,8 +135,10 @@ struct ExtractionSummary {
   int rejected_sections = 0;          // cross-sections dropped as outliers (fibres, specks)
   // Doubts worth a look, one line each, with their codes: other_polarity_band_ignored,
   // held_end_guessed, tip_end_unclear, edge_px_along_strip, border_gap_extrapolated,
-  // trace_starts_beyond_edge, oblique_view, low_contrast, sections_rejected.
+  // trace_starts_beyond_edge, oblique_view, low_contrast, sections_rejected, guess_accepted
+  // (ExtractOptions::accept_guesses).
   std::vector<Note> warnings;
+  ExtractionConfidence confidence;    // filled in when the profile is done
   double seconds = 0.0;               // wall time of the extraction
 
   // Geometry in full-resolution pixels, for overlays and checks.

@@ -277,6 +277,31 @@ TEST(DrapeCompare, PiR2DcIsTheSameShadowOverTheCutSpecimen) {
   EXPECT_GT(c.simulated_dc_pi_r2, c.simulated_dc - 0.002);
 }
 
+TEST(DrapeCompare, ADrapeMeasuredFromItsOwnShadowDiffersOnlyByTheDcDefinition) {
+  // A coarse plain drape (15 mm, no rim band: ~0.2 s) measured from its own shadow raster as a
+  // drape-measure input would be: the same outline (0 mm at 0°), the same nodes, and a DC that
+  // is the simulated one over π R² (simulated_dc_pi_r2) exactly.
+  Material fabric;
+  fabric.areal_density = 0.2;
+  fabric.bending = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+  DrapeOptions o;
+  o.element_size = 0.015;
+  o.raster_cell = 0.001;
+  const DrapeResult r = SimulateDrape(fabric, o);
+  ASSERT_TRUE(r.converged) << r.message;
+  const MeasuredDrape m =
+      MeasureDrapeShadow(r.per_seed[0].shadow, MeasureOptionsOf(o), "own shadow");
+  const DrapeComparison c = CompareDrapes(r, m, {});
+  EXPECT_NEAR(c.measured_dc, c.simulated_dc_pi_r2, 1e-12);
+  // A 15 mm mesh's polygon: the definitions differ by 0.0026 × DC (0.0013 here).
+  EXPECT_GT(c.dc_difference, 0.0005);
+  EXPECT_LT(c.dc_difference, 0.003);
+  EXPECT_EQ(c.measured_nodes, static_cast<int>(r.per_seed[0].nodes.angles.size()));
+  EXPECT_LT(c.outline_rms, 1e-12);
+  EXPECT_NEAR(c.best_rotation, 0.0, 1e-12);
+  EXPECT_TRUE(c.pass);
+}
+
 TEST(DrapeCompare, AnotherSpecimenOrSupportIsRefused) {
   const DrapeResult r = Simulated({Seed(1, Outline(360), 0.62, 6)});
   try {

@@ -259,18 +259,6 @@ std::string OutlinePath(const std::string& result) {
   return p.string() + ".outline.csv";
 }
 
-std::string OutlineCsv(const DrapeSeedResult& s) {
-  std::ostringstream out;
-  out.precision(10);
-  out << "theta_deg,r_mm,x_mm,y_mm\n";
-  for (int b = 0; b < s.shadow.angles.size(); ++b) {
-    const double t = s.shadow.angles(b), r = s.shadow.radii(b);
-    out << t / kDegree << "," << units::MToMm(r) << "," << units::MToMm(r * std::cos(t)) << ","
-        << units::MToMm(r * std::sin(t)) << "\n";
-  }
-  return out.str();
-}
-
 // The first seed's draped mesh as PLY, with each vertex's pattern position (to map a scan or a
 // texture onto it) and, with seams, its pattern distance to the nearest seam line [m].
 std::string DrapedPly(const DrapeResult& r, const DrapeSeedResult& s) {
@@ -597,7 +585,7 @@ void Run(const DrapeArgs& a) {
   nlohmann::json j = ResultJson(r, o, m, a);
   if (comparison) j["comparison"] = ComparisonJson(*comparison, a);
   j["outline_csv"] = outline_file.path();
-  outline_file.Write(OutlineCsv(first));
+  outline_file.Write(OutlineCsv(first.shadow));  // drape_measure.h: the shared columns
   if (png_file) {
     if (!(comparison ? WriteDrapeComparisonPng(r, *comparison, o, png_file->temp_path())
                      : WriteDrapeShadowPng(r, first, o, png_file->temp_path())))

@@ -1,6 +1,6 @@
 // textile drape: the virtual drapemeter (Cusick test; Pabst section 5.2). Drape coefficient and
 // nodes of a disk of fabric on a smaller disk, over N seeded perturbations; result JSON, outline
-// CSV, top-view shadow PNG, draped mesh OBJ.
+// CSV, top-view shadow PNG, draped mesh OBJ; with --compare, against a measured drape.
 
 #include <algorithm>
 #include <cmath>
@@ -15,12 +15,14 @@
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
-#include "textile/sim/scenes/drape.h"
-#include "textile/sim/plot/drape_picture.h"
 #include "textile/sim/core/error.h"
-#include "textile/sim/law/material.h"
-#include "textile/sim/io/mesh_io.h"
 #include "textile/sim/core/units.h"
+#include "textile/sim/io/mesh_io.h"
+#include "textile/sim/law/material.h"
+#include "textile/sim/plot/drape_picture.h"
+#include "textile/sim/scenes/drape.h"
+#include "textile/sim/scenes/drape_compare.h"
+#include "textile/sim/scenes/drape_measure.h"
 
 namespace textile::cli {
 namespace {
@@ -47,6 +49,10 @@ struct DrapeArgs {
   bool progress = false;  // the solver's progress lines on stderr even when it is not a terminal
   bool extrapolate = false, no_extrapolate = false;
   bool json = false;
+  // --compare MEASURED.json and its tolerances; --strict makes a failed verdict an error.
+  std::string compare;
+  std::optional<double> dc_tol, node_tol, outline_tol_mm;
+  bool strict = false;
 };
 
 SeamProfile LoadSeamProfile(const DrapeArgs& a) {
@@ -202,22 +208,55 @@ DrapeOptions Options(const DrapeArgs& a) {
   return o;
 }
 
+// The comparison's tolerances; each flag needs --compare.
+DrapeCompareOptions CompareOptions(const DrapeArgs& a) {
+  DrapeCompareOptions o;
+  if (a.compare.empty()) {
+    for (const auto& [given, flag] : {std::pair{a.dc_tol.has_value(), "--dc-tol"},
+                                      std::pair{a.node_tol.has_value(), "--node-tol"},
+                                      std::pair{a.outline_tol_mm.has_value(), "--outline-tol-mm"},
+                                      std::pair{a.strict, "--strict"}})
+      if (given) throw InputError(std::string(flag) + ": needs --compare MEASURED.json");
+    return o;
+  }
+  if (a.dc_tol) {
+    if (!(std::isfinite(*a.dc_tol) && *a.dc_tol > 0.0 && *a.dc_tol <= 1.0))
+      throw InputError("--dc-tol: must be in (0, 1]");
+    o.dc_tolerance = *a.dc_tol;
+  }
+  if (a.node_tol) {
+    if (!(std::isfinite(*a.node_tol) && *a.node_tol >= 0.0 && *a.node_tol <= 100.0))
+      throw InputError("--node-tol: must be between 0 and 100 nodes");
+    o.node_tolerance = *a.node_tol;
+  }
+  if (a.outline_tol_mm) {
+    if (!(std::isfinite(*a.outline_tol_mm) && *a.outline_tol_mm > 0.0 &&
+          *a.outline_tol_mm <= 1000.0))
+      throw InputError("--outline-tol-mm: must be in (0, 1000] mm");
+    o.outline_tolerance = units::MmToM(*a.outline_tol_mm);
+  }
+  if (std::string why; !o.Check(&why)) throw InputError("--compare: " + why);
+  return o;
+}
+
+// The measured drape of --compare (a MEASURED.json from drape-measure; at most 64 MB: an
+// outline of 100 000 bins is 2 MB), refused unless it was taken on the simulation's radii.
+std::optional<MeasuredDrape> ReadMeasured(const DrapeArgs& a, const DrapeOptions& o) {
+  if (a.compare.empty()) return std::nullopt;
+  MeasuredDrape m = ParseMeasuredDrapeJson(
+      ReadInputFile(a.compare, "measured drape (MEASURED.json)", 64u << 20), a.compare);
+  try {
+    CheckDrapesComparable(m, o);
+  } catch (const InputError& e) {
+    throw InputError(a.compare + ": " + e.what());
+  }
+  return m;
+}
+
 std::string OutlinePath(const std::string& result) {
   std::filesystem::path p(result);
   if (p.extension() == ".json") p.replace_extension();
   return p.string() + ".outline.csv";
-}
-
-std::string OutlineCsv(const DrapeSeedResult& s) {
-  std::ostringstream out;
-  out.precision(10);
-  out << "theta_deg,r_mm,x_mm,y_mm\n";
-  for (int b = 0; b < s.shadow.angles.size(); ++b) {
-    const double t = s.shadow.angles(b), r = s.shadow.radii(b);
-    out << t / kDegree << "," << units::MToMm(r) << "," << units::MToMm(r * std::cos(t)) << ","
-        << units::MToMm(r * std::sin(t)) << "\n";
-  }
-  return out.str();
 }
 
 // The first seed's draped mesh as PLY, with each vertex's pattern position (to map a scan or a
@@ -259,6 +298,82 @@ nlohmann::json SummaryJson(const SolveSummary& s) {
 
 nlohmann::json NumberOrNull(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
+
+nlohmann::json ComparisonJson(const DrapeComparison& c, const DrapeArgs& a) {
+  nlohmann::json seeds = nlohmann::json::array();
+  for (const DrapeSeedComparison& s : c.per_seed)
+    seeds.push_back({{"seed", s.seed},
+                     {"drape_coefficient", s.drape_coefficient},
+                     {"nodes", s.nodes},
+                     {"outline_rms_mm", units::MToMm(s.outline.rms)},
+                     {"outline_rms_unrotated_mm", units::MToMm(s.outline.rms_unrotated)},
+                     {"best_rotation_deg", s.outline.rotation / kDegree}});
+  nlohmann::json notes = nlohmann::json::array();
+  for (const Note& n : c.notes) notes.push_back({{"code", n.code}, {"text", n.text}});
+  return {{"measured_file", a.compare},
+          {"measured_source", c.measured_source},
+          {"measured_dc", c.measured_dc},
+          {"simulated_dc", c.simulated_dc},
+          {"simulated_dc_sd", c.simulated_dc_sd},
+          {"simulated_dc_pi_r2", c.simulated_dc_pi_r2},
+          {"dc_difference", c.dc_difference},
+          {"dc_tol", c.dc_tolerance},
+          {"dc_ok", c.dc_ok},
+          {"measured_nodes", c.measured_nodes},
+          {"simulated_nodes", c.simulated_nodes},
+          {"simulated_nodes_sd", c.simulated_nodes_sd},
+          {"node_tol", c.node_tolerance},
+          {"nodes_ok", c.nodes_ok},
+          {"outline_rms_mm", units::MToMm(c.outline_rms)},
+          {"outline_rms_sd_mm", units::MToMm(c.outline_rms_sd)},
+          {"outline_rms_unrotated_mm", units::MToMm(c.outline_rms_unrotated)},
+          {"best_rotation_deg", c.best_rotation / kDegree},
+          {"outline_tol_mm",
+           c.outline_judged ? nlohmann::json(units::MToMm(c.outline_tolerance)) : nlohmann::json()},
+          {"outline_ok", c.outline_judged ? nlohmann::json(c.outline_ok) : nlohmann::json()},
+          {"seeds", seeds},
+          {"verdict", c.Verdict()},
+          {"notes", notes}};
+}
+
+// The comparison block of the text output.
+void PrintComparison(const DrapeComparison& c, const DrapeArgs& a, bool several_seeds) {
+  const auto ok = [](bool b) { return b ? "ok" : "FAIL"; };
+  // Outline RMS to 0.01 mm: an outline compared with itself is 1e-8 mm off (the CSV's digits).
+  const auto mm = [](double metres) {
+    return Num(std::round(units::MToMm(metres) * 100.0) / 100.0) + " mm";
+  };
+  std::cout << "compared with: " << a.compare << " (measured from " << c.measured_source << ")\n"
+            << "  DC: measured " << Num(c.measured_dc, 3) << ", simulated "
+            << Num(c.simulated_dc, 3)
+            << (several_seeds ? " ± " + Num(c.simulated_dc_sd, 2) : std::string()) << ": "
+            << Num(std::abs(c.dc_difference), 2) << " apart, tolerance " << Num(c.dc_tolerance, 3)
+            << ": " << ok(c.dc_ok) << "\n"
+            << "  nodes: measured " << c.measured_nodes << ", simulated "
+            << Num(c.simulated_nodes, 3)
+            << (several_seeds ? " ± " + Num(c.simulated_nodes_sd, 2) : std::string())
+            << ", tolerance ± " << Num(c.node_tolerance, 3) << ": " << ok(c.nodes_ok) << "\n"
+            << "  outline: ";
+  if (several_seeds) {
+    std::cout << Num(std::round(units::MToMm(c.outline_rms) * 100.0) / 100.0) << " ± "
+              << mm(c.outline_rms_sd) << " RMS after each seed's best rotation ("
+              << mm(c.outline_rms_unrotated) << " as measured;";
+    for (const DrapeSeedComparison& s : c.per_seed)
+      std::cout << (&s == &c.per_seed.front() ? " seed " : ", seed ") << s.seed << ": "
+                << mm(s.outline.rms) << " turned " << Num(s.outline.rotation / kDegree, 4) << "°";
+    std::cout << ")";
+  } else {
+    std::cout << mm(c.outline_rms) << " RMS after turning the measured one by "
+              << Num(c.best_rotation / kDegree, 4) << "° (" << mm(c.outline_rms_unrotated)
+              << " as measured)";
+  }
+  std::cout << ": "
+            << (c.outline_judged ? "tolerance " + Num(units::MToMm(c.outline_tolerance), 3) +
+                                       " mm: " + ok(c.outline_ok)
+                                 : std::string("not judged (--outline-tol-mm)"))
+            << "\n  verdict: " << c.Verdict() << "\n";
+  for (const Note& n : c.notes) std::cout << "  note: " << n.text << "\n";
 }
 
 nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Material& m,
@@ -351,7 +466,7 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
 
 // The result as text on stdout (the JSON's figures, rounded for people).
 void PrintText(const DrapeResult& r, const DrapeOptions& o, const Material& m, const DrapeArgs& a,
-               const std::string& outline_path) {
+               const std::string& outline_path, const std::optional<DrapeComparison>& comparison) {
   const std::string note = JoinNoteTexts(r.notes, "; ");
   std::cout << "material: " << (m.name.empty() ? a.material : m.name) << "  [" << a.material << "]"
             << (m.compression_ratio < 1.0
@@ -401,7 +516,9 @@ void PrintText(const DrapeResult& r, const DrapeOptions& o, const Material& m, c
               << radius(r.max_radius, r.max_radius_sd);
   }
   if (!note.empty()) std::cout << "\nnote: " << note;
-  std::cout << "\ntime: " << Num(r.seconds, 3) << " s\nresult: " << a.out
+  std::cout << "\n";
+  if (comparison) PrintComparison(*comparison, a, r.per_seed.size() > 1);
+  std::cout << "time: " << Num(r.seconds, 3) << " s\nresult: " << a.out
             << "\noutline: " << outline_path << "\n";
   if (!a.png.empty()) std::cout << "shadow: " << a.png << "\n";
   if (!a.obj.empty()) std::cout << "mesh: " << a.obj << "\n";
@@ -417,13 +534,16 @@ void Run(const DrapeArgs& a) {
   // Check the outputs before reading or computing (an output must not be an input): distinct files
   // in usable folders. They appear together at the end, or none of them.
   const std::string outline_path = OutlinePath(a.out);
-  CheckDistinctOutputs({{"-o", a.out},
-                        {"the outline (next to -o)", outline_path},
-                        {"--png", a.png},
-                        {"--obj", a.obj},
-                        {"--ply", a.ply}},
-                       {{"--material", a.material}, {"--seam-file", a.seam_file}});
+  CheckDistinctOutputs(
+      {{"-o", a.out},
+       {"the outline (next to -o)", outline_path},
+       {"--png", a.png},
+       {"--obj", a.obj},
+       {"--ply", a.ply}},
+      {{"--material", a.material}, {"--seam-file", a.seam_file}, {"--compare", a.compare}});
+  const DrapeCompareOptions compare_options = CompareOptions(a);
   Material m = ReadMaterial(a.material);
+  const std::optional<MeasuredDrape> measured = ReadMeasured(a, o);
   if (a.compression_ratio) m.compression_ratio = *a.compression_ratio;
   ChooseDrapeRim(m, a.rim_mm == "auto",
                  a.extrapolate      ? DrapeExtrapolation::kOn
@@ -453,12 +573,22 @@ void Run(const DrapeArgs& a) {
   if (!r.converged)
     throw ComputeError("drape: not converged (" + r.message + "); no drape coefficient");
 
+  std::optional<DrapeComparison> comparison;
+  if (measured) {
+    comparison = CompareDrapes(r, *measured, compare_options);
+    if (a.strict && !comparison->pass)
+      throw ComputeError("drape: the comparison with " + a.compare +
+                         " failed (--strict): " + comparison->FailureReason());
+  }
+
   const DrapeSeedResult& first = r.per_seed.front();
   nlohmann::json j = ResultJson(r, o, m, a);
+  if (comparison) j["comparison"] = ComparisonJson(*comparison, a);
   j["outline_csv"] = outline_file.path();
-  outline_file.Write(OutlineCsv(first));
+  outline_file.Write(OutlineCsv(first.shadow));  // drape_measure.h: the shared columns
   if (png_file) {
-    if (!WriteDrapeShadowPng(r, first, o, png_file->temp_path()))
+    if (!(comparison ? WriteDrapeComparisonPng(r, *comparison, o, png_file->temp_path())
+                     : WriteDrapeShadowPng(r, first, o, png_file->temp_path())))
       throw InputError("--png: cannot write " + a.png);
     j["png"] = a.png;
   }
@@ -480,7 +610,7 @@ void Run(const DrapeArgs& a) {
     PrintJson(j);
     return;
   }
-  PrintText(r, o, m, a, outline_file.path());
+  PrintText(r, o, m, a, outline_file.path(), comparison);
 }
 
 }  // namespace
@@ -565,6 +695,21 @@ void RegisterDrape(CLI::App& app) {
       "--progress", a->progress,
       "Print the progress lines (the mesh, each seed's solves) on stderr even when it is not a "
       "terminal");
+  sub->add_option(
+      "--compare", a->compare,
+      "A measured drape (MEASURED.json from drape-measure) to compare with: DC, nodes, outline "
+      "RMS after the best rotation, a verdict; the --png overlays its outline (same specimen "
+      "and support radii only)");
+  sub->add_option("--dc-tol", a->dc_tol,
+                  "--compare: the largest |DC simulated - DC measured| that agrees (default 0.03)");
+  sub->add_option("--node-tol", a->node_tol,
+                  "--compare: the largest difference of the mean simulated node count from the "
+                  "measured one (default 1)");
+  sub->add_option("--outline-tol-mm", a->outline_tol_mm,
+                  "--compare: judge the outline too: the largest mean radius RMS after the best "
+                  "rotation [mm] (default: reported, not judged)");
+  sub->add_flag("--strict", a->strict,
+                "--compare: a failed verdict is an error (exit 3, nothing written)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   sub->callback([a] { Run(*a); });
 }

@@ -5,12 +5,14 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "run_cli.h"
+#include "textile/sim/scenes/drape_measure.h"
 
 namespace textile {
 namespace {
@@ -518,6 +520,132 @@ TEST(CliDrape, RefusesBadInput) {
   ExpectRefused(Textile("drape --material nope.json" + o), "nope.json", "missing material");
   ExpectRefused(Textile("drape " + kFig8 + " -o /nonexistent/dir/r.json"), "/nonexistent/dir", "bad output");
   EXPECT_FALSE(fs::exists(dir / "r.json"));
+}
+
+
+// A MEASURED.json made from a drape's own JSON (drape.json, its first seed) and outline CSV:
+// the outline turned clockwise by `turn_bins` 1° bins, the DC moved by `dc_shift`.
+std::string MeasuredFrom(const nlohmann::json& drape, const std::string& outline_csv, int turn_bins,
+                         double dc_shift, double specimen_mm = 150.0) {
+  std::vector<double> r_mm;
+  std::istringstream in(outline_csv);
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    const auto comma = line.find(',');
+    r_mm.push_back(std::stod(line.substr(comma + 1)));
+  }
+  const int bins = static_cast<int>(r_mm.size());
+  MeasuredDrape m;
+  m.source = "made by the test";
+  m.input_kind = "mesh";
+  m.specimen_radius = specimen_mm * 1e-3;
+  m.support_radius = 0.09;
+  m.drape_coefficient = drape["drape_coefficient"].get<double>() + dc_shift;
+  m.shadow.angles.resize(bins);
+  m.shadow.radii.resize(bins);
+  for (int b = 0; b < bins; ++b) {
+    m.shadow.angles(b) = (b + 0.5) * 2.0 * M_PI / bins;
+    m.shadow.radii(b) = 1e-3 * r_mm[(b + turn_bins) % bins];  // r_m(θ) = r_s(θ + turn)
+  }
+  for (const auto& node : drape["seeds"][0]["node_list"]) {
+    m.nodes.angles.push_back(node["angle_deg"].get<double>() * M_PI / 180.0);
+    m.nodes.radii.push_back(node["radius_mm"].get<double>() * 1e-3);
+    m.nodes.prominences.push_back(node["prominence_mm"].get<double>() * 1e-3);
+  }
+  m.min_radius = m.shadow.radii.minCoeff();
+  m.max_radius = m.shadow.radii.maxCoeff();
+  m.mean_radius = m.shadow.radii.mean();
+  return MeasuredDrapeJson(m);
+}
+
+void WriteFile(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+TEST(CliDrape, CompareWithAMeasuredDrapeReportsAVerdict) {
+  // The measured drape is this very simulation's, turned by 40° and 0.01 stiffer: the best
+  // rotation undoes the turn exactly (whole bins), the outline RMS is the CSV's round-off, the
+  // DCs are 0.01 apart, the nodes equal: pass. (Coarse and one seed: the same drape each run.)
+  const auto dir = Scratch("CliDrape.Compare");
+  const auto base = Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "self.json").string());
+  ASSERT_EQ(base.exit_code, 0) << base.err;
+  const auto self = nlohmann::json::parse(ReadAll(dir / "self.json"));
+  const std::string csv = ReadAll(dir / "self.outline.csv");
+  WriteFile(dir / "measured.json", MeasuredFrom(self, csv, 40, 0.01));
+  const auto r = Textile("drape " + kFig8 + kCoarse + " --compare " + (dir / "measured.json").string() +
+                         " -o " + (dir / "drape.json").string() + " --png " + (dir / "drape.png").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(ReadAll(dir / "drape.json"));
+  ASSERT_TRUE(j.contains("comparison")) << j.dump(2);
+  const auto& c = j["comparison"];
+  EXPECT_EQ(c["measured_file"], (dir / "measured.json").string());
+  EXPECT_EQ(c["measured_source"], "made by the test");
+  EXPECT_EQ(c["simulated_dc"], self["drape_coefficient"]);
+  EXPECT_NEAR(c["measured_dc"].get<double>(), self["drape_coefficient"].get<double>() + 0.01, 1e-12);
+  EXPECT_NEAR(c["dc_difference"].get<double>(), -0.01, 1e-9);
+  EXPECT_EQ(c["dc_tol"].get<double>(), 0.03);
+  EXPECT_TRUE(c["dc_ok"].get<bool>());
+  EXPECT_EQ(c["measured_nodes"].get<int>(), self["seeds"][0]["nodes"].get<int>());
+  EXPECT_TRUE(c["nodes_ok"].get<bool>());
+  EXPECT_NEAR(c["best_rotation_deg"].get<double>(), 40.0, 1e-6);
+  EXPECT_LT(c["outline_rms_mm"].get<double>(), 1e-6);
+  EXPECT_GT(c["outline_rms_unrotated_mm"].get<double>(), 1.0);
+  EXPECT_TRUE(c["outline_tol_mm"].is_null());
+  EXPECT_TRUE(c["outline_ok"].is_null());
+  // The same shadows over π R² (a 15 mm mesh's polygon: ~0.002 lower).
+  EXPECT_LT(c["simulated_dc_pi_r2"].get<double>(), c["simulated_dc"].get<double>());
+  EXPECT_GT(c["simulated_dc_pi_r2"].get<double>(), c["simulated_dc"].get<double>() - 0.004);
+  EXPECT_EQ(c["verdict"], "pass");
+  ASSERT_EQ(c["seeds"].size(), 1u);
+  EXPECT_EQ(c["notes"][0]["code"], "single_seed");
+  EXPECT_NE(r.out.find("compared with: " + (dir / "measured.json").string() + " (measured from made by the test)\n"),
+            std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  verdict: pass\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("after turning the measured one by 40°"), std::string::npos) << r.out;
+  EXPECT_GT(fs::file_size(dir / "drape.png"), 5000u);
+
+  // 0.05 stiffer, and the outline judged: a failed verdict is a result (exit 0) with its notes...
+  WriteFile(dir / "stiff.json", MeasuredFrom(self, csv, 0, 0.05));
+  const auto fail = Textile("drape " + kFig8 + kCoarse + " --compare " + (dir / "stiff.json").string() +
+                            " --outline-tol-mm 2 --dc-tol 0.04 -o " + (dir / "fail.json").string() + " --json");
+  ASSERT_EQ(fail.exit_code, 0) << fail.err;
+  const auto f = nlohmann::json::parse(fail.out)["comparison"];
+  EXPECT_EQ(f["verdict"], "fail");
+  EXPECT_FALSE(f["dc_ok"].get<bool>());
+  EXPECT_EQ(f["dc_tol"].get<double>(), 0.04);
+  EXPECT_TRUE(f["outline_ok"].get<bool>());
+  EXPECT_EQ(f["outline_tol_mm"].get<double>(), 2.0);
+  EXPECT_EQ(f["notes"][0]["code"], "dc_differs");
+  EXPECT_NE(f["notes"][0]["text"].get<std::string>().find("the simulation drapes more than measured"),
+            std::string::npos) << f.dump(2);
+  // ... and with --strict an error: exit 3, one line, nothing written.
+  const auto strict = Textile("drape " + kFig8 + kCoarse + " --compare " + (dir / "stiff.json").string() +
+                              " --strict -o " + (dir / "strict.json").string());
+  EXPECT_EQ(strict.exit_code, 3) << strict.err;
+  EXPECT_NE(LastError(strict.err).find("failed (--strict): the simulation drapes more than measured"),
+            std::string::npos) << strict.err;
+  EXPECT_EQ(strict.err.find("one seed"), std::string::npos) << strict.err;  // the failures only
+  EXPECT_FALSE(fs::exists(dir / "strict.json"));
+  EXPECT_FALSE(fs::exists(dir / "strict.outline.csv"));
+}
+
+TEST(CliDrape, CompareRefusesAnotherTestBeforeSimulating) {
+  // A measured drape of a 140 mm specimen: refused with both radii, before the mesh is made.
+  const auto dir = Scratch("CliDrape.CompareRadius");
+  std::string csv = "theta_deg,r_mm,x_mm,y_mm\n";
+  for (int b = 0; b < 360; ++b) csv += std::to_string(b + 0.5) + ",140,0,0\n";
+  const auto drape = nlohmann::json::parse(R"({"drape_coefficient": 0.6, "seeds": [{"node_list": []}]})");
+  WriteFile(dir / "other.json", MeasuredFrom(drape, csv, 0, 0.0, 160.0));
+  const auto r = Textile("drape " + kFig8 + kCoarse + " --compare " + (dir / "other.json").string() +
+                         " -o " + (dir / "d.json").string() + " --progress");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(LastError(r.err).find(": measured with a 160 mm specimen on a 90 mm support; the "
+                                  "simulation's is 150 mm on 90 mm"),
+            std::string::npos) << r.err;
+  EXPECT_EQ(MeshVertices(r.err), 0) << r.err;  // no work done
+  EXPECT_FALSE(fs::exists(dir / "d.json"));
 }
 
 }  // namespace

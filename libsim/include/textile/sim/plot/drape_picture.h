@@ -3,14 +3,17 @@
 
 // The drapemeter's photo (target textile::plot, drawn with Cairo): one seed's shadow seen from
 // above, the support's and the flat specimen's circles, the seams as they lie on the draped
-// cloth and the nodes, with a caption.
+// cloth and the nodes, with a caption; with a comparison, the measured outline over it.
 //
 //   const textile::DrapeResult r = textile::SimulateDrape(material, options);
 //   if (!textile::WriteDrapeShadowPng(r, r.per_seed.front(), options, "shadow.png")) ...
+//   const textile::DrapeComparison c = textile::CompareDrapes(r, measured, {});
+//   if (!textile::WriteDrapeComparisonPng(r, c, options, "compare.png")) ...
 
 #include <string>
 
 #include "textile/sim/scenes/drape.h"
+#include "textile/sim/scenes/drape_compare.h"
 
 namespace textile {
 
@@ -19,6 +22,13 @@ namespace textile {
 // the file cannot be written.
 bool WriteDrapeShadowPng(const DrapeResult& result, const DrapeSeedResult& seed,
                          const DrapeOptions& options, const std::string& file);
+
+// The picture of the first seed (as above) with the measured outline of `comparison` (of
+// `result`) drawn over it as a dashed magenta line, turned by that seed's best rotation so that
+// the folds can be compared, a legend (simulated and measured DC, the rotation, the outline
+// RMS) and the verdict in the caption. False when the file cannot be written.
+bool WriteDrapeComparisonPng(const DrapeResult& result, const DrapeComparison& comparison,
+                             const DrapeOptions& options, const std::string& file);
 
 }  // namespace textile
 

@@ -250,6 +250,23 @@ TEST(DrapePhoto, VerticalShadowWithAScaleMeasuresTheTruthDc) {
   EXPECT_EQ(overlay.size(), r.photo.size());
 }
 
+TEST(DrapePhoto, SpecksBesideTheShadowAndColourChangeNothing) {
+  RenderShadowOptions o = SmallPhoto();
+  o.tilt_deg = 5, o.gradient = 0.2, o.seed = 8;
+  const RenderedShadow r = Render(o);
+  const MeasuredDrape clean = MeasureDrapePhoto(r.photo, r.rig, DrapePhotoOptions{}, "c.png");
+  cv::Mat dirty;
+  cv::cvtColor(r.photo, dirty, cv::COLOR_GRAY2BGR);
+  cv::rectangle(dirty, cv::Rect(30, 30, 25, 25), cv::Scalar(20, 20, 20), cv::FILLED);  // a coin
+  cv::RNG rng(5);
+  for (int k = 0; k < 40; ++k)  // dust
+    cv::circle(dirty, cv::Point(rng.uniform(0, 1200), rng.uniform(0, 60)), 2, cv::Scalar(30, 30, 30),
+               cv::FILLED);
+  const MeasuredDrape m = MeasureDrapePhoto(dirty, r.rig, DrapePhotoOptions{}, "d.png");
+  EXPECT_NEAR(m.drape_coefficient, clean.drape_coefficient, 1e-4);
+  EXPECT_EQ(m.nodes.angles.size(), clean.nodes.angles.size());
+}
+
 TEST(DrapePhoto, TiltedPhotosWithTheTrueRigMeasureTheTruthDc) {
   for (const Case c :
        {Case{10.0, ShadowStyle::kShadow, 0.0}, Case{7.0, ShadowStyle::kTop, -0.08}}) {

@@ -119,6 +119,32 @@ TEST(DrapePhotoStages, FitIlluminationRecoversASmoothLight) {
     EXPECT_NEAR(fit.At(u, v) / light(u, v), 1.0, 0.006) << u << ", " << v;
 }
 
+TEST(DrapePhotoStages, SeparateShadowFlattensAStrongGradient) {
+  // Light falling by half from left to right, with vignetting; a dark disk in the middle.
+  const int W = 1600, H = 1000;
+  cv::Mat photo(H, W, CV_8UC1);
+  for (int v = 0; v < H; ++v)
+    for (int u = 0; u < W; ++u) {
+      const double r2 =
+          (std::pow(u - 800.0, 2) + std::pow(v - 500.0, 2)) / (800.0 * 800 + 500 * 500);
+      const double light = 230.0 * (1.0 - 0.5 * u / (W - 1.0)) * (1.0 - 0.2 * r2);
+      const bool dark = std::hypot(u - 800.0, v - 500.0) < 300;
+      photo.at<uchar>(v, u) = cv::saturate_cast<uchar>(light * (dark ? 0.15 : 1.0));
+    }
+  const Reduced reduced = Reduce(photo);
+  const Separation s = SeparateShadow(reduced, W, H, "g.png");
+  EXPECT_TRUE(s.levels.shadow_darker);
+  EXPECT_NEAR(s.levels.background, 1.0, 0.02);
+  EXPECT_NEAR(s.levels.shadow, 0.15, 0.02);
+  // The paper at the darkest corner and beside the disk flattens to 1.
+  EXPECT_NEAR(s.flat.at<float>(reduced.grey.rows - 1, reduced.grey.cols - 1), 1.0, 0.02);
+  EXPECT_NEAR(s.flat.at<float>(250 / reduced.factor, 1150 / reduced.factor), 1.0, 0.02);
+  // The light's fit used no pixel of the disk or its edge.
+  const cv::Mat background = BackgroundMask(s.flat, s.levels);
+  EXPECT_EQ(background.at<uchar>(500 / reduced.factor, 1095 / reduced.factor), 0);
+  EXPECT_EQ(background.at<uchar>(500 / reduced.factor, 1120 / reduced.factor), 255);
+}
+
 TEST(DrapePhotoStages, SeparateLevelsFindsBothPolarities) {
   const cv::Mat dark_on_light = Disks({200, 150}, {{{100, 75}, 40}});
   cv::Mat flat;
@@ -248,6 +274,15 @@ TEST(DrapePhoto, VerticalShadowWithAScaleMeasuresTheTruthDc) {
   EXPECT_LT((m.centre * 1e3 - r.centre_px * o.mm_per_px).norm(), 0.5);
   EXPECT_EQ(overlay.type(), CV_8UC3);
   EXPECT_EQ(overlay.size(), r.photo.size());
+  // The nodes are drawn in red where the rig puts them (the scale rig: mm / 0.34 px).
+  const Eigen::Vector2d node = (m.centre * 1e3 + 1e3 * m.nodes.radii[0] *
+                                                     Eigen::Vector2d(std::cos(m.nodes.angles[0]),
+                                                                     std::sin(m.nodes.angles[0]))) /
+                               o.mm_per_px;
+  const cv::Vec3b red = overlay.at<cv::Vec3b>(static_cast<int>(std::lround(node.y())),
+                                              static_cast<int>(std::lround(node.x())));
+  EXPECT_GT(red[2], 200);
+  EXPECT_LT(red[1], 60);
 }
 
 TEST(DrapePhoto, SpecksBesideTheShadowAndColourChangeNothing) {
@@ -260,8 +295,8 @@ TEST(DrapePhoto, SpecksBesideTheShadowAndColourChangeNothing) {
   cv::rectangle(dirty, cv::Rect(30, 30, 25, 25), cv::Scalar(20, 20, 20), cv::FILLED);  // a coin
   cv::RNG rng(5);
   for (int k = 0; k < 40; ++k)  // dust
-    cv::circle(dirty, cv::Point(rng.uniform(0, 1200), rng.uniform(0, 60)), 2, cv::Scalar(30, 30, 30),
-               cv::FILLED);
+    cv::circle(dirty, cv::Point(rng.uniform(0, 1200), rng.uniform(0, 60)), 2,
+               cv::Scalar(30, 30, 30), cv::FILLED);
   const MeasuredDrape m = MeasureDrapePhoto(dirty, r.rig, DrapePhotoOptions{}, "d.png");
   EXPECT_NEAR(m.drape_coefficient, clean.drape_coefficient, 1e-4);
   EXPECT_EQ(m.nodes.angles.size(), clean.nodes.angles.size());

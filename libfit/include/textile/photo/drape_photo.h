@@ -22,11 +22,17 @@ namespace textile {
 
 struct DrapePhotoOptions {
   DrapeMeasureOptions measure;
-  // The support's centre in the photo [px]; found from the shadow when not given.
+  // The support's centre in the photo [px]; when not given, the rectified shadow's area
+  // centroid (centre_from "shadow"), which a lopsided outline pulls off the support's centre by
+  // about its first harmonic (3.5 mm on the Fig. 8 drape; the DC does not depend on it;
+  // docs/methods/drape-photos.md, "The centre").
   std::optional<Eigen::Vector2d> centre_px;
 };
 
-// Measures the one shadow of `photo` (CV_8UC1 or CV_8UC3). Throws InputError for a photo the rig
+// Measures the one shadow of `photo` (CV_8UC1, CV_8UC3 or CV_8UC4), dark on light or light
+// on dark (found), in stages (drape_photo_stages.h): grey, the light flattened, two levels,
+// the one shadow, not cut, rectified to the paper through the rig at the measurement's cell,
+// the centre, MeasureDrapeShadow (input_kind "photo"). Throws InputError for a photo the rig
 // cannot map, ComputeError "<source>: <why>" for a photo with no shadow, two shadows, a shadow
 // cut by the border, or an outline that is not a closed curve around the support. With
 // `overlay`, it receives the photo (BGR) with the outline, the centre and the nodes drawn on it.

@@ -29,9 +29,8 @@ constexpr double kTargetSeconds = 0.5;
 // 90 mm support, its rim at r(θ) = 120 + 15 cos 6θ mm.
 TriangleMesh ScanLikeDrape(bool quick) {
   const int rings = quick ? 100 : 250, sectors = quick ? 500 : 1000;  // 99.5k / 499k triangles
-  return SyntheticDrapeMesh(0.15, 0.09, rings, sectors, [](double t) {
-    return 0.12 + 0.015 * std::cos(6.0 * t);
-  });
+  return SyntheticDrapeMesh(0.15, 0.09, rings, sectors,
+                            [](double t) { return 0.12 + 0.015 * std::cos(6.0 * t); });
 }
 
 double Seconds(std::chrono::steady_clock::time_point from) {
@@ -45,8 +44,8 @@ Benchmark DrapeMeasureMeshBenchmark() {
           "drape-measure of a ~500k-triangle draped mesh: read + measure per format (target 0.5 s)",
           [](const Context& ctx) {
             Result res;
-            res.columns = {"format", "triangles", "file_mb", "read_s", "measure_s", "total_s",
-                           "drape_coefficient", "nodes", "target_s", "met"};
+            res.columns = {"format",  "triangles",         "file_mb", "read_s",   "measure_s",
+                           "total_s", "drape_coefficient", "nodes",   "target_s", "met"};
             const TriangleMesh mesh = ScanLikeDrape(ctx.quick);
             EnsureDirectory(ctx.out_dir);
             const std::string dir = ctx.out_dir + "/drape-measure-mesh-files";
@@ -92,8 +91,8 @@ Benchmark DrapeMeasureMeshBenchmark() {
             std::ostringstream sum;
             char line[200];
             std::snprintf(line, sizeof line, "%-11s %9s %8s %8s %9s %8s %7s %5s %4s\n", "format",
-                          "triangles", "file_MB", "read_s", "measure_s", "total_s", "DC",
-                          "nodes", "met");
+                          "triangles", "file_MB", "read_s", "measure_s", "total_s", "DC", "nodes",
+                          "met");
             sum << line;
             for (const auto& r : res.rows) {
               std::snprintf(line, sizeof line, "%-11s %9d %8.1f %8.3f %9.3f %8.3f %7.4f %5d %4s\n",

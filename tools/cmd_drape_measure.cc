@@ -33,9 +33,9 @@ constexpr double kDegree = std::numbers::pi / 180.0;
 struct DrapeMeasureArgs {
   std::string input, out, png;
   double specimen_mm = 150.0, support_mm = 90.0;
-  std::string units, up, centre_mm;            // meshes (empty: not given)
-  std::string rig, centre_px;                  // photos
-  std::optional<double> mm_per_px;             // photos
+  std::string units, up, centre_mm;  // meshes (empty: not given)
+  std::string rig, centre_px;        // photos
+  std::optional<double> mm_per_px;   // photos
   bool json = false;
 };
 
@@ -48,8 +48,9 @@ InputKind KindOf(const std::string& path) {
   if (ext == ".obj" || ext == ".ply") return InputKind::kMesh;
   for (const char* e : {".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp"})
     if (ext == e) return InputKind::kPhoto;
-  throw InputError(path + ": name the input .obj or .ply (a draped mesh) or .png, .jpg, .tif or "
-                          ".bmp (a shadow photo)");
+  throw InputError(path +
+                   ": name the input .obj or .ply (a draped mesh) or .png, .jpg, .tif or "
+                   ".bmp (a shadow photo)");
 }
 
 // "X,Y" as two finite numbers; throws InputError naming the flag.
@@ -57,8 +58,8 @@ Eigen::Vector2d ParsePair(const std::string& flag, const std::string& text, cons
   const std::size_t comma = text.find(',');
   Eigen::Vector2d p;
   for (int k = 0; k < 2; ++k) {
-    const std::string s = k == 0 ? text.substr(0, comma)
-                                 : (comma == std::string::npos ? "" : text.substr(comma + 1));
+    const std::string s =
+        k == 0 ? text.substr(0, comma) : (comma == std::string::npos ? "" : text.substr(comma + 1));
     char* end = nullptr;
     p[k] = std::strtod(s.c_str(), &end);
     if (comma == std::string::npos || s.empty() || *end != '\0' || !std::isfinite(p[k]))
@@ -107,7 +108,8 @@ void CheckFlagsFor(InputKind kind, const DrapeMeasureArgs& a) {
 DrapeMeshOptions MeshOptions(const DrapeMeasureArgs& a) {
   DrapeMeshOptions o;
   o.measure = MeasureOptions(a);
-  if (a.units == "mm") o.metres_per_unit = 0.001;
+  if (a.units == "mm")
+    o.metres_per_unit = 0.001;
   else if (!a.units.empty() && a.units != "m")
     throw InputError("--units: '" + a.units + "' is not m or mm");
   if (!a.up.empty()) {
@@ -122,8 +124,8 @@ DrapeMeshOptions MeshOptions(const DrapeMeasureArgs& a) {
 }
 
 std::string CentreText(const MeasuredDrape& m) {
-  const std::string at = "(" + Num(units::MToMm(m.centre.x()), 4) + ", " +
-                         Num(units::MToMm(m.centre.y()), 4) + ") mm";
+  const std::string at =
+      "(" + Num(units::MToMm(m.centre.x()), 4) + ", " + Num(units::MToMm(m.centre.y()), 4) + ") mm";
   if (m.centre_from == "origin") return at + ", the mesh's origin (its flat top is centred there)";
   if (m.centre_from == "plateau") return at + ", the centroid of the mesh's flat top";
   if (m.centre_from == "given") return at + ", given";
@@ -143,8 +145,8 @@ void PrintText(const MeasuredDrape& m, const std::string& input_facts, const Dra
               << Num(units::MToMm(m.nodes.radii[k]), 4) << " mm, prominence "
               << Num(units::MToMm(m.nodes.prominences[k]), 3) << " mm\n";
   std::cout << "outline radius [mm]: min " << Num(units::MToMm(m.min_radius), 4) << ", mean "
-            << Num(units::MToMm(m.mean_radius), 4) << ", max "
-            << Num(units::MToMm(m.max_radius), 4) << "\n"
+            << Num(units::MToMm(m.mean_radius), 4) << ", max " << Num(units::MToMm(m.max_radius), 4)
+            << "\n"
             << "centre: " << CentreText(m) << "\n";
   if (!m.notes.empty()) std::cout << "note: " << JoinNoteTexts(m.notes, "; ") << "\n";
   std::cout << "result: " << a.out << "\noutline: " << outline_path << "\n";
@@ -188,8 +190,9 @@ void Run(const DrapeMeasureArgs& a) {
   const InputKind kind = KindOf(a.input);
   CheckFlagsFor(kind, a);
   const std::string outline_path = OutlinePath(a.out);
-  CheckDistinctOutputs({{"-o", a.out}, {"the outline (next to -o)", outline_path}, {"--png", a.png}},
-                       {{"INPUT", a.input}, {"--rig", a.rig}});
+  CheckDistinctOutputs(
+      {{"-o", a.out}, {"the outline (next to -o)", outline_path}, {"--png", a.png}},
+      {{"INPUT", a.input}, {"--rig", a.rig}});
   if (!a.png.empty()) CheckOutputExtension("--png", a.png, {".png"});
   AtomicFileSet outputs;
   AtomicFile& result_file = outputs.Add(a.out);
@@ -241,7 +244,8 @@ void RegisterDrapeMeasure(CLI::App& app) {
   sub->add_option("--centre-mm", a->centre_mm,
                   "Mesh: the support's centre X,Y in the horizontal plane [mm] (default: found "
                   "from the mesh's flat top)");
-  sub->add_option("--mm-per-px", a->mm_per_px, "Photo: the scale of a photo taken square on [mm/px]");
+  sub->add_option("--mm-per-px", a->mm_per_px,
+                  "Photo: the scale of a photo taken square on [mm/px]");
   sub->add_option("--rig", a->rig, "Photo: a rig JSON (from calibrate) instead of --mm-per-px");
   sub->add_option("--centre-px", a->centre_px,
                   "Photo: the support's centre X,Y in the photo [px] (default: found)");

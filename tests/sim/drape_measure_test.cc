@@ -130,6 +130,17 @@ TEST(DrapeMeasureMesh, YUpAndMillimetresMeasureTheSame) {
             std::string::npos);
 }
 
+TEST(DrapeMeasureMesh, StrayPointsWithoutFacesChangeNothing) {
+  const TriangleMesh clean = Drape(SixLobes());
+  TriangleMesh stray = clean;
+  stray.vertices.conservativeResize(clean.num_vertices() + 2, 3);
+  stray.vertices.row(clean.num_vertices()) << 0.3, -0.2, 0.05;  // above the top, far out
+  stray.vertices.row(clean.num_vertices() + 1) << -5.0, 0.0, -1.0;
+  const MeasuredDrape a = MeasureDrapeMesh(clean, {}, "a"), b = MeasureDrapeMesh(stray, {}, "b");
+  EXPECT_EQ(a.drape_coefficient, b.drape_coefficient);
+  EXPECT_EQ(b.centre_from, "origin");
+}
+
 TEST(DrapeMeasureMesh, GivenCentreIsUsed) {
   TriangleMesh moved = Drape(SixLobes());
   moved.vertices.col(0).array() += 0.02;
@@ -143,12 +154,15 @@ TEST(DrapeMeasureMesh, GivenCentreIsUsed) {
 TEST(DrapeMeasureMesh, RefusesBadMeshes) {
   TriangleMesh none = Drape(SixLobes());
   none.triangles.resize(0, 3);
-  EXPECT_NE(ErrorOf([&] { MeasureDrapeMesh(none, {}, "none.obj"); }).find("none.obj: the mesh has no faces"),
+  EXPECT_NE(ErrorOf([&] {
+              MeasureDrapeMesh(none, {}, "none.obj");
+            }).find("none.obj: the mesh has no faces"),
             std::string::npos);
   TriangleMesh nan = Drape(SixLobes());
   nan.vertices(7, 1) = std::nan("");
   EXPECT_TRUE(Throws<InputError>([&] { MeasureDrapeMesh(nan, {}, "nan.obj"); }));
-  EXPECT_NE(ErrorOf([&] { MeasureDrapeMesh(nan, {}, "nan.obj"); }).find("vertex 7"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { MeasureDrapeMesh(nan, {}, "nan.obj"); }).find("vertex 7"),
+            std::string::npos);
   TriangleMesh bad_index = Drape(SixLobes());
   bad_index.triangles(3, 2) = bad_index.num_vertices();
   EXPECT_NE(ErrorOf([&] { MeasureDrapeMesh(bad_index, {}, "i.obj"); }).find("out of range"),
@@ -173,9 +187,10 @@ TEST(DrapeMeasureMesh, RefusesHalfADiskAndATiltedMesh) {
   Triangles kept(half.num_triangles(), 3);
   int n = 0;
   for (int t = 0; t < half.num_triangles(); ++t) {
-    const Eigen::RowVector3d c = (half.vertices.row(half.triangles(t, 0)) +
-                                  half.vertices.row(half.triangles(t, 1)) +
-                                  half.vertices.row(half.triangles(t, 2))) / 3.0;
+    const Eigen::RowVector3d c =
+        (half.vertices.row(half.triangles(t, 0)) + half.vertices.row(half.triangles(t, 1)) +
+         half.vertices.row(half.triangles(t, 2))) /
+        3.0;
     if (c.y() > 0.0) kept.row(n++) = half.triangles.row(t);
   }
   half.triangles = kept.topRows(n);
@@ -203,7 +218,8 @@ TEST(DrapeMeasureMesh, RefusesHalfADiskAndATiltedMesh) {
   strict.plateau_tolerance = 0.005;
   const std::string slope = ErrorOf([&] { MeasureDrapeMesh(tilted, strict, "tilted.obj"); });
   EXPECT_TRUE(slope.find("slopes by") != std::string::npos ||
-              slope.find("no flat top") != std::string::npos) << slope;
+              slope.find("no flat top") != std::string::npos)
+      << slope;
 }
 
 TEST(DrapeMeasureMesh, PlateauCentreFollowsAreaNotVertexDensity) {

@@ -31,9 +31,11 @@ double AngleApart(double a_deg, double b_deg) {
 
 TEST(CliDrapeMeasure, RoundTripFromDrapeObjAndPly) {
   const auto dir = Scratch("CliDrapeMeasure.RoundTrip");
-  const auto d = Textile("drape --material samples/materials/pabst-fig8.json --resolution-mm 15 "
-                         "--rim-mm 0 -o " + (dir / "d.json").string() + " --obj " +
-                         (dir / "d.obj").string() + " --ply " + (dir / "d.ply").string());
+  const auto d = Textile(
+      "drape --material samples/materials/pabst-fig8.json --resolution-mm 15 "
+      "--rim-mm 0 -o " +
+      (dir / "d.json").string() + " --obj " + (dir / "d.obj").string() + " --ply " +
+      (dir / "d.ply").string());
   ASSERT_EQ(d.exit_code, 0) << d.err;
   const auto drape = nlohmann::json::parse(ReadAll(dir / "d.json"));
   const auto m = Textile("drape-measure " + (dir / "d.obj").string() + " -o " +
@@ -46,7 +48,8 @@ TEST(CliDrapeMeasure, RoundTripFromDrapeObjAndPly) {
   // The same raster (the mesh is centred: the centre is its origin, as the drape's), so the
   // whole difference is the definition: A_specimen = π R² here, the meshed pattern's area there.
   EXPECT_EQ(measured["centre_from"], "origin");
-  const double support = drape["scene"]["support_area_mm2"], pattern = drape["scene"]["specimen_area_mm2"];
+  const double support = drape["scene"]["support_area_mm2"],
+               pattern = drape["scene"]["specimen_area_mm2"];
   const double circle = kPi * 150.0 * 150.0;
   EXPECT_NEAR(dc, dc_drape * (pattern - support) / (circle - support), 1e-9);
   EXPECT_NEAR(measured["shadow_area_mm2"].get<double>(),
@@ -80,9 +83,8 @@ TEST(CliDrapeMeasure, RoundTripFromDrapeObjAndPly) {
 
 TEST(CliDrapeMeasure, ScanInMillimetresYUpAndMovedMeasuresTheSame) {
   const auto dir = Scratch("CliDrapeMeasure.Scan");
-  const TriangleMesh drape = SyntheticDrapeMesh(0.15, 0.09, 30, 360, [](double t) {
-    return 0.12 + 0.015 * std::cos(7.0 * t);
-  });
+  const TriangleMesh drape = SyntheticDrapeMesh(
+      0.15, 0.09, 30, 360, [](double t) { return 0.12 + 0.015 * std::cos(7.0 * t); });
   // The scan: millimetres, y up ((X, Y, H) → (X, H, −Y)), moved by (37, −12) mm, binary PLY.
   TriangleMesh scan = drape;
   for (int v = 0; v < scan.num_vertices(); ++v) {
@@ -93,8 +95,8 @@ TEST(CliDrapeMeasure, ScanInMillimetresYUpAndMovedMeasuresTheSame) {
   std::ofstream(dir / "scan.ply", std::ios::binary) << PlyBinaryBytes(scan);
   const auto a = Textile("drape-measure " + (dir / "drape.obj").string() + " -o " +
                          (dir / "a.json").string() + " --json");
-  const auto b = Textile("drape-measure " + (dir / "scan.ply").string() +
-                         " --units mm --up y -o " + (dir / "b.json").string() + " --json");
+  const auto b = Textile("drape-measure " + (dir / "scan.ply").string() + " --units mm --up y -o " +
+                         (dir / "b.json").string() + " --json");
   ASSERT_EQ(a.exit_code, 0) << a.err;
   ASSERT_EQ(b.exit_code, 0) << b.err;
   const auto ja = nlohmann::json::parse(a.out), jb = nlohmann::json::parse(b.out);
@@ -106,7 +108,8 @@ TEST(CliDrapeMeasure, ScanInMillimetresYUpAndMovedMeasuresTheSame) {
   ASSERT_EQ(jb["nodes"], 7);
   for (size_t k = 0; k < 7; ++k)
     EXPECT_NEAR(ja["node_list"][k]["radius_mm"].get<double>(),
-                jb["node_list"][k]["radius_mm"].get<double>(), 0.5) << k;
+                jb["node_list"][k]["radius_mm"].get<double>(), 0.5)
+        << k;
 }
 
 }  // namespace

@@ -409,7 +409,7 @@ class PlyAsciiReader {
  public:
   PlyAsciiReader(std::string_view body, int first_line, const std::string& source)
       : text_(body), line_(first_line), source_(source) {}
-  double Read(PlyType) {
+  double Read(PlyType type) {
     while (at_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[at_]))) {
       if (text_[at_] == '\n') ++line_;
       ++at_;
@@ -419,6 +419,11 @@ class PlyAsciiReader {
     while (end < text_.size() && !std::isspace(static_cast<unsigned char>(text_[end]))) ++end;
     const std::string_view word = text_.substr(at_, end - at_);
     at_ = end;
+    // Whole numbers (counts, indices) parse faster as integers; "1.0" for an int falls through.
+    if (type != PlyType::kFloat32 && type != PlyType::kFloat64) {
+      long i;
+      if (ParseWhole(word, &i)) return static_cast<double>(i);
+    }
     double v;
     if (!ParseWhole(word, &v)) Fail("bad number \"" + std::string(word) + "\"");
     return v;
@@ -426,7 +431,9 @@ class PlyAsciiReader {
   [[noreturn]] void Fail(const std::string& what) const {
     throw InputError(source_ + ":" + std::to_string(line_) + ": " + what);
   }
-  std::string Where() const { return source_ + ":" + std::to_string(line_); }
+  // Where a problem found later is: "<source>:<line>" of a line recorded by Line().
+  std::string Where(int line) const { return source_ + ":" + std::to_string(line); }
+  int Line() const { return line_; }
 
  private:
   std::string_view text_;
@@ -459,7 +466,8 @@ class PlyBinaryReader {
     return 0.0;
   }
   [[noreturn]] void Fail(const std::string& what) const { throw InputError(source_ + ": " + what); }
-  std::string Where() const { return source_; }
+  std::string Where(int) const { return source_; }
+  int Line() const { return 0; }
 
  private:
   template <typename T>
@@ -487,7 +495,9 @@ template <typename Reader>
 TriangleMesh ReadPlyBody(const PlyHeader& h, Reader& in, const std::string& source) {
   std::vector<double> xyz;
   std::vector<std::array<double, 3>> faces;
-  std::vector<std::string> face_where;  // for an index found out of range after the vertices
+  // Where each triangle's face was (line, face number), for an index found out of range once
+  // every vertex is known.
+  std::vector<std::pair<int, std::size_t>> face_where;
   bool vertices_seen = false, faces_seen = false;
   std::vector<double> corners;
   for (const PlyElement& e : h.elements) {
@@ -542,7 +552,7 @@ TriangleMesh ReadPlyBody(const PlyHeader& h, Reader& in, const std::string& sour
                   " vertices; faces need 3 or more");
         Fan(corners, [&](double a, double b, double c) {
           faces.push_back({a, b, c});
-          face_where.push_back(in.Where() + ": face " + std::to_string(n));
+          face_where.push_back({in.Line(), n});
         });
       }
       if (is_vertex) xyz.insert(xyz.end(), p, p + 3);
@@ -556,7 +566,9 @@ TriangleMesh ReadPlyBody(const PlyHeader& h, Reader& in, const std::string& sour
   for (std::size_t f = 0; f < faces.size(); ++f)
     for (int c = 0; c < 3; ++c) {
       if (faces[f][c] >= static_cast<double>(nv))
-        throw InputError(face_where[f] + ": vertex index " + NumberText(faces[f][c]) +
+        throw InputError(in.Where(face_where[f].first) + ": face " +
+                         std::to_string(face_where[f].second) + ": vertex index " +
+                         NumberText(faces[f][c]) +
                          " is out of range (" + std::to_string(nv) + " vertices)");
       mesh.triangles(static_cast<Eigen::Index>(f), c) = static_cast<int>(faces[f][c]);
     }

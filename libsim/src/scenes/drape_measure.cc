@@ -287,8 +287,8 @@ MeshSupportCentre FindMeshSupportCentre(const Vertices& f, const Triangles& tria
   if (c.plateau_area < 0.5 * support_area)
     throw InputError(source + ": no flat top the size of the support: the faces within " +
                      Mm(o.plateau_tolerance) + " of the highest point cover " +
-                     NumberText(c.plateau_area * 1e6, 4) + " mm², under half the support's " +
-                     NumberText(support_area * 1e6, 4) + " mm²" + settle);
+                     NumberText(c.plateau_area * 1e6, 5) + " mm², under half the support's " +
+                     NumberText(support_area * 1e6, 5) + " mm²" + settle);
   c.tilt = PlateauTilt(f, top_vertices);
   if (c.tilt > o.max_tilt)
     throw InputError(source + ": the mesh's flat top slopes by " + NumberText(c.tilt / kDegree, 3) +
@@ -355,9 +355,39 @@ DrapeShadow RasteriseFabric(const Vertices& f, const Triangles& triangles,
   return s;
 }
 
-MeasuredDrape MeasureDrapeMesh(const TriangleMesh& draped, const DrapeMeshOptions& o,
+namespace {
+
+// The vertices some face uses, the faces renumbered: a scan's stray points (no face) cast no
+// shadow and must not set the span, the top or the grid.
+TriangleMesh UsedPart(const TriangleMesh& mesh) {
+  std::vector<int> id(static_cast<size_t>(mesh.num_vertices()), -1);
+  int used = 0;
+  for (int t = 0; t < mesh.num_triangles(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const int v = mesh.triangles(t, c);
+      if (v >= 0 && v < mesh.num_vertices() && id[v] < 0) id[v] = used++;
+    }
+  if (used == mesh.num_vertices()) return mesh;
+  TriangleMesh part;
+  part.vertices.resize(used, 3);
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    if (id[v] >= 0) part.vertices.row(id[v]) = mesh.vertices.row(v);
+  part.triangles.resize(mesh.num_triangles(), 3);
+  for (int t = 0; t < mesh.num_triangles(); ++t)
+    for (int c = 0; c < 3; ++c) part.triangles(t, c) = id[mesh.triangles(t, c)];
+  return part;
+}
+
+}  // namespace
+
+MeasuredDrape MeasureDrapeMesh(const TriangleMesh& input, const DrapeMeshOptions& o,
                                const std::string& source) {
   if (std::string why; !o.Check(&why)) throw InputError(source + ": " + why);
+  if (input.num_triangles() > 0 &&
+      (input.triangles.minCoeff() < 0 || input.triangles.maxCoeff() >= input.num_vertices()))
+    throw InputError(source + ": a face's vertex index is out of range (" +
+                     std::to_string(input.num_vertices()) + " vertices)");
+  const TriangleMesh draped = UsedPart(input);
   const Vertices frame = MeshInMeasureFrame(draped, o, source);
   CheckMeshScale(frame, o, source);
   const MeshSupportCentre c = FindMeshSupportCentre(frame, draped.triangles, o, source);

@@ -19,6 +19,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -94,7 +95,7 @@ struct DrapeMeshOptions {
   // the first millimetre of the overhang's turn-down lie within it).
   double plateau_tolerance = 0.001;
   // The flat top's least-squares plane may slope by at most this [rad].
-  double max_tilt = 2.0 * 3.14159265358979323846 / 180.0;
+  double max_tilt = std::numbers::pi / 90.0;  // 2°
 
   // False with "<field>: <problem>" when a field is out of range (measure's fields too).
   bool Check(std::string* why) const;
@@ -136,7 +137,8 @@ MeshSupportCentre FindMeshSupportCentre(const Vertices& frame, const Triangles& 
 DrapeShadow RasteriseFabric(const Vertices& frame, const Triangles& triangles,
                             const Eigen::Vector2d& centre, double cell, double support_radius);
 
-// A draped mesh measured as the drapemeter measures a simulated one: stages 1-4, then
+// A draped mesh measured as the drapemeter measures a simulated one: vertices no face uses
+// dropped (a scan's stray points), stages 1-4, then
 // MeasureDrapeShadow (input_kind "mesh"; centre and centre_from from stage 3). Throws as the
 // stages and MeasureDrapeShadow do (InputError for bad input, ComputeError for an outline that
 // is not a closed curve around the support).

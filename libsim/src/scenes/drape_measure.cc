@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cmath>
 #include <Eigen/Cholesky>
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <sstream>
@@ -236,26 +237,70 @@ void CheckMeshScale(const Vertices& f, const DrapeMeshOptions& o, const std::str
 
 namespace {
 
-// The flat top's plane h = a x + b y + c by least squares over its vertices; the slope
-// atan(|(a, b)|) [rad].
-double PlateauTilt(const Vertices& f, const std::vector<int>& top) {
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (int v : top) mean += f.row(v).transpose();
-  mean /= static_cast<double>(top.size());
+// The vertices within `tolerance` of the highest one.
+std::vector<int> TopVertices(const Vertices& f, double tolerance) {
+  const double level = f.col(2).maxCoeff() - tolerance;
+  std::vector<int> top;
+  for (int v = 0; v < f.rows(); ++v)
+    if (f(v, 2) >= level) top.push_back(v);
+  return top;
+}
+
+// The plane h = a x + b y + c through `top` by least squares: its upward unit normal and the
+// vertices' mean; false when they do not span a plane.
+bool FitTopPlane(const Vertices& f, const std::vector<int>& top, Eigen::Vector3d* normal,
+                 Eigen::Vector3d* mean) {
+  if (top.size() < 3) return false;
+  Eigen::Vector3d m = Eigen::Vector3d::Zero();
+  for (int v : top) m += f.row(v).transpose();
+  m /= static_cast<double>(top.size());
   Eigen::Matrix3d normal_eq = Eigen::Matrix3d::Zero();
   Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
   for (int v : top) {
-    const Eigen::Vector3d d = f.row(v).transpose() - mean;
+    const Eigen::Vector3d d = f.row(v).transpose() - m;
     const Eigen::Vector3d row(d.x(), d.y(), 1.0);
     normal_eq += row * row.transpose();
     rhs += row * d.z();
   }
-  const Eigen::Vector3d abc = normal_eq.ldlt().solve(rhs);
-  if (!abc.allFinite()) return 0.0;  // collinear top: the area check has refused it
-  return std::atan(std::hypot(abc.x(), abc.y()));
+  Eigen::LDLT<Eigen::Matrix3d> ldlt(normal_eq);
+  if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-12)) return false;
+  const Eigen::Vector3d abc = ldlt.solve(rhs);
+  if (!abc.allFinite()) return false;
+  *normal = Eigen::Vector3d(-abc.x(), -abc.y(), 1.0).normalized();
+  *mean = m;
+  return true;
+}
+
+std::string Settle() {
+  return " (a tilted mesh, or one whose vertical axis is y: --up y; or give the support's centre "
+         "with --centre-mm)";
 }
 
 }  // namespace
+
+MeshLevelling LevelMeshTop(Vertices* f, const DrapeMeshOptions& o, const std::string& source) {
+  MeshLevelling l;
+  Eigen::Vector3d normal, mean;
+  for (int round = 0; round < 6; ++round) {
+    if (!FitTopPlane(*f, TopVertices(*f, o.plateau_tolerance), &normal, &mean)) break;
+    const double slope = std::acos(std::clamp(normal.z(), -1.0, 1.0));
+    if (round == 0 && slope < kLevelBelow) return l;  // level enough: the input's own frame
+    if (slope < 1e-9) break;
+    // Turn the top's normal to vertical about the top's mean.
+    const Eigen::Matrix3d q =
+        Eigen::Quaterniond::FromTwoVectors(normal, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    for (Eigen::Index v = 0; v < f->rows(); ++v)
+      f->row(v) = (mean + q * (f->row(v).transpose() - mean)).transpose();
+    l.rotation = q * l.rotation;
+    l.translation = q * (l.translation - mean) + mean;
+    l.levelled = true;
+  }
+  l.tilt = std::acos(std::clamp(l.rotation(2, 2), -1.0, 1.0));
+  if (l.tilt > o.max_tilt)
+    throw InputError(source + ": the mesh's flat top slopes by " + NumberText(l.tilt / kDegree, 3) +
+                     "°, over " + NumberText(o.max_tilt / kDegree, 3) + "°" + Settle());
+  return l;
+}
 
 MeshSupportCentre FindMeshSupportCentre(const Vertices& f, const Triangles& triangles,
                                         const DrapeMeshOptions& o, const std::string& source) {
@@ -265,11 +310,8 @@ MeshSupportCentre FindMeshSupportCentre(const Vertices& f, const Triangles& tria
     c.from = "given";
     return c;
   }
-  const double top = f.col(2).maxCoeff(), level = top - o.plateau_tolerance;
   std::vector<char> on_top(static_cast<size_t>(f.rows()), 0);
-  std::vector<int> top_vertices;
-  for (int v = 0; v < f.rows(); ++v)
-    if (f(v, 2) >= level) on_top[v] = 1, top_vertices.push_back(v);
+  for (int v : TopVertices(f, o.plateau_tolerance)) on_top[v] = 1;
   Eigen::Vector2d moment = Eigen::Vector2d::Zero();
   for (int t = 0; t < triangles.rows(); ++t) {
     const int a = triangles(t, 0), b = triangles(t, 1), d = triangles(t, 2);
@@ -281,18 +323,11 @@ MeshSupportCentre FindMeshSupportCentre(const Vertices& f, const Triangles& tria
     moment += area * (pa + pb + pd) / 3.0;
   }
   const double support_area = kPi * o.measure.support_radius * o.measure.support_radius;
-  const std::string settle =
-      " (a tilted mesh, or one whose vertical axis is y: --up y; or give the support's centre "
-      "with --centre-mm)";
   if (c.plateau_area < 0.5 * support_area)
     throw InputError(source + ": no flat top the size of the support: the faces within " +
                      Mm(o.plateau_tolerance) + " of the highest point cover " +
                      NumberText(c.plateau_area * 1e6, 5) + " mm², under half the support's " +
-                     NumberText(support_area * 1e6, 5) + " mm²" + settle);
-  c.tilt = PlateauTilt(f, top_vertices);
-  if (c.tilt > o.max_tilt)
-    throw InputError(source + ": the mesh's flat top slopes by " + NumberText(c.tilt / kDegree, 3) +
-                     "°, over " + NumberText(o.max_tilt / kDegree, 3) + "°" + settle);
+                     NumberText(support_area * 1e6, 5) + " mm²" + Settle());
   c.centre = moment / c.plateau_area;
   c.from = "plateau";
   if (c.centre.norm() <= kOriginSnap) {
@@ -388,8 +423,9 @@ MeasuredDrape MeasureDrapeMesh(const TriangleMesh& input, const DrapeMeshOptions
     throw InputError(source + ": a face's vertex index is out of range (" +
                      std::to_string(input.num_vertices()) + " vertices)");
   const TriangleMesh draped = UsedPart(input);
-  const Vertices frame = MeshInMeasureFrame(draped, o, source);
+  Vertices frame = MeshInMeasureFrame(draped, o, source);
   CheckMeshScale(frame, o, source);
+  const MeshLevelling level = o.centre ? MeshLevelling{} : LevelMeshTop(&frame, o, source);
   const MeshSupportCentre c = FindMeshSupportCentre(frame, draped.triangles, o, source);
   MeasuredDrape m = MeasureDrapeShadow(
       RasteriseFabric(frame, draped.triangles, c.centre, o.measure.raster_cell,
@@ -398,6 +434,11 @@ MeasuredDrape MeasureDrapeMesh(const TriangleMesh& input, const DrapeMeshOptions
   m.input_kind = "mesh";
   m.centre = c.centre;
   m.centre_from = c.from;
+  if (level.levelled)
+    m.notes.push_back({"levelled", "the mesh's flat top sloped by " +
+                                       NumberText(level.tilt / kDegree, 3) +
+                                       "°: it was levelled about the top's centre before the "
+                                       "projection (centre_mm is in the levelled frame)"});
   return m;
 }
 

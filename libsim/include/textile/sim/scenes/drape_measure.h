@@ -94,7 +94,8 @@ struct DrapeMeshOptions {
   // The flat top: the vertices within this height of the highest one [m] (a scan's noise and
   // the first millimetre of the overhang's turn-down lie within it).
   double plateau_tolerance = 0.001;
-  // The flat top's least-squares plane may slope by at most this [rad].
+  // The flat top's least-squares plane may slope by at most this [rad]; less is levelled
+  // (LevelMeshTop).
   double max_tilt = std::numbers::pi / 90.0;  // 2°
 
   // False with "<field>: <problem>" when a field is out of range (measure's fields too).
@@ -113,33 +114,53 @@ Vertices MeshInMeasureFrame(const TriangleMesh& draped, const DrapeMeshOptions& 
 void CheckMeshScale(const Vertices& frame, const DrapeMeshOptions& options,
                     const std::string& source);
 
-// Stage 3: the support's centre. Given: options.centre ("given"). Found: the flat top is the
+// Stage 3: levelling. The flat top (the vertices within plateau_tolerance of the highest one)
+// is fitted with a plane by least squares; when it slopes by kLevelBelow or more, *frame is
+// turned about the top's mean so that the plane is horizontal, and again (at most six rounds)
+// until the refitted top is level to 1e-9 rad: a scan taken on a drapemeter that was not quite
+// level is measured as if it were. Below kLevelBelow nothing is turned (the shadow moves by
+// under 0.1 mm: the skirt hangs about 60 mm below the top), so a level mesh keeps its own
+// frame. Throws InputError "<source>: ... slopes by X°" naming --up and --centre-mm when the
+// total turn exceeds max_tilt (a y-up mesh read as z-up slopes by about 90°).
+inline constexpr double kLevelBelow = 0.1 * std::numbers::pi / 180.0;  // [rad]
+struct MeshLevelling {
+  // levelled = rotation · p + translation for every vertex p of the frame before [m].
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  double tilt = 0.0;  // the top's slope before [rad] (0 when not levelled)
+  bool levelled = false;
+};
+MeshLevelling LevelMeshTop(Vertices* frame, const DrapeMeshOptions& options,
+                           const std::string& source);
+
+// Stage 4: the support's centre. Given: options.centre ("given"). Found: the flat top is the
 // triangles whose corners all lie within plateau_tolerance of the highest vertex; its centre is
 // their centroid weighted by projected area (so mesh density does not pull it), snapped to the
 // origin when within kOriginSnap of it ("origin": a mesh that is centred already, as `textile
 // drape` writes them; else "plateau"). Throws InputError "<source>: ..." naming --up and
-// --centre-mm when the flat top covers less than half the support's area (a tilted or y-up mesh)
-// or its plane slopes by more than max_tilt.
+// --centre-mm when the flat top covers less than half the support's area (a tilted mesh beyond
+// levelling, or a y-up mesh read as z-up).
 inline constexpr double kOriginSnap = 0.0005;  // [m]
 struct MeshSupportCentre {
-  Eigen::Vector2d centre{0.0, 0.0};  // [m], in the frame of MeshInMeasureFrame
+  Eigen::Vector2d centre{0.0, 0.0};  // [m], in the (levelled) frame
   std::string from;                  // "given" | "origin" | "plateau"
   double plateau_area = 0.0;         // [m²], 0 when given
-  double tilt = 0.0;                 // the flat top's slope [rad], 0 when given
 };
 MeshSupportCentre FindMeshSupportCentre(const Vertices& frame, const Triangles& triangles,
                                         const DrapeMeshOptions& options,
                                         const std::string& source);
 
-// Stage 4: the fabric's raster (mask 1 where a projected triangle covers a cell centre) on a
+// Stage 5: the fabric's raster (mask 1 where a projected triangle covers a cell centre) on a
 // grid about `centre` [m], spanning the projection and the support's disk (support_radius [m])
 // with two empty cells of margin, for MeasureDrapeShadow. Throws InputError beyond 1e8 cells.
 DrapeShadow RasteriseFabric(const Vertices& frame, const Triangles& triangles,
                             const Eigen::Vector2d& centre, double cell, double support_radius);
 
 // A draped mesh measured as the drapemeter measures a simulated one: vertices no face uses
-// dropped (a scan's stray points), stages 1-4, then
-// MeasureDrapeShadow (input_kind "mesh"; centre and centre_from from stage 3). Throws as the
+// dropped (a scan's stray points), stages 1-5 (no levelling with a given centre, which is in
+// the input's frame), then
+// MeasureDrapeShadow (input_kind "mesh"; centre and centre_from from stage 4; the note
+// "levelled" when stage 3 turned the mesh). Throws as the
 // stages and MeasureDrapeShadow do (InputError for bad input, ComputeError for an outline that
 // is not a closed curve around the support).
 MeasuredDrape MeasureDrapeMesh(const TriangleMesh& draped, const DrapeMeshOptions& options,

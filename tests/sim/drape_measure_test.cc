@@ -153,6 +153,23 @@ TEST(DrapeMeasureMesh, StrayPointsWithoutFacesChangeNothing) {
   EXPECT_EQ(b.centre_from, "origin");
 }
 
+TEST(DrapeMeasureMesh, SpikesAndStrayFacesAboveTheTopChangeNothing) {
+  const TriangleMesh clean = Drape(SixLobes());
+  TriangleMesh noisy = clean;
+  noisy.vertices(1 + 5 * kSectors + 100, 2) += 0.02;  // a spike 20 mm up on the support
+  const int n = noisy.num_vertices();
+  noisy.vertices.conservativeResize(n + 3, 3);
+  noisy.vertices.row(n) << 0.03, 0.03, 0.05;  // a stray 1 mm² face 50 mm above the support
+  noisy.vertices.row(n + 1) << 0.032, 0.03, 0.05;
+  noisy.vertices.row(n + 2) << 0.03, 0.031, 0.05;
+  noisy.triangles.conservativeResize(noisy.num_triangles() + 1, 3);
+  noisy.triangles.row(noisy.num_triangles() - 1) << n, n + 1, n + 2;
+  const MeasuredDrape a = MeasureDrapeMesh(clean, {}, "a"), b = MeasureDrapeMesh(noisy, {}, "b");
+  EXPECT_EQ(a.drape_coefficient, b.drape_coefficient);
+  EXPECT_EQ(b.centre_from, "origin");
+  EXPECT_TRUE(b.notes.empty());  // not levelled by the spike
+}
+
 TEST(DrapeMeasureMesh, GivenCentreIsUsed) {
   TriangleMesh moved = Drape(SixLobes());
   moved.vertices.col(0).array() += 0.02;

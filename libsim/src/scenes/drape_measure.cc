@@ -237,13 +237,43 @@ void CheckMeshScale(const Vertices& f, const DrapeMeshOptions& o, const std::str
 
 namespace {
 
-// The vertices within `tolerance` of the highest one.
-std::vector<int> TopVertices(const Vertices& f, double tolerance) {
-  const double level = f.col(2).maxCoeff() - tolerance;
-  std::vector<int> top;
+// The top's height: the highest h such that the faces whose highest corner lies at h or above
+// cover kTopArea of the support's area (projected), so that a scan's stray faces and spikes
+// (a few small faces) above the fabric do not set it, while a coarse mesh's large faces do.
+constexpr double kTopArea = 0.02;
+double TopHeight(const Vertices& f, const Triangles& triangles, double support_radius) {
+  std::vector<std::pair<double, double>> faces(static_cast<size_t>(triangles.rows()));
+  for (Eigen::Index t = 0; t < triangles.rows(); ++t) {
+    const auto a = f.row(triangles(t, 0)), b = f.row(triangles(t, 1)), c = f.row(triangles(t, 2));
+    const double area =
+        0.5 * std::abs((b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x()));
+    faces[t] = {std::max({a.z(), b.z(), c.z()}), area};
+  }
+  if (faces.empty()) return f.col(2).maxCoeff();
+  const auto higher = [](const auto& p, const auto& q) { return p.first > q.first; };
+  // The highest tenth of the faces in order first (they nearly always reach kTopArea); the rest
+  // only when they do not: a full sort of 500k faces took about 0.01 s of each call.
+  const auto tenth = faces.begin() + static_cast<std::ptrdiff_t>(std::max<size_t>(1, faces.size() / 10));
+  std::nth_element(faces.begin(), tenth - 1, faces.end(), higher);
+  std::sort(faces.begin(), tenth, higher);
+  const double wanted = kTopArea * kPi * support_radius * support_radius;
+  double covered = 0.0;
+  for (auto it = faces.begin(); it != faces.end(); ++it) {
+    if (it == tenth) std::sort(tenth, faces.end(), higher);
+    covered += it->second;
+    if (covered >= wanted) return it->first;
+  }
+  return faces.back().first;
+}
+
+// The top's vertices: at most `tolerance` below the top's height, and at most as far above it
+// (a spike's tip is left out of the plane fit; `all_above` keeps it, for the top's faces).
+std::vector<int> TopVertices(const Vertices& f, double top, double tolerance, bool all_above) {
+  std::vector<int> vertices;
   for (int v = 0; v < f.rows(); ++v)
-    if (f(v, 2) >= level) top.push_back(v);
-  return top;
+    if (f(v, 2) >= top - tolerance && (all_above || f(v, 2) <= top + tolerance))
+      vertices.push_back(v);
+  return vertices;
 }
 
 // The plane h = a x + b y + c through `top` by least squares: its upward unit normal and the
@@ -278,11 +308,13 @@ std::string Settle() {
 
 }  // namespace
 
-MeshLevelling LevelMeshTop(Vertices* f, const DrapeMeshOptions& o, const std::string& source) {
+MeshLevelling LevelMeshTop(Vertices* f, const Triangles& triangles, const DrapeMeshOptions& o,
+                           const std::string& source) {
   MeshLevelling l;
   Eigen::Vector3d normal, mean;
   for (int round = 0; round < 6; ++round) {
-    if (!FitTopPlane(*f, TopVertices(*f, o.plateau_tolerance), &normal, &mean)) break;
+    const double top = TopHeight(*f, triangles, o.measure.support_radius);
+    if (!FitTopPlane(*f, TopVertices(*f, top, o.plateau_tolerance, false), &normal, &mean)) break;
     const double slope = std::acos(std::clamp(normal.z(), -1.0, 1.0));
     if (round == 0 && slope < kLevelBelow) return l;  // level enough: the input's own frame
     if (slope < 1e-9) break;
@@ -311,7 +343,8 @@ MeshSupportCentre FindMeshSupportCentre(const Vertices& f, const Triangles& tria
     return c;
   }
   std::vector<char> on_top(static_cast<size_t>(f.rows()), 0);
-  for (int v : TopVertices(f, o.plateau_tolerance)) on_top[v] = 1;
+  const double top = TopHeight(f, triangles, o.measure.support_radius);
+  for (int v : TopVertices(f, top, o.plateau_tolerance, true)) on_top[v] = 1;
   Eigen::Vector2d moment = Eigen::Vector2d::Zero();
   for (int t = 0; t < triangles.rows(); ++t) {
     const int a = triangles(t, 0), b = triangles(t, 1), d = triangles(t, 2);
@@ -325,7 +358,7 @@ MeshSupportCentre FindMeshSupportCentre(const Vertices& f, const Triangles& tria
   const double support_area = kPi * o.measure.support_radius * o.measure.support_radius;
   if (c.plateau_area < 0.5 * support_area)
     throw InputError(source + ": no flat top the size of the support: the faces within " +
-                     Mm(o.plateau_tolerance) + " of the highest point cover " +
+                     Mm(o.plateau_tolerance) + " of the top cover " +
                      NumberText(c.plateau_area * 1e6, 5) + " mm², under half the support's " +
                      NumberText(support_area * 1e6, 5) + " mm²" + Settle());
   c.centre = moment / c.plateau_area;
@@ -425,7 +458,8 @@ MeasuredDrape MeasureDrapeMesh(const TriangleMesh& input, const DrapeMeshOptions
   const TriangleMesh draped = UsedPart(input);
   Vertices frame = MeshInMeasureFrame(draped, o, source);
   CheckMeshScale(frame, o, source);
-  const MeshLevelling level = o.centre ? MeshLevelling{} : LevelMeshTop(&frame, o, source);
+  const MeshLevelling level =
+      o.centre ? MeshLevelling{} : LevelMeshTop(&frame, draped.triangles, o, source);
   const MeshSupportCentre c = FindMeshSupportCentre(frame, draped.triangles, o, source);
   MeasuredDrape m = MeasureDrapeShadow(
       RasteriseFabric(frame, draped.triangles, c.centre, o.measure.raster_cell,

@@ -60,8 +60,8 @@ struct MeasuredDrape {
   DrapeShadow shadow;              // about the support's centre (origin of the grid's frame)
   DrapeNodes nodes;
   double min_radius = 0.0, max_radius = 0.0, mean_radius = 0.0;  // of the outline [m]
-  Eigen::Vector2d centre{0.0, 0.0};  // the support's centre in the input's frame [m] (photo: the
-                                     // rig's plane)
+  Eigen::Vector2d centre{0.0, 0.0};  // the support's centre in the input's frame [m] (a mesh:
+                                     // levelled when noted; a photo: the rig's plane)
   std::string centre_from;           // see above
   std::vector<Note> notes;           // what to know before trusting the figures
 };
@@ -91,8 +91,8 @@ struct DrapeMeshOptions {
   // The support's centre in the horizontal frame above [m] (after metres_per_unit); found from
   // the mesh's flat top when not given (FindMeshSupportCentre).
   std::optional<Eigen::Vector2d> centre;
-  // The flat top: the vertices within this height of the highest one [m] (a scan's noise and
-  // the first millimetre of the overhang's turn-down lie within it).
+  // The flat top: the vertices at most this far below the top's height [m] (a scan's noise and
+  // the first millimetre of the overhang's turn-down lie within it; LevelMeshTop).
   double plateau_tolerance = 0.001;
   // The flat top's least-squares plane may slope by at most this [rad]; less is levelled
   // (LevelMeshTop).
@@ -114,8 +114,12 @@ Vertices MeshInMeasureFrame(const TriangleMesh& draped, const DrapeMeshOptions& 
 void CheckMeshScale(const Vertices& frame, const DrapeMeshOptions& options,
                     const std::string& source);
 
-// Stage 3: levelling. The flat top (the vertices within plateau_tolerance of the highest one)
-// is fitted with a plane by least squares; when it slopes by kLevelBelow or more, *frame is
+// The top: its height is the highest h such that faces whose highest corner lies at h or above
+// cover 2 % of the support's area (so a scan's stray faces and spikes, a few small faces, do
+// not set it); the flat top is what lies within plateau_tolerance below it.
+//
+// Stage 3: levelling. The flat top's vertices (spike tips more than plateau_tolerance above
+// the top's height left out) are fitted with a plane by least squares; when it slopes by kLevelBelow or more, *frame is
 // turned about the top's mean so that the plane is horizontal, and again (at most six rounds)
 // until the refitted top is level to 1e-9 rad: a scan taken on a drapemeter that was not quite
 // level is measured as if it were. Below kLevelBelow nothing is turned (the shadow moves by
@@ -130,11 +134,11 @@ struct MeshLevelling {
   double tilt = 0.0;  // the top's slope before [rad] (0 when not levelled)
   bool levelled = false;
 };
-MeshLevelling LevelMeshTop(Vertices* frame, const DrapeMeshOptions& options,
-                           const std::string& source);
+MeshLevelling LevelMeshTop(Vertices* frame, const Triangles& triangles,
+                           const DrapeMeshOptions& options, const std::string& source);
 
 // Stage 4: the support's centre. Given: options.centre ("given"). Found: the flat top is the
-// triangles whose corners all lie within plateau_tolerance of the highest vertex; its centre is
+// triangles whose corners all lie at most plateau_tolerance below the top's height; its centre is
 // their centroid weighted by projected area (so mesh density does not pull it), snapped to the
 // origin when within kOriginSnap of it ("origin": a mesh that is centred already, as `textile
 // drape` writes them; else "plateau"). Throws InputError "<source>: ..." naming --up and
@@ -158,11 +162,10 @@ DrapeShadow RasteriseFabric(const Vertices& frame, const Triangles& triangles,
 
 // A draped mesh measured as the drapemeter measures a simulated one: vertices no face uses
 // dropped (a scan's stray points), stages 1-5 (no levelling with a given centre, which is in
-// the input's frame), then
-// MeasureDrapeShadow (input_kind "mesh"; centre and centre_from from stage 4; the note
-// "levelled" when stage 3 turned the mesh). Throws as the
-// stages and MeasureDrapeShadow do (InputError for bad input, ComputeError for an outline that
-// is not a closed curve around the support).
+// the input's frame), then MeasureDrapeShadow (input_kind "mesh"; centre and centre_from from
+// stage 4; the note "levelled" when stage 3 turned the mesh). Throws as the stages and
+// MeasureDrapeShadow do (InputError for bad input, ComputeError for an outline that is not a
+// closed curve around the support).
 MeasuredDrape MeasureDrapeMesh(const TriangleMesh& draped, const DrapeMeshOptions& options,
                                const std::string& source);
 

@@ -231,7 +231,8 @@ TEST(DrapeMeasureMesh, RefusesHalfADiskAndATiltedMesh) {
   EXPECT_TRUE(Throws<std::exception>([&] { MeasureDrapeMesh(half, {}, "half.obj"); }));
 
   // Tilted by 3° about x: past max_tilt (2°); --up and --centre-mm are named.
-  const std::string tilt = ErrorOf([&] { MeasureDrapeMesh(Tilted(Drape(SixLobes()), 3.0), {}, "t.obj"); });
+  const std::string tilt =
+      ErrorOf([&] { MeasureDrapeMesh(Tilted(Drape(SixLobes()), 3.0), {}, "t.obj"); });
   EXPECT_NE(tilt.find("slopes by 3°, over 2°"), std::string::npos) << tilt;
   EXPECT_NE(tilt.find("--centre-mm"), std::string::npos) << tilt;
 }
@@ -247,7 +248,8 @@ TEST(DrapeMeasureMesh, SlightlyTiltedScanIsLevelled) {
     const MeasuredDrape b = MeasureDrapeMesh(tilted, {}, "tilted");
     ASSERT_EQ(b.notes.size(), 1u) << degrees;
     EXPECT_EQ(b.notes[0].code, "levelled");
-    EXPECT_NE(b.notes[0].text.find(NumberText(degrees, 3) + "°"), std::string::npos) << b.notes[0].text;
+    EXPECT_NE(b.notes[0].text.find(NumberText(degrees, 3) + "°"), std::string::npos)
+        << b.notes[0].text;
     // Levelled about the top's centre (at the origin before the move): the centre and the
     // figures are the level mesh's, to the raster's sampling.
     EXPECT_NEAR(b.centre.x(), 0.037, 1e-4) << degrees;

@@ -174,7 +174,8 @@ void Put(std::string* out, T v) {
 
 TEST(MeshIo, PlyAsciiAndBinaryReadBackEqual) {
   const TriangleMesh m = AwkwardMesh();
-  const TriangleMesh a = ParsePly(PlyText(m, {{"s", Eigen::VectorXd::LinSpaced(m.num_vertices(), 0, 1)}}), "a.ply");
+  const TriangleMesh a =
+      ParsePly(PlyText(m, {{"s", Eigen::VectorXd::LinSpaced(m.num_vertices(), 0, 1)}}), "a.ply");
   const TriangleMesh b = ParsePly(PlyBinaryBytes(m), "b.ply");
   EXPECT_EQ(a.vertices, m.vertices);  // shortest round-trip text: bit for bit
   EXPECT_EQ(b.vertices, m.vertices);
@@ -222,9 +223,10 @@ TEST(MeshIo, PlyReaderSkipsOtherDataAndFansQuads) {
 }
 
 TEST(MeshIo, PlyReaderNamesBadInput) {
-  const std::string head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\n"
-                           "property double y\nproperty double z\nelement face 1\n"
-                           "property list uchar int vertex_indices\nend_header\n";
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\n"
+      "property double y\nproperty double z\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
   EXPECT_EQ(InputErrorOf([&] { ParsePly(head + "0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n", "n.ply"); }),
             "n.ply:11: vertex 1: coordinate z is NaN or infinite");
   EXPECT_EQ(InputErrorOf([&] { ParsePly(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n", "i.ply"); }),
@@ -233,12 +235,16 @@ TEST(MeshIo, PlyReaderNamesBadInput) {
             "s.ply:12: the file ends before the data its header announces");
   EXPECT_EQ(InputErrorOf([] { ParsePly("solid x\n", "g.ply"); }),
             "g.ply:1: not a PLY file (its first line is not \"ply\")");
-  EXPECT_EQ(InputErrorOf([] { ParsePly("ply\nformat binary_big_endian 1.0\nend_header\n", "b.ply"); }),
-            "b.ply:2: format binary_big_endian is not read (ascii or binary_little_endian)");
-  EXPECT_EQ(InputErrorOf([] {
-              ParsePly("ply\nformat ascii 1.0\nelement vertex 99999999\nproperty float x\nend_header\n1\n", "c.ply");
-            }),
-            "c.ply: the PLY header announces 99999999 vertex elements, more than the file holds");
+  EXPECT_EQ(
+      InputErrorOf([] { ParsePly("ply\nformat binary_big_endian 1.0\nend_header\n", "b.ply"); }),
+      "b.ply:2: format binary_big_endian is not read (ascii or binary_little_endian)");
+  EXPECT_EQ(
+      InputErrorOf([] {
+        ParsePly(
+            "ply\nformat ascii 1.0\nelement vertex 99999999\nproperty float x\nend_header\n1\n",
+            "c.ply");
+      }),
+      "c.ply: the PLY header announces 99999999 vertex elements, more than the file holds");
   EXPECT_EQ(InputErrorOf([] { ReadDrapedMesh("mesh.stl"); }),
             "mesh.stl: not a mesh this reads: name it .obj or .ply");
 }

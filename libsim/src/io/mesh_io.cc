@@ -6,11 +6,11 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <cstdint>
-#include <cstring>
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -194,7 +194,9 @@ class Words {
   }
 
  private:
-  static bool IsBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+  static bool IsBlank(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
+  }
   std::string_view rest_;
 };
 
@@ -309,10 +311,18 @@ struct PlyHeader {
 
 int PlySize(PlyType t) {
   switch (t) {
-    case PlyType::kInt8: case PlyType::kUint8: return 1;
-    case PlyType::kInt16: case PlyType::kUint16: return 2;
-    case PlyType::kInt32: case PlyType::kUint32: case PlyType::kFloat32: return 4;
-    case PlyType::kFloat64: return 8;
+    case PlyType::kInt8:
+    case PlyType::kUint8:
+      return 1;
+    case PlyType::kInt16:
+    case PlyType::kUint16:
+      return 2;
+    case PlyType::kInt32:
+    case PlyType::kUint32:
+    case PlyType::kFloat32:
+      return 4;
+    case PlyType::kFloat64:
+      return 8;
   }
   return 8;
 }
@@ -366,9 +376,12 @@ PlyHeader ParsePlyHeader(const std::string& bytes, const std::string& source) {
     if (key == "end_header") break;
     if (key == "format") {
       if (!words.Next(&a)) fail("format: needs ascii or binary_little_endian");
-      if (a == "ascii") h.binary = false;
-      else if (a == "binary_little_endian") h.binary = true;
-      else fail("format " + std::string(a) + " is not read (ascii or binary_little_endian)");
+      if (a == "ascii")
+        h.binary = false;
+      else if (a == "binary_little_endian")
+        h.binary = true;
+      else
+        fail("format " + std::string(a) + " is not read (ascii or binary_little_endian)");
       format_seen = true;
     } else if (key == "element") {
       PlyElement e;
@@ -454,14 +467,22 @@ class PlyBinaryReader {
     const char* p = bytes_.data() + at_;
     at_ += n;
     switch (t) {
-      case PlyType::kInt8: return Load<std::int8_t>(p);
-      case PlyType::kUint8: return Load<std::uint8_t>(p);
-      case PlyType::kInt16: return Load<std::int16_t>(p);
-      case PlyType::kUint16: return Load<std::uint16_t>(p);
-      case PlyType::kInt32: return Load<std::int32_t>(p);
-      case PlyType::kUint32: return Load<std::uint32_t>(p);
-      case PlyType::kFloat32: return Load<float>(p);
-      case PlyType::kFloat64: return Load<double>(p);
+      case PlyType::kInt8:
+        return Load<std::int8_t>(p);
+      case PlyType::kUint8:
+        return Load<std::uint8_t>(p);
+      case PlyType::kInt16:
+        return Load<std::int16_t>(p);
+      case PlyType::kUint16:
+        return Load<std::uint16_t>(p);
+      case PlyType::kInt32:
+        return Load<std::int32_t>(p);
+      case PlyType::kUint32:
+        return Load<std::uint32_t>(p);
+      case PlyType::kFloat32:
+        return Load<float>(p);
+      case PlyType::kFloat64:
+        return Load<double>(p);
     }
     return 0.0;
   }
@@ -472,7 +493,8 @@ class PlyBinaryReader {
  private:
   template <typename T>
   static double Load(const char* p) {
-    static_assert(std::endian::native == std::endian::little, "binary PLY reader: little-endian only");
+    static_assert(std::endian::native == std::endian::little,
+                  "binary PLY reader: little-endian only");
     T v;
     std::memcpy(&v, p, sizeof(T));
     return static_cast<double>(v);
@@ -568,8 +590,8 @@ TriangleMesh ReadPlyBody(const PlyHeader& h, Reader& in, const std::string& sour
       if (faces[f][c] >= static_cast<double>(nv))
         throw InputError(in.Where(face_where[f].first) + ": face " +
                          std::to_string(face_where[f].second) + ": vertex index " +
-                         NumberText(faces[f][c]) +
-                         " is out of range (" + std::to_string(nv) + " vertices)");
+                         NumberText(faces[f][c]) + " is out of range (" + std::to_string(nv) +
+                         " vertices)");
       mesh.triangles(static_cast<Eigen::Index>(f), c) = static_cast<int>(faces[f][c]);
     }
   return mesh;
@@ -582,7 +604,8 @@ TriangleMesh ParsePly(const std::string& bytes, const std::string& source) {
   // A count beyond what the body can hold is a damaged header, not a reason to reserve memory.
   for (const PlyElement& e : h.elements) {
     std::size_t per = 0;
-    for (const PlyProperty& p : e.properties) per += h.binary ? PlySize(p.list ? p.count_type : p.type) : 2;
+    for (const PlyProperty& p : e.properties)
+      per += h.binary ? PlySize(p.list ? p.count_type : p.type) : 2;
     if (per > 0 && e.count > (bytes.size() - h.body) / per + 1)
       throw InputError(source + ": the PLY header announces " + std::to_string(e.count) + " " +
                        e.name + " elements, more than the file holds");
@@ -597,7 +620,8 @@ TriangleMesh ParsePly(const std::string& bytes, const std::string& source) {
 }
 
 std::string PlyBinaryBytes(const TriangleMesh& mesh) {
-  std::string out = "ply\nformat binary_little_endian 1.0\ncomment textile mesh; positions in metres\n";
+  std::string out =
+      "ply\nformat binary_little_endian 1.0\ncomment textile mesh; positions in metres\n";
   out += "element vertex " + std::to_string(mesh.num_vertices()) + "\n";
   out += "property double x\nproperty double y\nproperty double z\n";
   out += "element face " + std::to_string(mesh.num_triangles()) + "\n";

@@ -1,10 +1,10 @@
 #include "textile/sim/scenes/drape_measure.h"
 
-#include <algorithm>
-#include <cstdint>
-#include <cmath>
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <sstream>
@@ -200,7 +200,8 @@ Vertices MeshInMeasureFrame(const TriangleMesh& draped, const DrapeMeshOptions& 
                      " vertices): nothing casts a shadow");
   for (int v = 0; v < draped.num_vertices(); ++v)
     if (!draped.vertices.row(v).allFinite())
-      throw InputError(source + ": vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
+      throw InputError(source + ": vertex " + std::to_string(v) +
+                       " has a NaN or infinite coordinate");
   if (draped.triangles.minCoeff() < 0 || draped.triangles.maxCoeff() >= draped.num_vertices())
     throw InputError(source + ": a face's vertex index is out of range (" +
                      std::to_string(draped.num_vertices()) + " vertices)");
@@ -253,7 +254,8 @@ double TopHeight(const Vertices& f, const Triangles& triangles, double support_r
   const auto higher = [](const auto& p, const auto& q) { return p.first > q.first; };
   // The highest tenth of the faces in order first (they nearly always reach kTopArea); the rest
   // only when they do not: a full sort of 500k faces took about 0.01 s of each call.
-  const auto tenth = faces.begin() + static_cast<std::ptrdiff_t>(std::max<size_t>(1, faces.size() / 10));
+  const auto tenth =
+      faces.begin() + static_cast<std::ptrdiff_t>(std::max<size_t>(1, faces.size() / 10));
   std::nth_element(faces.begin(), tenth - 1, faces.end(), higher);
   std::sort(faces.begin(), tenth, higher);
   const double wanted = kTopArea * kPi * support_radius * support_radius;
@@ -381,10 +383,16 @@ void CoverTriangle(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eig
   const double sign = area2 > 0.0 ? 1.0 : -1.0;
   const double inv = 1.0 / s->cell;
   auto index = [inv](double v, double origin) { return (v - origin) * inv; };
-  const int i0 = std::max(0, static_cast<int>(std::ceil(index(std::min({a.x(), b.x(), c.x()}), s->origin_x))));
-  const int i1 = std::min(s->width - 1, static_cast<int>(std::floor(index(std::max({a.x(), b.x(), c.x()}), s->origin_x))));
-  const int j0 = std::max(0, static_cast<int>(std::ceil(index(std::min({a.y(), b.y(), c.y()}), s->origin_y))));
-  const int j1 = std::min(s->height - 1, static_cast<int>(std::floor(index(std::max({a.y(), b.y(), c.y()}), s->origin_y))));
+  const int i0 =
+      std::max(0, static_cast<int>(std::ceil(index(std::min({a.x(), b.x(), c.x()}), s->origin_x))));
+  const int i1 =
+      std::min(s->width - 1,
+               static_cast<int>(std::floor(index(std::max({a.x(), b.x(), c.x()}), s->origin_x))));
+  const int j0 =
+      std::max(0, static_cast<int>(std::ceil(index(std::min({a.y(), b.y(), c.y()}), s->origin_y))));
+  const int j1 =
+      std::min(s->height - 1,
+               static_cast<int>(std::floor(index(std::max({a.y(), b.y(), c.y()}), s->origin_y))));
   auto edge = [sign](const Eigen::Vector2d& p, const Eigen::Vector2d& q, double px, double py) {
     return sign * ((q.x() - p.x()) * (py - p.y()) - (q.y() - p.y()) * (px - p.x()));
   };
@@ -461,10 +469,10 @@ MeasuredDrape MeasureDrapeMesh(const TriangleMesh& input, const DrapeMeshOptions
   const MeshLevelling level =
       o.centre ? MeshLevelling{} : LevelMeshTop(&frame, draped.triangles, o, source);
   const MeshSupportCentre c = FindMeshSupportCentre(frame, draped.triangles, o, source);
-  MeasuredDrape m = MeasureDrapeShadow(
-      RasteriseFabric(frame, draped.triangles, c.centre, o.measure.raster_cell,
-                      o.measure.support_radius),
-      o.measure, source);
+  MeasuredDrape m =
+      MeasureDrapeShadow(RasteriseFabric(frame, draped.triangles, c.centre, o.measure.raster_cell,
+                                         o.measure.support_radius),
+                         o.measure, source);
   m.input_kind = "mesh";
   m.centre = c.centre;
   m.centre_from = c.from;
@@ -497,8 +505,8 @@ TriangleMesh SyntheticDrapeMesh(double R, double Rs, int rings, int sectors,
       const double r = ring_radius(k);
       const double t = r <= Rs ? 0.0 : (r - Rs) / (R - Rs);  // along the skirt, 0 .. 1
       const double rho = r <= Rs ? r : Rs + t * (rim - Rs);
-      m.vertices.row(1 + static_cast<Eigen::Index>(k - 1) * sectors + s)
-          << rho * std::cos(theta), rho * std::sin(theta), -t * drop;
+      m.vertices.row(1 + static_cast<Eigen::Index>(k - 1) * sectors + s) << rho * std::cos(theta),
+          rho * std::sin(theta), -t * drop;
     }
   }
   auto id = [sectors](int k, int s) { return 1 + (k - 1) * sectors + (s % sectors); };

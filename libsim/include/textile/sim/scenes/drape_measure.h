@@ -86,7 +86,8 @@ MeshUpAxis ParseMeshUpAxis(const std::string& s);  // InputError naming the valu
 // How a draped mesh is read (MeasureDrapeMesh).
 struct DrapeMeshOptions {
   DrapeMeasureOptions measure;
-  double metres_per_unit = 1.0;  // the file's unit [m]: 1 (metres, `textile drape --obj`), 0.001 (mm)
+  // The file's unit [m]: 1 (metres, as `textile drape --obj` writes), 0.001 (mm).
+  double metres_per_unit = 1.0;
   MeshUpAxis up = MeshUpAxis::kZ;
   // The support's centre in the horizontal frame above [m] (after metres_per_unit); found from
   // the mesh's flat top when not given (FindMeshSupportCentre).
@@ -119,13 +120,13 @@ void CheckMeshScale(const Vertices& frame, const DrapeMeshOptions& options,
 // not set it); the flat top is what lies within plateau_tolerance below it.
 //
 // Stage 3: levelling. The flat top's vertices (spike tips more than plateau_tolerance above
-// the top's height left out) are fitted with a plane by least squares; when it slopes by kLevelBelow or more, *frame is
-// turned about the top's mean so that the plane is horizontal, and again (at most six rounds)
-// until the refitted top is level to 1e-9 rad: a scan taken on a drapemeter that was not quite
-// level is measured as if it were. Below kLevelBelow nothing is turned (the shadow moves by
-// under 0.1 mm: the skirt hangs about 60 mm below the top), so a level mesh keeps its own
-// frame. Throws InputError "<source>: ... slopes by X°" naming --up and --centre-mm when the
-// total turn exceeds max_tilt (a y-up mesh read as z-up slopes by about 90°).
+// the top's height left out) are fitted with a plane by least squares; when it slopes by
+// kLevelBelow or more, *frame is turned about the top's mean so that the plane is horizontal, and
+// again (at most six rounds) until the refitted top is level to 1e-9 rad: a scan taken on a
+// drapemeter that was not quite level is measured as if it were. Below kLevelBelow nothing is
+// turned (the shadow moves by under 0.1 mm: the skirt hangs about 60 mm below the top), so a level
+// mesh keeps its own frame. Throws InputError "<source>: ... slopes by X°" naming --up and
+// --centre-mm when the total turn exceeds max_tilt (a y-up mesh read as z-up slopes by about 90°).
 inline constexpr double kLevelBelow = 0.1 * std::numbers::pi / 180.0;  // [rad]
 struct MeshLevelling {
   // levelled = rotation · p + translation for every vertex p of the frame before [m].
@@ -151,8 +152,7 @@ struct MeshSupportCentre {
   double plateau_area = 0.0;         // [m²], 0 when given
 };
 MeshSupportCentre FindMeshSupportCentre(const Vertices& frame, const Triangles& triangles,
-                                        const DrapeMeshOptions& options,
-                                        const std::string& source);
+                                        const DrapeMeshOptions& options, const std::string& source);
 
 // Stage 5: the fabric's raster (mask 1 where a projected triangle covers a cell centre) on a
 // grid about `centre` [m], spanning the projection and the support's disk (support_radius [m])

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -153,6 +154,99 @@ TEST(MeshIo, ObjReaderHandlesCommonFormsAndNamesBadLines) {
             "q.obj:1: bad coordinate \"zero\"");
   EXPECT_EQ(InputErrorOf([] { ParseObj("v 0 0\n", "q.obj"); }),
             "q.obj:1: a vertex needs 3 coordinates");
+}
+
+TEST(MeshIo, ObjReaderFansPolygonsWhenAsked) {
+  const std::string quad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1 2 3\n";
+  const TriangleMesh m = ParseObj(quad, "q.obj", ObjPolygons::kFan);
+  ASSERT_EQ(m.num_triangles(), 3);
+  EXPECT_EQ(m.triangles.row(0), Eigen::RowVector3i(0, 1, 2));
+  EXPECT_EQ(m.triangles.row(1), Eigen::RowVector3i(0, 2, 3));
+  EXPECT_EQ(InputErrorOf([] { ParseObj("v 0 0 0\nv 1 0 0\nf 1 2\n", "q.obj", ObjPolygons::kFan); }),
+            "q.obj:3: face with 2 vertices; only polygons of 3 or more are read");
+}
+
+// Bytes of a little-endian value, for hand-made binary PLYs.
+template <typename T>
+void Put(std::string* out, T v) {
+  out->append(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+
+TEST(MeshIo, PlyAsciiAndBinaryReadBackEqual) {
+  const TriangleMesh m = AwkwardMesh();
+  const TriangleMesh a =
+      ParsePly(PlyText(m, {{"s", Eigen::VectorXd::LinSpaced(m.num_vertices(), 0, 1)}}), "a.ply");
+  const TriangleMesh b = ParsePly(PlyBinaryBytes(m), "b.ply");
+  EXPECT_EQ(a.vertices, m.vertices);  // shortest round-trip text: bit for bit
+  EXPECT_EQ(b.vertices, m.vertices);
+  EXPECT_EQ(a.triangles, m.triangles);
+  EXPECT_EQ(b.triangles, m.triangles);
+}
+
+TEST(MeshIo, PlyReaderSkipsOtherDataAndFansQuads) {
+  // float coordinates among normals and colours, a quad and a triangle with uint indices, and
+  // an edge element after the faces; the same in ASCII and in binary.
+  const std::string header_tail =
+      "element vertex 4\nproperty float nx\nproperty float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nelement face 2\nproperty uchar flags\n"
+      "property list uchar uint vertex_indices\nelement edge 1\nproperty int vertex1\n"
+      "property int vertex2\nend_header\n";
+  const std::string ascii = "ply\nformat ascii 1.0\ncomment hand-made\n" + header_tail +
+                            "9 0 0 0 255\n9 1 0 0 255\n9 1 1 0.5 255\n9 0 1 0 255\n"
+                            "7 4 0 1 2 3\n7 3 0 2 3\n0 1\n";
+  std::string binary = "ply\nformat binary_little_endian 1.0\n" + header_tail;
+  const float xyz[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0.5f}, {0, 1, 0}};
+  for (const auto& p : xyz) {
+    Put<float>(&binary, 9.0f);
+    for (float c : p) Put<float>(&binary, c);
+    Put<std::uint8_t>(&binary, 255);
+  }
+  Put<std::uint8_t>(&binary, 7);
+  Put<std::uint8_t>(&binary, 4);
+  for (std::uint32_t i : {0u, 1u, 2u, 3u}) Put<std::uint32_t>(&binary, i);
+  Put<std::uint8_t>(&binary, 7);
+  Put<std::uint8_t>(&binary, 3);
+  for (std::uint32_t i : {0u, 2u, 3u}) Put<std::uint32_t>(&binary, i);
+  Put<std::int32_t>(&binary, 0);
+  Put<std::int32_t>(&binary, 1);
+  for (const std::string& bytes : {ascii, binary}) {
+    const TriangleMesh m = ParsePly(bytes, "h.ply");
+    ASSERT_EQ(m.num_vertices(), 4);
+    ASSERT_EQ(m.num_triangles(), 3);
+    EXPECT_EQ(m.vertices(2, 2), 0.5);
+    EXPECT_EQ(m.triangles.row(1), Eigen::RowVector3i(0, 2, 3));
+    EXPECT_EQ(m.triangles.row(2), Eigen::RowVector3i(0, 2, 3));
+  }
+  // Cut short, the binary file is refused, not read past its end.
+  EXPECT_EQ(InputErrorOf([&] { ParsePly(binary.substr(0, binary.size() - 5), "h.ply"); }),
+            "h.ply: the file ends before the data its header announces");
+}
+
+TEST(MeshIo, PlyReaderNamesBadInput) {
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\n"
+      "property double y\nproperty double z\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  EXPECT_EQ(InputErrorOf([&] { ParsePly(head + "0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n", "n.ply"); }),
+            "n.ply:11: vertex 1: coordinate z is NaN or infinite");
+  EXPECT_EQ(InputErrorOf([&] { ParsePly(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n", "i.ply"); }),
+            "i.ply:13: face 0: vertex index 9 is out of range (3 vertices)");
+  EXPECT_EQ(InputErrorOf([&] { ParsePly(head + "0 0 0\n1 0 0\n", "s.ply"); }),
+            "s.ply:12: the file ends before the data its header announces");
+  EXPECT_EQ(InputErrorOf([] { ParsePly("solid x\n", "g.ply"); }),
+            "g.ply:1: not a PLY file (its first line is not \"ply\")");
+  EXPECT_EQ(
+      InputErrorOf([] { ParsePly("ply\nformat binary_big_endian 1.0\nend_header\n", "b.ply"); }),
+      "b.ply:2: format binary_big_endian is not read (ascii or binary_little_endian)");
+  EXPECT_EQ(
+      InputErrorOf([] {
+        ParsePly(
+            "ply\nformat ascii 1.0\nelement vertex 99999999\nproperty float x\nend_header\n1\n",
+            "c.ply");
+      }),
+      "c.ply: the PLY header announces 99999999 vertex elements, more than the file holds");
+  EXPECT_EQ(InputErrorOf([] { ReadDrapedMesh("mesh.stl"); }),
+            "mesh.stl: not a mesh this reads: name it .obj or .ply");
 }
 
 TEST(MeshIo, QualityOfKnownTriangles) {

@@ -43,12 +43,35 @@ void WriteObj(const std::string& path, const TriangleMesh& mesh,
 void WritePly(const std::string& path, const TriangleMesh& mesh,
               const std::vector<VertexScalar>& scalars = {});
 
+// How ParseObj takes a face of more than three corners.
+enum class ObjPolygons {
+  kRefuse,  // an InputError naming the line (the default: the solvers' meshes are triangles)
+  kFan,     // split into the fan (0, k, k + 1): exact for convex polygons (scans' quads)
+};
+
 // Reads the vertices and triangles of an OBJ ("v" and "f" lines; "f" entries may be v, v/vt,
 // v/vt/vn or v//vn, negative indices count from the end; other lines are ignored). Throws
-// InputError "<source>:<line>: <problem>" for faces that are not triangles, bad numbers or
-// indices out of range.
-TriangleMesh ParseObj(const std::string& text, const std::string& source);
+// InputError "<source>:<line>: <problem>" for faces that are not triangles (kRefuse) or have
+// fewer than 3 corners, bad numbers or indices out of range.
+TriangleMesh ParseObj(const std::string& text, const std::string& source,
+                      ObjPolygons polygons = ObjPolygons::kRefuse);
 TriangleMesh ReadObj(const std::string& path);
+
+// Reads a PLY (ascii or binary_little_endian): the vertex element's x, y, z (any scalar type)
+// and the face element's vertex_indices (or vertex_index) lists (any count and index type),
+// polygons fanned as ObjPolygons::kFan; other elements and properties are read past. Throws
+// InputError "<source>:<line>: <problem>" (ASCII) or "<source>: <problem>" (binary) for a bad
+// header, a short body, NaN or infinite coordinates, bad or out-of-range indices.
+TriangleMesh ParsePly(const std::string& bytes, const std::string& source);
+// Binary little-endian PLY bytes of a mesh: double x y z, faces as uchar count + int indices
+// (the large meshes of tests and benchmarks; PlyText is the readable one).
+std::string PlyBinaryBytes(const TriangleMesh& mesh);
+
+// A draped mesh from a file, by its extension (any case): .obj (ParseObj with kFan) or .ply
+// (ParsePly), up to 1 GB. Throws InputError naming the path for another extension, a file that
+// cannot be read, or ParseObj's and ParsePly's problems. Positions are as in the file (the
+// caller knows its units).
+TriangleMesh ReadDrapedMesh(const std::string& path);
 
 // Shape and size of a mesh's triangles.
 struct MeshQuality {

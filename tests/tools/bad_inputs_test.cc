@@ -315,7 +315,8 @@ TEST(BadInputs, EverySubcommandHasCases) {
   std::set<std::string> covered;
   for (const Case& c : LoadCases(&errors)) covered.insert(c.args.front());
   for (const char* sub : {"law", "calibrate", "extract", "render-photo", "fit", "fit-seam", "acpm",
-                          "drape", "validate", "synth-profile", "bench"}) {
+                          "drape", "drape-measure", "render-shadow", "validate", "synth-profile",
+                          "bench"}) {
     // A subcommand is listed in --help as "  NAME  description".
     if (help.out.find("  " + std::string(sub) + " ") == std::string::npos) continue;
     EXPECT_TRUE(covered.count(sub)) << "textile " << sub << " has no case in tests/bad_inputs/";

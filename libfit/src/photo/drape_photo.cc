@@ -451,12 +451,17 @@ cv::Mat DrawOverlay(const cv::Mat& photo, const Rig& rig, const MeasuredDrape& m
     cv::cvtColor(photo, out, cv::COLOR_BGRA2BGR);
   else
     out = photo.clone();
+  // At most kOverlayMaxSidePx on the long side (a 20 MP overlay is a 40 MB PNG).
+  const double f = std::min(1.0, kOverlayMaxSidePx / static_cast<double>(std::max(out.cols, out.rows)));
+  if (f < 1.0) cv::resize(out, out, cv::Size(), f, f, cv::INTER_AREA);
   const int thick = std::max(1, std::max(out.cols, out.rows) / 800);
   const Eigen::Vector2d c_mm = m.centre * 1e3;
   auto px = [&](double theta, double r_m) {
     const Eigen::Vector2d p =
         PhotoPxOfPlane(rig, c_mm + 1e3 * r_m * Eigen::Vector2d(std::cos(theta), std::sin(theta)));
-    return cv::Point(static_cast<int>(std::lround(p.x())), static_cast<int>(std::lround(p.y())));
+    // Pixel centres at integers in both images: x_out = (x + 0.5) f - 0.5.
+    return cv::Point(static_cast<int>(std::lround((p.x() + 0.5) * f - 0.5)),
+                     static_cast<int>(std::lround((p.y() + 0.5) * f - 0.5)));
   };
   std::vector<cv::Point> outline, support;
   for (int b = 0; b < m.shadow.angles.size(); ++b)

@@ -20,6 +20,8 @@
 
 namespace textile {
 
+inline constexpr int kOverlayMaxSidePx = 2000;
+
 struct DrapePhotoOptions {
   DrapeMeasureOptions measure;
   // The support's centre in the photo [px]; when not given, the rectified shadow's area
@@ -35,7 +37,8 @@ struct DrapePhotoOptions {
 // the centre, MeasureDrapeShadow (input_kind "photo"). Throws InputError for a photo the rig
 // cannot map, ComputeError "<source>: <why>" for a photo with no shadow, two shadows, a shadow
 // cut by the border, or an outline that is not a closed curve around the support. With
-// `overlay`, it receives the photo (BGR) with the outline, the centre and the nodes drawn on it.
+// `overlay`, it receives the photo (BGR, reduced to at most kOverlayMaxSidePx on its long side)
+// with the outline, the support's circle, the centre and the nodes drawn on it.
 MeasuredDrape MeasureDrapePhoto(const cv::Mat& photo, const Rig& rig,
                                 const DrapePhotoOptions& options, const std::string& source,
                                 cv::Mat* overlay = nullptr);

@@ -8,55 +8,17 @@
 #include <numbers>
 #include <sstream>
 
+#include "top_view.h"
+
 namespace textile {
 namespace {
 
-constexpr int kSize = 800;  // [px] square
-
-struct SurfaceDeleter {
-  void operator()(cairo_surface_t* s) const { cairo_surface_destroy(s); }
-};
-struct ContextDeleter {
-  void operator()(cairo_t* c) const { cairo_destroy(c); }
-};
-
-// Pixels of the picture: x to the right, y up, the specimen's centre in the middle.
-struct View {
-  double half = 0.0;      // [m] from the centre to the image edge
-  double px_per_m = 0.0;  // [px/m]
-  double U(double x) const { return (x + half) * px_per_m; }
-  double V(double y) const { return (half - y) * px_per_m; }
-};
-
-void SetRgb(cairo_t* cr, int r, int g, int b) {
-  cairo_set_source_rgb(cr, r / 255.0, g / 255.0, b / 255.0);
-}
-
-// The shadow's raster, sampled at each pixel's centre, painted straight into the surface.
-void PaintShadow(cairo_surface_t* surface, const DrapeShadow& sh, const View& view) {
-  cairo_surface_flush(surface);
-  unsigned char* data = cairo_image_surface_get_data(surface);
-  const int stride = cairo_image_surface_get_stride(surface);
-  constexpr std::uint32_t kShadow = 0x00323c46;  // RGB (50, 60, 70)
-  for (int v = 0; v < kSize; ++v) {
-    auto* row = reinterpret_cast<std::uint32_t*>(data + static_cast<std::ptrdiff_t>(v) * stride);
-    for (int u = 0; u < kSize; ++u) {
-      const double x = u / view.px_per_m - view.half, y = view.half - v / view.px_per_m;
-      const long i = std::lround((x - sh.origin_x) / sh.cell);
-      const long j = std::lround((y - sh.origin_y) / sh.cell);
-      if (i < 0 || j < 0 || i >= sh.width || j >= sh.height) continue;
-      if (sh.mask[static_cast<size_t>(j) * sh.width + i]) row[u] = kShadow;
-    }
-  }
-  cairo_surface_mark_dirty(surface);
-}
-
-void Circle(cairo_t* cr, const View& view, double x, double y, double radius_px, double width) {
-  cairo_new_path(cr);
-  cairo_arc(cr, view.U(x), view.V(y), radius_px, 0.0, 2.0 * std::numbers::pi);
-  cairo_set_line_width(cr, width);
-  cairo_stroke(cr);
-}
+using plot_internal::Circle;
+using plot_internal::ContextDeleter;
+using plot_internal::SetRgb;
+using plot_internal::SurfaceDeleter;
+using View = plot_internal::TopView;
+constexpr int kSize = plot_internal::kTopViewSize;
 
 // The seams as they lie on the draped cloth: their vertex paths at the seed's positions.
 void DrawSeams(cairo_t* cr, const View& view, const DrapeResult& r, const DrapeSeedResult& s) {
@@ -95,7 +57,7 @@ std::unique_ptr<cairo_surface_t, SurfaceDeleter> DrawScene(const DrapeResult& r,
   const std::unique_ptr<cairo_t, ContextDeleter> cr(cairo_create(surface.get()));
   SetRgb(cr.get(), 250, 250, 250);
   cairo_paint(cr.get());
-  PaintShadow(surface.get(), s.shadow, view);
+  plot_internal::PaintShadow(surface.get(), s.shadow, view, 0x00323c46);
   // Pixel centres sit at half-pixel coordinates in Cairo.
   cairo_translate(cr.get(), 0.5, 0.5);
   SetRgb(cr.get(), 160, 160, 160);

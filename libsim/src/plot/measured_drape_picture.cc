@@ -10,60 +10,18 @@
 #include <string>
 
 #include "textile/sim/core/number_text.h"
+#include "top_view.h"
 
 namespace textile {
 namespace {
 
-constexpr int kSize = 800;  // [px] square
+using plot_internal::Circle;
+using plot_internal::ContextDeleter;
+using plot_internal::SetRgb;
+using plot_internal::SurfaceDeleter;
+using View = plot_internal::TopView;
+constexpr int kSize = plot_internal::kTopViewSize;
 constexpr double kDegree = std::numbers::pi / 180.0;
-
-struct SurfaceDeleter {
-  void operator()(cairo_surface_t* s) const { cairo_surface_destroy(s); }
-};
-struct ContextDeleter {
-  void operator()(cairo_t* c) const { cairo_destroy(c); }
-};
-
-// Pixels of the picture: x to the right, y up, the support's centre in the middle.
-struct View {
-  double half = 0.0;      // [m] from the centre to the image edge
-  double px_per_m = 0.0;  // [px/m]
-  double U(double x) const { return (x + half) * px_per_m; }
-  double V(double y) const { return (half - y) * px_per_m; }
-};
-
-void SetRgb(cairo_t* cr, int r, int g, int b) {
-  cairo_set_source_rgb(cr, r / 255.0, g / 255.0, b / 255.0);
-}
-
-// The shadow's raster, sampled at each pixel's centre, painted straight into the surface.
-void PaintShadow(cairo_surface_t* surface, const DrapeShadow& sh, const View& view) {
-  if (sh.mask.empty() || !(sh.cell > 0.0)) return;
-  cairo_surface_flush(surface);
-  unsigned char* data = cairo_image_surface_get_data(surface);
-  const int stride = cairo_image_surface_get_stride(surface);
-  constexpr std::uint32_t kShadow = 0x00b4bec8;  // RGB (180, 190, 200): light, under the lines
-  for (int v = 0; v < kSize; ++v) {
-    auto* row = reinterpret_cast<std::uint32_t*>(data + static_cast<std::ptrdiff_t>(v) * stride);
-    const double y = view.half - v / view.px_per_m;
-    const long j = std::lround((y - sh.origin_y) / sh.cell);
-    if (j < 0 || j >= sh.height) continue;
-    for (int u = 0; u < kSize; ++u) {
-      const double x = u / view.px_per_m - view.half;
-      const long i = std::lround((x - sh.origin_x) / sh.cell);
-      if (i < 0 || i >= sh.width) continue;
-      if (sh.mask[static_cast<size_t>(j) * sh.width + i]) row[u] = kShadow;
-    }
-  }
-  cairo_surface_mark_dirty(surface);
-}
-
-void Circle(cairo_t* cr, const View& view, double x, double y, double radius_px, double width) {
-  cairo_new_path(cr);
-  cairo_arc(cr, view.U(x), view.V(y), radius_px, 0.0, 2.0 * std::numbers::pi);
-  cairo_set_line_width(cr, width);
-  cairo_stroke(cr);
-}
 
 // The polar outline r(θ) as a closed polyline; dashed for the second drape.
 void DrawOutline(cairo_t* cr, const View& view, const DrapeShadow& sh, bool dashed) {
@@ -148,7 +106,7 @@ bool WriteMeasuredDrapePng(const MeasuredDrape& m, const std::string& file,
   const std::unique_ptr<cairo_t, ContextDeleter> cr(cairo_create(surface.get()));
   SetRgb(cr.get(), 250, 250, 250);
   cairo_paint(cr.get());
-  PaintShadow(surface.get(), m.shadow, view);
+  plot_internal::PaintShadow(surface.get(), m.shadow, view, 0x00b4bec8);
   cairo_translate(cr.get(), 0.5, 0.5);  // pixel centres sit at half-pixel coordinates in Cairo
   SetRgb(cr.get(), 150, 150, 150);
   Circle(cr.get(), view, 0.0, 0.0, m.specimen_radius * view.px_per_m, 1.0);

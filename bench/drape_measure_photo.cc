@@ -6,7 +6,6 @@
 // count mismatches, the found centre's error, gross failures and the time per photo (wall
 // clock with OpenCV's threads, and the CPU time of one thread with OpenCV single-threaded).
 
-#include <time.h>
 
 #include <algorithm>
 #include <chrono>
@@ -26,12 +25,6 @@
 
 namespace textile::bench {
 namespace {
-
-double ThreadCpuSeconds() {
-  timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec + 1e-9 * t.tv_nsec;
-}
 
 // A polar mesh whose projection is r ≤ mean + lobe cos(n θ + φ) + skew cos(θ − ψ) [m].
 TriangleMesh LobedMesh(int nodes, double lobe, double skew, double phase, double skew_angle) {

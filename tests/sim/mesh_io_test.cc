@@ -19,7 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path ScratchDir(const std::string& name) {
-  const fs::path d = fs::path(TEXTILE_BINARY_DIR) / "test_scratch" / ("mesh_io_" + name);
+  fs::path d = fs::path(TEXTILE_BINARY_DIR) / "test_scratch" / ("mesh_io_" + name);
   fs::remove_all(d);
   fs::create_directories(d);
   return d;

@@ -199,7 +199,7 @@ std::string LastError(const std::string& err) {
     ADD_FAILURE() << "no error line in: " << err;
     return {};
   }
-  const std::string last = err.substr(at);
+  std::string last = err.substr(at);
   EXPECT_EQ(testing::CountLines(last), 1) << err;
   return last;
 }

@@ -49,7 +49,7 @@ PhotoScene Strip() {
 }
 
 fs::path WritePhoto(const fs::path& dir, const std::string& name, const PhotoScene& scene) {
-  const fs::path p = dir / name;
+  fs::path p = dir / name;
   cv::imwrite(p.string(), testing::Render(scene).gray);
   return p;
 }
@@ -187,7 +187,7 @@ TEST(CliExtract, BadInputExitsTwoWithOneLineAndNoOutput) {
   const fs::path dir = Scratch("cli_extract_bad");
   const fs::path good = WritePhoto(dir, "good.png", Strip());
   const std::string whole = ReadAll(good);
-  std::ofstream(dir / "empty.png");
+  std::ofstream{dir / "empty.png"}.close();
   std::ofstream(dir / "text.jpg") << "not an image at all\n";
   std::ofstream(dir / "cut.png", std::ios::binary) << whole.substr(0, whole.size() / 3);
   cv::imwrite((dir / "tiny.png").string(), cv::Mat(1, 1, CV_8U, cv::Scalar(3)));

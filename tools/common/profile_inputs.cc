@@ -24,8 +24,11 @@ bool HasImageMagic(const std::string& path) {
   const auto starts = [&](const char* magic, size_t m) {
     return n >= m && std::memcmp(b, magic, m) == 0;
   };
-  return starts("\x89PNG\r\n\x1a\n", 8) || starts("\xFF\xD8\xFF", 3) || starts("II*\0", 4) ||
-         starts("MM\0*", 4) || starts("BM", 2);
+  // TIFF's magic numbers hold a NUL: spelled as arrays, not as literals cut short at it.
+  static constexpr char kTiffLittle[] = {'I', 'I', '*', '\0'};
+  static constexpr char kTiffBig[] = {'M', 'M', '\0', '*'};
+  return starts("\x89PNG\r\n\x1a\n", 8) || starts("\xFF\xD8\xFF", 3) || starts(kTiffLittle, 4) ||
+         starts(kTiffBig, 4) || starts("BM", 2);
 }
 
 bool HasImageExtension(const std::string& path) {
@@ -114,11 +117,16 @@ Eigen::Vector2d ParseEdgePx(const std::string& text) {
 
 nlohmann::json ExtractionJson(const LoadedProfile& in) {
   const ExtractionSummary& r = *in.extraction;
-  return {{"photo", in.source},       {"rig_type", r.rig_type},
-          {"polarity", r.polarity},   {"direction", r.direction},
-          {"trace", r.trace},         {"points", r.profile.size()},
-          {"length_mm", r.length_mm}, {"tip_mm", {r.tip_mm.x(), r.tip_mm.y()}},
-          {"mm_per_px", r.mm_per_px}, {"confidence", ConfidenceJson(r.confidence)},
+  return {{"photo", in.source},
+          {"rig_type", r.rig_type},
+          {"polarity", r.polarity},
+          {"direction", r.direction},
+          {"trace", r.trace},
+          {"points", r.profile.size()},
+          {"length_mm", r.length_mm},
+          {"tip_mm", {r.tip_mm.x(), r.tip_mm.y()}},
+          {"mm_per_px", r.mm_per_px},
+          {"confidence", ConfidenceJson(r.confidence)},
           {"warnings", r.WarningTexts()}};
 }
 
@@ -174,12 +182,15 @@ PhotoInputOptions PhotoFlags::Options() const {
 }
 
 void AddPhotoFlags(CLI::App* sub, PhotoFlags* f) {
-  f->rig_option = sub->add_option(
-      "--rig", f->rig_file, "Rig file (from `textile calibrate`): pixels -> mm in the bending plane");
-  f->scale_option = sub->add_option(
-      "--mm-per-px", f->mm_per_px, "Plain scale for a perpendicular, distortion-free camera [mm/px]");
-  sub->add_option("--edge-px", f->edge,
-                  "Origin override X,Y [px]: the platform edge, or where the strip leaves the clamp");
+  f->rig_option =
+      sub->add_option("--rig", f->rig_file,
+                      "Rig file (from `textile calibrate`): pixels -> mm in the bending plane");
+  f->scale_option =
+      sub->add_option("--mm-per-px", f->mm_per_px,
+                      "Plain scale for a perpendicular, distortion-free camera [mm/px]");
+  sub->add_option(
+      "--edge-px", f->edge,
+      "Origin override X,Y [px]: the platform edge, or where the strip leaves the clamp");
   f->level_option = sub->add_option(
       "--level-deg", f->level_deg,
       "Horizontal = image rows turned by this angle [deg], counter-clockwise as seen (default: "
@@ -188,9 +199,11 @@ void AddPhotoFlags(CLI::App* sub, PhotoFlags* f) {
                   "Line to trace: mid (silhouette mid-line, default), upper or lower boundary "
                   "(oblique views: the lit near edge)")
       ->check(CLI::IsMember({"mid", "upper", "lower"}));
-  sub->add_option("--rig-type", f->rig_type, "auto (default), platform (fail if none is found) or clamp")
+  sub->add_option("--rig-type", f->rig_type,
+                  "auto (default), platform (fail if none is found) or clamp")
       ->check(CLI::IsMember({"auto", "platform", "clamp"}));
-  sub->add_option("--step-mm", f->step_mm, "Profile spacing along the arc length [mm] (default 0.5)");
+  sub->add_option("--step-mm", f->step_mm,
+                  "Profile spacing along the arc length [mm] (default 0.5)");
   sub->add_flag("--accept-guesses", f->accept_guesses,
                 "Take what extraction had to guess (the held end, the tip, a profile failing the "
                 "physics check) instead of failing; each guess becomes a warning");

@@ -126,7 +126,7 @@ cv::Mat Coverage(const Camera& cam, const cv::Mat& ideal, int supersample, Insid
   cv::parallel_for_(cv::Range(0, ideal.rows), [&](const cv::Range& rows) {
     for (int v = rows.start; v < rows.end; ++v)
       for (int u = 0; u < ideal.cols; ++u) {
-        const cv::Vec2f p = ideal.at<cv::Vec2f>(v, u);
+        const cv::Vec2f& p = ideal.at<cv::Vec2f>(v, u);
         centre.at<uchar>(v, u) = at(p[0], p[1]) ? 1 : 0;
       }
   });
@@ -350,7 +350,7 @@ RenderedShadow RenderShadowPhoto(const Vertices& x, const Triangles& triangles,
         const float c = cover.at<float>(v, u);
         double specimen = o.specimen_reflectance;
         if (c > 0.0f && o.texture > 0.0) {
-          const cv::Vec2f p = ideal.at<cv::Vec2f>(v, u);
+          const cv::Vec2f& p = ideal.at<cv::Vec2f>(v, u);
           const Eigen::Vector2d mm =
               (plane_from_image * Eigen::Vector3d(p[0], p[1], 1.0)).hnormalized();
           specimen *= 1.0 + tex.Value(mm.x(), mm.y(), o.texture);

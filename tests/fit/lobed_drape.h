@@ -9,6 +9,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "textile/photo/render_shadow.h"
 #include "textile/sim/mesh/mesh.h"
 
 namespace textile::testing {
@@ -44,6 +45,21 @@ struct LobedDrape {
     return m;
   }
 };
+
+// A 1.1 MP camera (408 x 306 mm at the centre: the lobed shadow, 268 mm across, fits at 10°
+// of tilt) without the chessboard photo (it doubles the rendering), to keep the tests fast.
+inline RenderShadowOptions SmallPhoto(bool board = false) {
+  RenderShadowOptions o;
+  o.width_px = 1200, o.height_px = 900, o.mm_per_px = 0.34;
+  o.render_board = board;
+  return o;
+}
+
+// The lobed drape's mesh, made once.
+inline const TriangleMesh& Lobed() {
+  static const TriangleMesh mesh = LobedDrape{}.Mesh();
+  return mesh;
+}
 
 }  // namespace textile::testing
 

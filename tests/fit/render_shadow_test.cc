@@ -12,19 +12,8 @@
 namespace textile {
 namespace {
 
-// A 1.1 MP camera (408 x 306 mm at the centre: the lobed shadow, 268 mm across, fits at 10°
-// of tilt) without the chessboard photo (it doubles the rendering), to keep the tests fast.
-RenderShadowOptions SmallPhoto(bool board = false) {
-  RenderShadowOptions o;
-  o.width_px = 1200, o.height_px = 900, o.mm_per_px = 0.34;
-  o.render_board = board;
-  return o;
-}
-
-const TriangleMesh& Lobed() {
-  static const TriangleMesh mesh = testing::LobedDrape{}.Mesh();
-  return mesh;
-}
+using testing::Lobed;
+using testing::SmallPhoto;
 
 RenderedShadow Render(const RenderShadowOptions& o) {
   return RenderShadowPhoto(Lobed().vertices, Lobed().triangles, o);

@@ -2,7 +2,9 @@
 // draped mesh, e.g. `textile drape --obj`) with a known truth, and the chessboard photo by the
 // same camera for `textile calibrate` (docs/guide/render-shadow.md).
 
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -41,13 +43,12 @@ std::pair<int, int> ParseSize(const std::string& text) {
 }
 
 void WriteImage(AtomicFile& f, const cv::Mat& image, const std::vector<unsigned char>& jpeg) {
-  const bool as_jpeg =
-      f.path().size() > 4 &&
-      (f.path().ends_with(".jpg") || f.path().ends_with(".JPG") || f.path().ends_with(".jpeg"));
+  std::string ext = std::filesystem::path(f.path()).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const bool as_jpeg = ext == ".jpg" || ext == ".jpeg";
   if (as_jpeg && !jpeg.empty()) {
-    std::ofstream(f.temp_path(), std::ios::binary)
-        .write(reinterpret_cast<const char*>(jpeg.data()),
-               static_cast<std::streamsize>(jpeg.size()));
+    // The rendered JPEG's own bytes (the photo was decoded from them), checked as written.
+    f.Write(std::string_view(reinterpret_cast<const char*>(jpeg.data()), jpeg.size()));
     return;
   }
   std::vector<int> params;
@@ -83,21 +84,13 @@ void Run(const RenderShadowArgs& a) {
   if (a.units != "m" && a.units != "mm")
     throw InputError("--units: m or mm, got '" + a.units + "'");
 
-  TriangleMesh mesh = ReadObj(a.mesh);
-  if (a.units == "mm") mesh.vertices *= 1e-3;
+  const TriangleMesh mesh = ReadDrapedMesh(a.mesh);
   AtomicFileSet outputs;
   AtomicFile& photo_file = outputs.Add(a.out);
   AtomicFile* board_file = a.board.empty() ? nullptr : &outputs.Add(a.board);
   AtomicFile* truth_file = a.truth.empty() ? nullptr : &outputs.Add(a.truth);
   image_codecs::Load();  // a missing codec library fails before the rendering
-  RenderedShadow r;
-  try {
-    r = RenderShadowPhoto(mesh.vertices, mesh.triangles, o);
-  } catch (const InputError& e) {
-    throw InputError(a.mesh + ": " + e.what());
-  } catch (const ComputeError& e) {
-    throw ComputeError(a.mesh + ": " + e.what());
-  }
+  const RenderedShadow r = RenderShadowPhoto(mesh, a.units == "mm" ? 1e-3 : 1.0, o, a.mesh);
   WriteImage(photo_file, r.photo, r.encoded);
   if (board_file) WriteImage(*board_file, r.board, {});
   const std::string truth = RenderedShadowTruthJson(r, o);
@@ -133,7 +126,7 @@ void RegisterRenderShadow(CLI::App& app) {
       "textile render-shadow out/drape.obj -o out/shadow.png --board out/board.png --truth "
       "out/truth.json --tilt-deg 8 --gradient 0.3 --noise 3 --jpeg 90");
   sub->add_option("mesh", a->mesh,
-                  "Draped mesh (OBJ; `textile drape --obj`), support centre at the origin")
+                  "Draped mesh (OBJ or PLY; `textile drape --obj`), z up, support centre at the origin")
       ->required();
   sub->add_option("-o,--out", a->out, "Photo to write (.png or .jpg)")->required();
   sub->add_option("--board", a->board, "Also write the chessboard photo by the same camera");
@@ -159,7 +152,7 @@ void RegisterRenderShadow(CLI::App& app) {
   sub->add_option("--specimen-mm", a->specimen_mm,
                   "Specimen radius for the truth [mm] (default 150)");
   sub->add_option("--support-mm", a->support_mm, "Support radius for the truth [mm] (default 90)");
-  sub->add_option("--units", a->units, "Units of the OBJ: m (default) or mm");
+  sub->add_option("--units", a->units, "Units of the mesh: m (default) or mm");
   sub->add_option("--seed", a->seed, "Random seed of the noise and texture (default 1)");
   sub->add_flag("--json", a->json, "Print one JSON object (the truth) instead of text");
   sub->callback([a] { Run(*a); });

@@ -15,7 +15,6 @@
 
 #include "common/atomic_file.h"
 #include "common/chart_file.h"
-#include "textile/sim/core/polyline.h"
 #include "common/cli.h"
 #include "common/profile_inputs.h"
 #include "textile/fit/direct_fit.h"
@@ -117,10 +116,10 @@ textile::chart::Panel HeldOutPanel(const ValidationSummary& v, const std::vector
                              Num(units::MToMm(m.sigma.rms), 2) + " mm" + (h.ok ? " ok" : " FAIL"),
                     .style = chart::Series::Style::kLineAndMarkers,
                     .color = chart::PaletteColor(static_cast<int>(h.index))};
-    for (size_t j = 0; j < measured.size(); ++j) {
+    // The distances the rms and max were taken over, one per measured point.
+    for (size_t j = 0; j < measured.size() && j < c.distances.size(); ++j) {
       d.x.push_back(units::MToMm(measured.s[j]));
-      d.y.push_back(units::MToMm(
-          DistanceToPolyline(c.model_x, c.model_y, measured.x[j], measured.y[j])));
+      d.y.push_back(units::MToMm(c.distances[j]));
     }
     s_max = std::max(s_max, d.x.empty() ? 0.0 : d.x.back());
     p.series.push_back(std::move(d));

@@ -78,6 +78,7 @@ ProfileComparison CompareWithElastica(const BendingLaw& law, double areal_densit
     const double d = model.residual(j) * 1e-3;
     s2 += d * d;
     c.max = std::max(c.max, std::abs(d));
+    c.distances.push_back(std::abs(d));
   }
   c.rms = std::sqrt(s2 / model.num_points());
   c.tip_dx = model.tip_residual()[0] * 1e-3;
@@ -185,6 +186,7 @@ ProfileComparison CompareWithCurve(const Profile& measured, const std::vector<do
                                            /*extend_ends=*/true);
     s2 += dist * dist;
     c.max = std::max(c.max, dist);
+    c.distances.push_back(dist);
   }
   c.rms = std::sqrt(s2 / static_cast<double>(measured.size()));
   c.tip_dx = c.model_x.back() - measured.x.back();

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -85,6 +86,17 @@ TEST(CompareWithCurve, AgreesWithTheElasticaComparison) {
   EXPECT_NEAR(a.max, b.max, 1e-5);
   EXPECT_NEAR(a.tip_dx, b.tip_dx, 1e-6);
   EXPECT_NEAR(a.tip_dy, b.tip_dy, 1e-6);
+  // Both carry each point's distance, the numbers the rms and max were taken over (what
+  // validate's held-out panel plots).
+  for (const ProfileComparison* c : {&a, &b}) {
+    ASSERT_EQ(c->distances.size(), measured.size());
+    double s2 = 0.0, worst = 0.0;
+    for (const double d : c->distances) s2 += d * d, worst = std::max(worst, d);
+    EXPECT_NEAR(std::sqrt(s2 / measured.size()), c->rms, 1e-12);
+    EXPECT_DOUBLE_EQ(worst, c->max);
+  }
+  for (size_t j = 0; j < measured.size(); ++j)
+    EXPECT_NEAR(a.distances[j], b.distances[j], 1e-5) << j;
 }
 
 TEST(CompareWithCurve, RefusesBadCurves) {

@@ -253,7 +253,9 @@ Levels SeparateLevels(const cv::Mat& flat, const std::string& source) {
   levels.background = MaskedMedian(u8, bg_mask) / to8;
   levels.shadow = MaskedMedian(u8, sh_mask) / to8;
   levels.threshold = 0.5 * (levels.background + levels.shadow);
-  const double contrast = std::abs(levels.background - levels.shadow) / levels.background;
+  // Relative to the brighter level (a black ground has a background of 0).
+  const double contrast = std::abs(levels.background - levels.shadow) /
+                          std::max({levels.background, levels.shadow, 1e-12});
   if (!(contrast >= kMinContrast))
     throw ComputeError(source + ": no shadow found (the two grey levels differ by only " +
                        NumberText(100.0 * contrast, 2) + " %; Otsu's threshold " +

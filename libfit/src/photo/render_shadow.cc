@@ -394,4 +394,21 @@ std::string RenderedShadowTruthJson(const RenderedShadow& r, const RenderShadowO
   return j.dump(2) + "\n";
 }
 
+RenderedShadow RenderShadowPhoto(const TriangleMesh& draped, double metres_per_unit,
+                                 const RenderShadowOptions& o, const std::string& source) {
+  DrapeMeshOptions frame_options;
+  frame_options.measure = o.measure;
+  frame_options.metres_per_unit = metres_per_unit;
+  if (std::string why; !frame_options.Check(&why)) throw InputError(source + ": " + why);
+  const Vertices x = MeshInMeasureFrame(draped, frame_options, source);
+  CheckMeshScale(x, frame_options, source);
+  try {
+    return RenderShadowPhoto(x, draped.triangles, o);
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
+  } catch (const ComputeError& e) {
+    throw ComputeError(source + ": " + e.what());
+  }
+}
+
 }  // namespace textile

@@ -243,7 +243,7 @@ DrapeComparison CompareDrapes(const DrapeResult& r, const MeasuredDrape& measure
                               const DrapeCompareOptions& o) {
   if (std::string why; !o.Check(&why)) throw InputError("drape comparison: " + why);
   if (!r.converged || r.per_seed.empty())
-    throw InputError("drape comparison: the simulated drape did not converge (" + r.message +
+    throw ComputeError("drape comparison: the simulated drape did not converge (" + r.message +
                      "): nothing to compare");
   const double specimen_radius = SimulatedSpecimenRadius(r);
   const double support_radius = std::sqrt(r.support_area / kPi);

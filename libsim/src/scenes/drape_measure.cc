@@ -61,7 +61,10 @@ void CheckNotCut(const DrapeShadow& s, const std::string& source) {
 // the specimen is torn, partial or off centre.
 void CheckCoversSupport(const DrapeShadow& s, const DrapeMeasureOptions& o,
                         const std::string& source) {
-  const int bins = o.outline_bins;
+  // Directions no finer than two cells along the support's edge, so that every one holds cell
+  // centres there (finer outline bins may hold none: coarse cells, many bins).
+  const int bins = std::clamp(static_cast<int>(2.0 * kPi * o.support_radius / (2.0 * s.cell)), 8,
+                              o.outline_bins);
   std::vector<double> reach(bins, -1.0);
   for (int j = 0; j < s.height; ++j) {
     const double y = s.origin_y + j * s.cell;

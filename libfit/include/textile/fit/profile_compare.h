@@ -24,6 +24,7 @@ struct ProfileComparison {
   double tip_dy = 0.0;    // simulated minus measured tip, y [m]
   double clamp_curvature = 0.0;  // κ(0) of the simulated strip [1/m]
   std::vector<double> model_x, model_y;  // the simulated curve, measurement frame [m]
+  std::vector<double> distances;  // each measured point's distance, as rms and max count it [m]
 };
 
 // Simulates the strip (law [SI], areal density [kg/m²], overhang [m]) and compares it with

@@ -103,6 +103,12 @@ struct RenderedShadow {
 RenderedShadow RenderShadowPhoto(const Vertices& x, const Triangles& triangles,
                                  const RenderShadowOptions& options);
 
+// The same for a draped mesh as a file gives it (ReadDrapedMesh: OBJ, PLY), in `metres_per_unit`
+// (1: m, 0.001: mm), z up: its scale is checked as drape-measure checks it (CheckMeshScale:
+// InputError "<source>: ... --units mm?") before it is rendered; messages name `source`.
+RenderedShadow RenderShadowPhoto(const TriangleMesh& draped, double metres_per_unit,
+                                 const RenderShadowOptions& options, const std::string& source);
+
 // The rendered truth as JSON (drape coefficient, nodes, centre_px, scale, the true rig, the
 // board), for `textile render-shadow --truth`.
 std::string RenderedShadowTruthJson(const RenderedShadow& r, const RenderShadowOptions& o);

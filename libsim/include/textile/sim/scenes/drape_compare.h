@@ -123,8 +123,9 @@ struct DrapeComparison {
 void CheckDrapesComparable(const MeasuredDrape& measured, const DrapeOptions& options);
 
 // The comparison (see the top of this file). The simulation's radii are its pattern's: R the
-// outermost vertex's radius, R_s from support_area. Throws InputError for a result that did not
-// converge, options that fail Check, or radii that differ (CheckDrapesComparable's message).
+// outermost vertex's radius, R_s from support_area. Throws ComputeError for a result that did
+// not converge, InputError for options that fail Check or radii that differ
+// (CheckDrapesComparable's message).
 DrapeComparison CompareDrapes(const DrapeResult& simulated, const MeasuredDrape& measured,
                               const DrapeCompareOptions& options);
 

@@ -323,7 +323,7 @@ TEST(DrapeCompare, RefusesUnconvergedResultsAndBadOptions) {
   DrapeResult r = Simulated({Seed(1, Outline(360), 0.62, 6)});
   r.converged = false;
   r.message = "seed 1: 3000 iterations";
-  EXPECT_THROW(CompareDrapes(r, Measured(Outline(360), 0.62, 6), {}), InputError);
+  EXPECT_THROW(CompareDrapes(r, Measured(Outline(360), 0.62, 6), {}), ComputeError);
   std::string why;
   DrapeCompareOptions o;
   EXPECT_TRUE(o.Check(&why));

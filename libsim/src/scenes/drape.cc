@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "drape_stages.h"
+#include "textile/sim/scenes/drape_measure.h"
 #include "textile/sim/solve/cloth_problem.h"
 #include "textile/sim/elements/contact.h"
 #include "textile/sim/core/error.h"
@@ -361,57 +362,6 @@ std::uint8_t& ShadowCell(DrapeShadow* s, int i, int j) {
   return s->mask[static_cast<size_t>(j) * s->width + i];
 }
 
-// Shadow stage 1: the empty grid over the projection and the support, with two empty cells of
-// margin on every side, so the border is outside the shadow.
-DrapeShadow ShadowGrid(const Vertices& x, double cell, double support_radius) {
-  DrapeShadow s;
-  s.cell = cell;
-  const double lo_x = std::min(x.col(0).minCoeff(), -support_radius);
-  const double hi_x = std::max(x.col(0).maxCoeff(), support_radius);
-  const double lo_y = std::min(x.col(1).minCoeff(), -support_radius);
-  const double hi_y = std::max(x.col(1).maxCoeff(), support_radius);
-  const double cells_x = (hi_x - lo_x) / cell, cells_y = (hi_y - lo_y) / cell;
-  if (cells_x * cells_y > 1e8)
-    throw InputError("shadow: the projection spans over 1e8 raster cells");
-  s.width = static_cast<int>(std::ceil(cells_x)) + 5;
-  s.height = static_cast<int>(std::ceil(cells_y)) + 5;
-  s.origin_x = lo_x - 2.0 * cell;
-  s.origin_y = lo_y - 2.0 * cell;
-  s.mask.assign(static_cast<size_t>(s.width) * s.height, 0);
-  return s;
-}
-
-// Shadow stage 2: the cells whose centres a projected triangle covers.
-void RasteriseTriangle(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
-                       DrapeShadow* s) {
-  const double area2 = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-  if (area2 == 0.0) return;  // seen edge-on: its neighbours cover its line
-  const double sign = area2 > 0.0 ? 1.0 : -1.0;
-  const double cell = s->cell;
-  const int i0 = std::max(
-      0, static_cast<int>(std::floor((std::min({a.x(), b.x(), c.x()}) - s->origin_x) / cell)));
-  const int i1 = std::min(
-      s->width - 1,
-      static_cast<int>(std::ceil((std::max({a.x(), b.x(), c.x()}) - s->origin_x) / cell)));
-  const int j0 = std::max(
-      0, static_cast<int>(std::floor((std::min({a.y(), b.y(), c.y()}) - s->origin_y) / cell)));
-  const int j1 = std::min(
-      s->height - 1,
-      static_cast<int>(std::ceil((std::max({a.y(), b.y(), c.y()}) - s->origin_y) / cell)));
-  // Edge functions, inclusive (a cell centre on a shared edge belongs to both triangles).
-  auto edge = [sign](const Eigen::Vector2d& p, const Eigen::Vector2d& q, double px, double py) {
-    return sign * ((q.x() - p.x()) * (py - p.y()) - (q.y() - p.y()) * (px - p.x()));
-  };
-  for (int j = j0; j <= j1; ++j) {
-    const double py = s->origin_y + j * cell;
-    for (int i = i0; i <= i1; ++i) {
-      const double px = s->origin_x + i * cell;
-      if (edge(a, b, px, py) >= 0.0 && edge(b, c, px, py) >= 0.0 && edge(c, a, px, py) >= 0.0)
-        ShadowCell(s, i, j) = 1;
-    }
-  }
-}
-
 }  // namespace
 
 namespace drape_internal {
@@ -518,11 +468,9 @@ DrapeShadow MeasureShadow(const Vertices& x, const Triangles& triangles, double 
   if (!x.allFinite()) throw InputError("shadow: non-finite vertex positions");
   if (triangles.minCoeff() < 0 || triangles.maxCoeff() >= x.rows())
     throw InputError("shadow: triangle index out of range");
-  DrapeShadow s = ShadowGrid(x, cell, support_radius);
-  for (int f = 0; f < triangles.rows(); ++f)
-    RasteriseTriangle(x.row(triangles(f, 0)).head<2>().transpose(),
-                      x.row(triangles(f, 1)).head<2>().transpose(),
-                      x.row(triangles(f, 2)).head<2>().transpose(), &s);
+  // Stages 1-2, shared with measured drapes: the grid over the projection and the support, and
+  // the cells whose centres a projected triangle covers.
+  DrapeShadow s = RasteriseFabric(x, triangles, Eigen::Vector2d::Zero(), cell, support_radius);
   AddSupportShadow(support_radius, &s);
   FloodFromBorder(&s);
   MeasureOutline(bins, &s);

@@ -16,6 +16,7 @@
 #include "common/atomic_file.h"
 #include "common/cli.h"
 #include "textile/sim/core/error.h"
+#include "textile/sim/io/json_text.h"
 #include "textile/sim/core/units.h"
 #include "textile/sim/io/mesh_io.h"
 #include "textile/sim/law/material.h"
@@ -309,8 +310,6 @@ nlohmann::json ComparisonJson(const DrapeComparison& c, const DrapeArgs& a) {
                      {"outline_rms_mm", units::MToMm(s.outline.rms)},
                      {"outline_rms_unrotated_mm", units::MToMm(s.outline.rms_unrotated)},
                      {"best_rotation_deg", s.outline.rotation / kDegree}});
-  nlohmann::json notes = nlohmann::json::array();
-  for (const Note& n : c.notes) notes.push_back({{"code", n.code}, {"text", n.text}});
   return {{"measured_file", a.compare},
           {"measured_source", c.measured_source},
           {"measured_dc", c.measured_dc},
@@ -334,7 +333,7 @@ nlohmann::json ComparisonJson(const DrapeComparison& c, const DrapeArgs& a) {
           {"outline_ok", c.outline_judged ? nlohmann::json(c.outline_ok) : nlohmann::json()},
           {"seeds", seeds},
           {"verdict", c.Verdict()},
-          {"notes", notes}};
+          {"notes", NotesJson(c.notes)}};
 }
 
 // The comparison block of the text output.

@@ -79,7 +79,7 @@ DrapeMeasureOptions MeasureOptions(const DrapeMeasureArgs& a) {
   DrapeMeasureOptions o;
   o.specimen_radius = units::MmToM(a.specimen_mm);
   o.support_radius = units::MmToM(a.support_mm);
-  if (std::string why; !o.Check(&why)) throw InputError("--support-mm: " + why);
+  if (std::string why; !o.Check(&why)) throw InputError("drape-measure: " + why);
   return o;
 }
 

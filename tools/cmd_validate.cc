@@ -22,6 +22,7 @@
 #include "textile/fit/profile_compare.h"
 #include "textile/fit/validate.h"
 #include "textile/sim/core/error.h"
+#include "textile/sim/io/json_text.h"
 #include "textile/sim/law/material.h"
 #include "textile/sim/core/note.h"
 #include "textile/sim/core/units.h"
@@ -61,13 +62,6 @@ nlohmann::json ModelJson(const ModelComparison& k) {
 
 // JSON null for a value that is not available (an undetermined constant's σ).
 nlohmann::json OrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
-
-// validate.json's `notes`: [{"code", "text"}].
-nlohmann::json NotesJson(const std::vector<Note>& notes) {
-  nlohmann::json list = nlohmann::json::array();
-  for (const Note& n : notes) list.push_back({{"code", n.code}, {"text", n.text}});
-  return list;
-}
 
 // The material with the fit report `textile fit` writes (fit_report.h), for the direct fit with
 // default options that validate runs, and the verdicts.

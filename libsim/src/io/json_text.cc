@@ -62,4 +62,10 @@ nlohmann::json ParseJsonText(const std::string& text, const std::string& source)
   }
 }
 
+nlohmann::json NotesJson(const std::vector<Note>& notes) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const Note& n : notes) list.push_back({{"code", n.code}, {"text", n.text}});
+  return list;
+}
+
 }  // namespace textile

@@ -109,12 +109,6 @@ void CheckWithinSpecimen(const MeasuredDrape& m, const std::string& source,
                                              ": a stretched specimen or a loose scale"});
 }
 
-nlohmann::json NotesJson(const std::vector<Note>& notes) {
-  nlohmann::json j = nlohmann::json::array();
-  for (const Note& n : notes) j.push_back({{"code", n.code}, {"text", n.text}});
-  return j;
-}
-
 }  // namespace
 
 bool DrapeMeasureOptions::Check(std::string* why) const {

@@ -8,6 +8,9 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
+
+#include "textile/sim/core/note.h"
 
 namespace textile {
 
@@ -16,6 +19,9 @@ namespace textile {
 // \"k\" in \"a.b\" ..." for an object that repeats a key (JSON leaves it open; the last would
 // win silently).
 nlohmann::json ParseJsonText(const std::string& text, const std::string& source);
+
+// Notes as JSON results list them: [{"code": ..., "text": ...}, ...] ([] for none).
+nlohmann::json NotesJson(const std::vector<Note>& notes);
 
 }  // namespace textile
 

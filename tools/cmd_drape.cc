@@ -301,41 +301,6 @@ nlohmann::json NumberOrNull(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
 }
 
-nlohmann::json ComparisonJson(const DrapeComparison& c, const DrapeArgs& a) {
-  nlohmann::json seeds = nlohmann::json::array();
-  for (const DrapeSeedComparison& s : c.per_seed)
-    seeds.push_back({{"seed", s.seed},
-                     {"drape_coefficient", s.drape_coefficient},
-                     {"nodes", s.nodes},
-                     {"outline_rms_mm", units::MToMm(s.outline.rms)},
-                     {"outline_rms_unrotated_mm", units::MToMm(s.outline.rms_unrotated)},
-                     {"best_rotation_deg", s.outline.rotation / kDegree}});
-  return {{"measured_file", a.compare},
-          {"measured_source", c.measured_source},
-          {"measured_dc", c.measured_dc},
-          {"simulated_dc", c.simulated_dc},
-          {"simulated_dc_sd", c.simulated_dc_sd},
-          {"simulated_dc_pi_r2", c.simulated_dc_pi_r2},
-          {"dc_difference", c.dc_difference},
-          {"dc_tol", c.dc_tolerance},
-          {"dc_ok", c.dc_ok},
-          {"measured_nodes", c.measured_nodes},
-          {"simulated_nodes", c.simulated_nodes},
-          {"simulated_nodes_sd", c.simulated_nodes_sd},
-          {"node_tol", c.node_tolerance},
-          {"nodes_ok", c.nodes_ok},
-          {"outline_rms_mm", units::MToMm(c.outline_rms)},
-          {"outline_rms_sd_mm", units::MToMm(c.outline_rms_sd)},
-          {"outline_rms_unrotated_mm", units::MToMm(c.outline_rms_unrotated)},
-          {"best_rotation_deg", c.best_rotation / kDegree},
-          {"outline_tol_mm",
-           c.outline_judged ? nlohmann::json(units::MToMm(c.outline_tolerance)) : nlohmann::json()},
-          {"outline_ok", c.outline_judged ? nlohmann::json(c.outline_ok) : nlohmann::json()},
-          {"seeds", seeds},
-          {"verdict", c.Verdict()},
-          {"notes", NotesJson(c.notes)}};
-}
-
 // The comparison block of the text output.
 void PrintComparison(const DrapeComparison& c, const DrapeArgs& a, bool several_seeds) {
   const auto ok = [](bool b) { return b ? "ok" : "FAIL"; };
@@ -582,7 +547,10 @@ void Run(const DrapeArgs& a) {
 
   const DrapeSeedResult& first = r.per_seed.front();
   nlohmann::json j = ResultJson(r, o, m, a);
-  if (comparison) j["comparison"] = ComparisonJson(*comparison, a);
+  if (comparison) {
+    j["comparison"] = DrapeComparisonJson(*comparison);
+    j["comparison"]["measured_file"] = a.compare;
+  }
   j["outline_csv"] = outline_file.path();
   outline_file.Write(OutlineCsv(first.shadow));  // drape_measure.h: the shared columns
   if (png_file) {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <numbers>
 
@@ -147,6 +149,24 @@ TEST(DrapeCompare, ScaledOutlineGivesItsKnownRms) {
   EXPECT_NEAR(c.outline_rms, 0.04 * RmsOf(r), 1e-7);
   EXPECT_NEAR(c.outline_rms_unrotated, 0.04 * RmsOf(r), 1e-12);
   EXPECT_NEAR(c.best_rotation / kDegree, 0.0, 0.05);
+}
+
+// drape.json's `comparison`: the struct's figures in mm and degrees, its verdict and notes as
+// data; the measured file's name is the caller's to add.
+TEST(DrapeCompare, JsonCarriesTheFiguresTheVerdictAndTheNotes) {
+  const DrapeComparison c = CompareDrapes(Simulated({Seed(1, Outline(360), 0.60, 6)}),
+                                          Measured(Outline(360), 0.65, 6), DrapeCompareOptions{});
+  const nlohmann::json j = DrapeComparisonJson(c);
+  EXPECT_EQ(j["verdict"], "fail");
+  EXPECT_EQ(j["dc_ok"], false);
+  EXPECT_DOUBLE_EQ(j["measured_dc"].get<double>(), c.measured_dc);
+  EXPECT_DOUBLE_EQ(j["dc_difference"].get<double>(), c.dc_difference);
+  EXPECT_DOUBLE_EQ(j["outline_rms_mm"].get<double>(), c.outline_rms * 1e3);
+  EXPECT_TRUE(j["outline_tol_mm"].is_null());
+  ASSERT_EQ(j["seeds"].size(), c.per_seed.size());
+  ASSERT_EQ(j["notes"].size(), c.notes.size());
+  EXPECT_EQ(j["notes"][0]["code"], "dc_differs");
+  EXPECT_FALSE(j.contains("measured_file"));
 }
 
 TEST(DrapeCompare, DcOffByMoreThanTheToleranceFailsWithTheNote) {

@@ -8,11 +8,13 @@
 #include "textile/sim/core/error.h"
 #include "textile/sim/core/number_text.h"
 #include "textile/sim/core/units.h"
+#include "textile/sim/io/json_text.h"
 
 namespace textile {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
+constexpr double kDegree = kPi / 180.0;
 // The radii compared are the flags' values (mm, as typed), not measured lengths: 0.01 mm tells
 // another test from round-off in the mm ↔ m conversions and the mesh's circle.
 constexpr double kRadiusMatch = 1e-5;  // [m]
@@ -284,6 +286,40 @@ DrapeComparison CompareDrapes(const DrapeResult& r, const MeasuredDrape& measure
   c.pass = c.dc_ok && c.nodes_ok && c.outline_ok;
   TrustNotes(r, o, &c);
   return c;
+}
+
+nlohmann::json DrapeComparisonJson(const DrapeComparison& c) {
+  nlohmann::json seeds = nlohmann::json::array();
+  for (const DrapeSeedComparison& s : c.per_seed)
+    seeds.push_back({{"seed", s.seed},
+                     {"drape_coefficient", s.drape_coefficient},
+                     {"nodes", s.nodes},
+                     {"outline_rms_mm", units::MToMm(s.outline.rms)},
+                     {"outline_rms_unrotated_mm", units::MToMm(s.outline.rms_unrotated)},
+                     {"best_rotation_deg", s.outline.rotation / kDegree}});
+  return {{"measured_source", c.measured_source},
+          {"measured_dc", c.measured_dc},
+          {"simulated_dc", c.simulated_dc},
+          {"simulated_dc_sd", c.simulated_dc_sd},
+          {"simulated_dc_pi_r2", c.simulated_dc_pi_r2},
+          {"dc_difference", c.dc_difference},
+          {"dc_tol", c.dc_tolerance},
+          {"dc_ok", c.dc_ok},
+          {"measured_nodes", c.measured_nodes},
+          {"simulated_nodes", c.simulated_nodes},
+          {"simulated_nodes_sd", c.simulated_nodes_sd},
+          {"node_tol", c.node_tolerance},
+          {"nodes_ok", c.nodes_ok},
+          {"outline_rms_mm", units::MToMm(c.outline_rms)},
+          {"outline_rms_sd_mm", units::MToMm(c.outline_rms_sd)},
+          {"outline_rms_unrotated_mm", units::MToMm(c.outline_rms_unrotated)},
+          {"best_rotation_deg", c.best_rotation / kDegree},
+          {"outline_tol_mm",
+           c.outline_judged ? nlohmann::json(units::MToMm(c.outline_tolerance)) : nlohmann::json()},
+          {"outline_ok", c.outline_judged ? nlohmann::json(c.outline_ok) : nlohmann::json()},
+          {"seeds", seeds},
+          {"verdict", c.Verdict()},
+          {"notes", NotesJson(c.notes)}};
 }
 
 }  // namespace textile

@@ -29,6 +29,7 @@
 // Units: SI inside (m, rad).
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -128,6 +129,10 @@ void CheckDrapesComparable(const MeasuredDrape& measured, const DrapeOptions& op
 // (CheckDrapesComparable's message).
 DrapeComparison CompareDrapes(const DrapeResult& simulated, const MeasuredDrape& measured,
                               const DrapeCompareOptions& options);
+
+// The comparison as drape.json's `comparison` (mm and degrees; docs/guide/drape.md): every
+// figure, the per-seed rows, the verdict and the notes; the caller adds `measured_file`.
+nlohmann::json DrapeComparisonJson(const DrapeComparison& comparison);
 
 }  // namespace textile
 

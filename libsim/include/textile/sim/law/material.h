@@ -14,10 +14,13 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "textile/sim/law/bending_law.h"
+#include "textile/sim/core/note.h"
+#include "textile/sim/law/membrane_law.h"
 
 namespace textile {
 
@@ -25,6 +28,9 @@ namespace textile {
 // MembraneLame::compression): below it Newton's steps meet a nearly singular Hessian wherever
 // a drape compresses the sheet.
 constexpr double kMinCompressionRatio = 1e-3;
+// The compression ratio a material gets when its file gives none (docs/methods/drapemeter.md,
+// "Compression": why this value).
+constexpr double kDefaultCompressionRatio = 1.0;
 
 struct Material {
   std::string name;                          // free text
@@ -32,12 +38,22 @@ struct Material {
   BendingLaw bending = BendingLaw::FromKes(0.1, 0.1, 0.0);  // warp law (or the only law)
   std::optional<BendingLaw> bending_weft;    // weft law, when anisotropic
   double beta = 1.0;                         // linear bending stiffness factor β (section 3.4)
-  double stretch_stiffness = 1000.0;  // membrane stiffness [N/m] (docs/spec/physics.md default)
-  double poisson = 0.3;                      // Poisson ratio [-]
+  // The membrane (docs/methods/materials.md, "Membrane"). Isotropic (stabilised StVK of
+  // docs/spec/physics.md) with stretch_stiffness and poisson when the file gives only
+  // stretch.stiffness_N_per_m / stretch.poisson; orthotropic (membrane_law.h) when it gives
+  // stretch.warp, stretch.weft or stretch.shear, or no membrane at all (documented defaults).
+  double stretch_stiffness = 1000.0;  // isotropic membrane stiffness [N/m]
+  double poisson = 0.3;                      // isotropic Poisson ratio [-]
+  std::optional<OrthotropicMembrane> orthotropic;  // set: the orthotropic membrane
+  // The fields the file left out whose documented defaults the membrane uses ("stretch.shear",
+  // "stretch.compression_ratio", ...), in file order; each run says so (MaterialDefaultNotes).
+  std::vector<std::string> defaulted;
   // The membrane's stiffness against compression as a fraction of its stretch stiffness [-]
   // (stretch.compression_ratio, kMinCompressionRatio .. 1): 1, the default, is the stabilised
   // StVK of docs/spec/physics.md, as stiff in compression as in tension (membrane.h).
   double compression_ratio = 1.0;
+  // Strain a yarn takes at full stiffness before buckling (stretch.buckling_strain) [-], ≥ 0.
+  double buckling_strain = 0.0;
   double friction = 0.3;                     // Coulomb coefficient against supports [-]
   nlohmann::json fit;                        // the `fit` report when a fit made this file
   nlohmann::json extra;                      // "notes"/"assumptions"/"source", carried through
@@ -48,11 +64,24 @@ struct Material {
   //   if (std::string why; !m.Check(&why)) throw InputError("fitted law: " + why);
   bool Check(std::string* why) const;
 
+  MembraneCompression Compression() const { return {compression_ratio, buckling_strain}; }
+  // A representative small-strain stretch modulus [N/m]: stretch_stiffness, or the mean of the
+  // orthotropic warp and weft curves' small-strain moduli (penalty and friction scales).
+  double MembraneModulus() const {
+    return orthotropic ? 0.5 * (orthotropic->warp.SmallStrainModulus() +
+                                orthotropic->weft.SmallStrainModulus())
+                       : stretch_stiffness;
+  }
+
   // The warp law with β applied (M_β = β M), which every simulation uses.
   BendingLaw EffectiveLaw() const { return bending.Scaled(beta); }
   // The weft law with β applied, or the warp law when the material is isotropic.
   BendingLaw EffectiveWeftLaw() const { return (bending_weft ? *bending_weft : bending).Scaled(beta); }
 };
+
+// One note a default the material's membrane uses (code "membrane_default"), naming the field,
+// the value and docs/methods/materials.md; none when the file gave every membrane field.
+std::vector<Note> MaterialDefaultNotes(const Material& material);
 
 // Parses material JSON text; `source` names the file in messages. Throws InputError.
 Material ParseMaterialJson(const std::string& text, const std::string& source);

@@ -388,7 +388,7 @@ TEST(MaterialMembrane, StiffnessAndPoissonAloneAreTheIsotropicMembrane) {
 
 TEST(MaterialMembrane, NoMembraneFieldIsTheDefaultOrthotropicMembrane) {
   for (const std::string& text :
-       {"{" + kLaw + "}", "{" + kLaw + R"(, "stretch": {})", "{" + kLaw + R"(, "stretch": {"compression_ratio": 0.05}})"}) {
+       {"{" + kLaw + "}", "{" + kLaw + R"(, "stretch": {}})", "{" + kLaw + R"(, "stretch": {"compression_ratio": 0.05}})"}) {
     const Material m = ParseMaterialJson(text, "defaults.json");
     ASSERT_TRUE(m.orthotropic.has_value()) << text;
     const OrthotropicMembrane d = DefaultOrthotropicMembrane();

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -71,10 +73,10 @@ TEST(Material, DefaultsAndOptionalFields) {
   EXPECT_DOUBLE_EQ(m.friction, 0.5);
 }
 
-TEST(Material, CompressionRatioDefaultsToOneAndSurvivesTheRoundTrip) {
+TEST(Material, CompressionRatioDefaultsAndSurvivesTheRoundTrip) {
   const std::string law = R"("bending": {"units": "kes", "b1": 0.1, "b2": 0.0892, "c1": -0.0092})";
   const Material plain = ParseMaterialJson(R"({"areal_density_gsm": 180, )" + law + "}", "plain");
-  EXPECT_EQ(plain.compression_ratio, 1.0);
+  EXPECT_EQ(plain.compression_ratio, kDefaultCompressionRatio);
   EXPECT_FALSE(MaterialToJson(plain)["stretch"].contains("compression_ratio"));
   const Material soft = ParseMaterialJson(
       R"({"areal_density_gsm": 180, )" + law + R"(, "stretch": {"compression_ratio": 0.02}})",
@@ -220,7 +222,28 @@ INSTANTIATE_TEST_SUITE_P(
                       BadCase{"spline-missing-moment.json", "bending.moment", "missing"},
                       BadCase{"spline-sd-negative.json", "bending.moment_sd[1]", "must be >= 0"},
                       BadCase{"spline-kappa-not-array.json", "bending.kappa", "must be an array"},
-                      BadCase{"spline-weft-invalid.json", "bending_weft.kappa[2]", "is not above"}),
+                      BadCase{"spline-weft-invalid.json", "bending_weft.kappa[2]", "is not above"},
+                      BadCase{"membrane-curve-not-monotone.json", "stretch.warp.curve[1]", "is not monotone"},
+                      BadCase{"membrane-curve-percent.json", "stretch.warp.curve[0]", "strain is a fraction"},
+                      BadCase{"membrane-shear-negative.json", "stretch.shear.modulus_N_per_m", "must be > 0 N/m"},
+                      BadCase{"membrane-shear-zero.json", "stretch.shear.kes.G_gf_per_cm_deg", "must be > 0 gf/cm/deg"},
+                      BadCase{"membrane-emt-above-100.json", "stretch.warp.kes.EMT_percent", "at most 100 %"},
+                      BadCase{"membrane-emt-zero.json", "stretch.warp.kes.EMT_percent", "must be > 0 %"},
+                      BadCase{"membrane-emt-fraction.json", "stretch.warp.kes.EMT_percent", "looks like a fraction: EMT is in %"},
+                      BadCase{"membrane-lt-outside.json", "stretch.weft.kes.LT", "must lie in (0.1, 1.25)"},
+                      BadCase{"membrane-wt-disagrees.json", "stretch.warp.kes.WT_gfcm_per_cm2", "disagrees with LT"},
+                      BadCase{"membrane-compression-tiny.json", "stretch.compression_ratio", "[0.001, 1]"},
+                      BadCase{"membrane-two-forms.json", "stretch.warp", "got modulus_N_per_m and kes"},
+                      BadCase{"membrane-shear-in-newton.json", "stretch.shear.kes.G_gf_per_cm_deg", "looks like N/m: use modulus_N_per_m"},
+                      BadCase{"membrane-poisson-orthotropic.json", "stretch.poisson", "no Poisson coupling"},
+                      BadCase{"membrane-stiffness-and-warp.json", "stretch.stiffness_N_per_m", "ambiguous"},
+                      BadCase{"membrane-buckling-large.json", "stretch.buckling_strain", "[0, 0.05]"},
+                      BadCase{"membrane-kes-no-lt.json", "stretch.warp.kes", "needs LT or WT_gfcm_per_cm2"},
+                      BadCase{"membrane-unknown-key.json", "stretch.warp.modulus", "unknown field"},
+                      BadCase{"membrane-eb5-zero.json", "stretch.shear.fast.EB5_percent", "must be > 0 %"},
+                      BadCase{"membrane-e100-above-100.json", "stretch.weft.fast.E100_percent", "at most 100 %"},
+                      BadCase{"membrane-2hg-negative.json", "stretch.shear.kes.2HG_gf_per_cm", "must be >= 0 gf/cm"},
+                      BadCase{"membrane-empty-form.json", "stretch.warp", "needs one of modulus_N_per_m, curve, kes, fast"}),
     [](const auto& info) {
       std::string n = info.param.file;
       n = n.substr(0, n.find('.'));
@@ -307,6 +330,273 @@ TEST(MaterialCheck, AcceptsTheSamplesAndTheDefaults) {
   Material m;
   m.areal_density = 0.2;
   EXPECT_TRUE(m.Check(nullptr));
+}
+
+}  // namespace
+}  // namespace textile
+
+namespace textile {
+namespace {
+
+// The membrane block (docs/methods/materials.md, "Membrane").
+const std::string kLaw =
+    R"("areal_density_gsm": 200, "bending": {"units": "kes", "b1": 0.1, "b2": 0.0892, "c1": -0.0092})";
+
+Material WithStretch(const std::string& stretch) {
+  return ParseMaterialJson("{" + kLaw + R"(, "stretch": )" + stretch + "}", "membrane.json");
+}
+
+// The message ParseMaterialJson gives for this stretch block ("" when accepted).
+std::string StretchError(const std::string& stretch) {
+  try {
+    WithStretch(stretch);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+bool Lists(const Material& m, const std::string& field) {
+  return std::find(m.defaulted.begin(), m.defaulted.end(), field) != m.defaulted.end();
+}
+
+// Forces of two curves agree at strains across the KES range, in tension and compression.
+void ExpectSameCurve(const TensileCurve& a, const TensileCurve& b, const std::string& what) {
+  constexpr double kRelative = 1e-12;  // the brief's round-trip tolerance
+  for (double e : {-0.01, 0.001, 0.005, 0.01, 0.03, 0.06, 0.2}) {
+    EXPECT_NEAR(a.Force(e), b.Force(e), kRelative * std::abs(b.Force(e))) << what << " at " << e;
+  }
+}
+
+TEST(MaterialMembrane, StiffnessAndPoissonAloneAreTheIsotropicMembrane) {
+  const Material both = WithStretch(R"({"stiffness_N_per_m": 2000, "poisson": 0.2})");
+  EXPECT_FALSE(both.orthotropic.has_value());
+  EXPECT_DOUBLE_EQ(both.stretch_stiffness, 2000.0);
+  EXPECT_DOUBLE_EQ(both.poisson, 0.2);
+  EXPECT_EQ(both.defaulted, std::vector<std::string>{"stretch.compression_ratio"});
+  EXPECT_DOUBLE_EQ(both.MembraneModulus(), 2000.0);
+  const Material no_poisson = WithStretch(R"({"stiffness_N_per_m": 2000})");
+  EXPECT_FALSE(no_poisson.orthotropic.has_value());
+  EXPECT_DOUBLE_EQ(no_poisson.poisson, kDefaultPoisson);
+  EXPECT_TRUE(Lists(no_poisson, "stretch.poisson"));
+  EXPECT_FALSE(Lists(no_poisson, "stretch.stiffness_N_per_m"));
+  // The samples are isotropic, as before.
+  const Material fig8 = ReadMaterial(kSamples + "pabst-fig8.json");
+  EXPECT_FALSE(fig8.orthotropic.has_value());
+  EXPECT_DOUBLE_EQ(fig8.stretch_stiffness, 1000.0);
+}
+
+TEST(MaterialMembrane, NoMembraneFieldIsTheDefaultOrthotropicMembrane) {
+  for (const std::string& text :
+       {"{" + kLaw + "}", "{" + kLaw + R"(, "stretch": {}})", "{" + kLaw + R"(, "stretch": {"compression_ratio": 0.05}})"}) {
+    const Material m = ParseMaterialJson(text, "defaults.json");
+    ASSERT_TRUE(m.orthotropic.has_value()) << text;
+    const OrthotropicMembrane d = DefaultOrthotropicMembrane();
+    ExpectSameCurve(m.orthotropic->warp, d.warp, "warp");
+    ExpectSameCurve(m.orthotropic->weft, d.weft, "weft");
+    EXPECT_EQ(m.orthotropic->shear_modulus, d.shear_modulus);
+    for (const char* f : {"stretch.warp", "stretch.weft", "stretch.shear"})
+      EXPECT_TRUE(Lists(m, f)) << f << " in " << text;
+    EXPECT_EQ(Lists(m, "stretch.compression_ratio"),
+              text.find("compression_ratio") == std::string::npos);
+  }
+  // The defaults are the documented KES values: EMT meets 500 gf/cm, G = 0.8 gf/cm/deg.
+  const OrthotropicMembrane d = DefaultOrthotropicMembrane();
+  EXPECT_NEAR(d.warp.Force(kDefaultWarpEmtPercent / 100), kKesMaxLoad, 1e-9 * kKesMaxLoad);
+  EXPECT_NEAR(d.weft.Force(kDefaultWeftEmtPercent / 100), kKesMaxLoad, 1e-9 * kKesMaxLoad);
+  EXPECT_GT(d.warp.SmallStrainModulus(), d.weft.SmallStrainModulus());  // warp the stiffer
+  EXPECT_NEAR(d.shear_modulus, 45.0, 0.1);
+}
+
+TEST(MaterialMembrane, ReadsEveryTensileForm) {
+  const Material m = WithStretch(
+      R"({"warp": {"modulus_N_per_m": 1500},
+          "weft": {"curve": [[0.01, 5], [0.02, 20], [0.04, 150], [0.05, 490]]},
+          "shear": {"modulus_N_per_m": 30}})");
+  ASSERT_TRUE(m.orthotropic.has_value());
+  ExpectSameCurve(m.orthotropic->warp, TensileCurve::Linear(1500.0), "modulus");
+  ExpectSameCurve(m.orthotropic->weft,
+                  TensileCurve::FromPoints({0.01, 0.02, 0.04, 0.05}, {5, 20, 150, 490}), "curve");
+  EXPECT_EQ(m.orthotropic->shear_modulus, 30.0);
+  EXPECT_EQ(m.defaulted, std::vector<std::string>{"stretch.compression_ratio"});
+
+  const Material kes = WithStretch(
+      R"({"warp": {"kes": {"EMT_percent": 4, "LT": 0.65}},
+          "weft": {"kes": {"EMT_percent": 6, "WT_gfcm_per_cm2": 9.75}},
+          "shear": {"kes": {"G_gf_per_cm_deg": 0.8, "2HG_gf_per_cm": 1.2}}})");
+  ExpectSameCurve(kes.orthotropic->warp, TensileCurveFromKes(4.0, 0.65), "kes LT");
+  // WT alone gives LT = WT / (½·500·EMT/100) = 9.75 / 15 = 0.65.
+  ExpectSameCurve(kes.orthotropic->weft, TensileCurveFromKes(6.0, 9.75 / 15.0), "kes WT");
+  EXPECT_EQ(kes.orthotropic->shear_modulus, KesShearToNewtonPerMetre(0.8));
+  // LT and WT both, agreeing within 5 %: LT decides.
+  const Material both = WithStretch(
+      R"({"warp": {"kes": {"EMT_percent": 4, "LT": 0.65, "WT_gfcm_per_cm2": 6.7}}})");
+  ExpectSameCurve(both.orthotropic->warp, TensileCurveFromKes(4.0, 0.65), "kes LT and WT");
+
+  const Material fast =
+      WithStretch(R"({"warp": {"fast": {"E100_percent": 2}}, "shear": {"fast": {"EB5_percent": 3}}})");
+  ExpectSameCurve(fast.orthotropic->warp, TensileCurveFromFastE100(2.0), "fast");
+  EXPECT_DOUBLE_EQ(fast.orthotropic->shear_modulus, 123.0 / 3.0);
+  EXPECT_TRUE(Lists(fast, "stretch.weft"));
+  EXPECT_FALSE(Lists(fast, "stretch.warp"));
+  EXPECT_FALSE(Lists(fast, "stretch.shear"));
+}
+
+TEST(MaterialMembrane, StiffnessBesideShearAloneIsBothYarnModuli) {
+  const Material m = WithStretch(R"({"stiffness_N_per_m": 800, "shear": {"modulus_N_per_m": 40}})");
+  ASSERT_TRUE(m.orthotropic.has_value());
+  ExpectSameCurve(m.orthotropic->warp, TensileCurve::Linear(800.0), "warp");
+  ExpectSameCurve(m.orthotropic->weft, TensileCurve::Linear(800.0), "weft");
+  EXPECT_DOUBLE_EQ(m.MembraneModulus(), 800.0);
+  EXPECT_FALSE(Lists(m, "stretch.warp"));
+  EXPECT_FALSE(Lists(m, "stretch.weft"));
+  // Refused: the stiffness beside a direction, and any Poisson ratio with the orthotropic sheet.
+  EXPECT_NE(StretchError(R"({"stiffness_N_per_m": 800, "weft": {"modulus_N_per_m": 900}})")
+                .find("membrane.json: stretch.stiffness_N_per_m: ambiguous"),
+            std::string::npos);
+  EXPECT_NE(StretchError(R"({"poisson": 0.3, "shear": {"modulus_N_per_m": 40}})")
+                .find("membrane.json: stretch.poisson: "),
+            std::string::npos);
+}
+
+TEST(MaterialMembrane, CompressionFieldsAndTheirDefault) {
+  const Material m = WithStretch(R"({"compression_ratio": 0.02, "buckling_strain": 0.003})");
+  EXPECT_DOUBLE_EQ(m.Compression().ratio, 0.02);
+  EXPECT_DOUBLE_EQ(m.Compression().buckling_strain, 0.003);
+  EXPECT_FALSE(Lists(m, "stretch.compression_ratio"));
+  const Material plain = WithStretch(R"({"stiffness_N_per_m": 1000})");
+  EXPECT_EQ(plain.compression_ratio, kDefaultCompressionRatio);
+  EXPECT_EQ(plain.buckling_strain, 0.0);
+  EXPECT_TRUE(Lists(plain, "stretch.compression_ratio"));
+  EXPECT_FALSE(Lists(plain, "stretch.buckling_strain"));  // 0 is the model's plain form
+  // The ends of both ranges are accepted.
+  EXPECT_EQ(StretchError(R"({"compression_ratio": 0.001, "buckling_strain": 0.05})"), "");
+  EXPECT_EQ(StretchError(R"({"compression_ratio": 1, "buckling_strain": 0})"), "");
+  EXPECT_NE(StretchError(R"({"buckling_strain": -0.001})").find("stretch.buckling_strain"),
+            std::string::npos);
+}
+
+TEST(MaterialMembrane, KesPlausibilityNamesTheUnit) {
+  // WT at 5 % off LT·EMT passes, 6 % off is refused: 4 % EMT, LT 0.65 → WT 6.5 gf·cm/cm².
+  EXPECT_EQ(StretchError(R"({"warp": {"kes": {"EMT_percent": 4, "LT": 0.65, "WT_gfcm_per_cm2": 6.82}}})"), "");
+  EXPECT_NE(StretchError(R"({"warp": {"kes": {"EMT_percent": 4, "LT": 0.65, "WT_gfcm_per_cm2": 6.9}}})")
+                .find("stretch.warp.kes.WT_gfcm_per_cm2: 6.9 gf·cm/cm² disagrees"),
+            std::string::npos);
+  // WT alone whose LT falls outside (0.1, 1.25).
+  EXPECT_NE(StretchError(R"({"warp": {"kes": {"EMT_percent": 4, "WT_gfcm_per_cm2": 40}}})")
+                .find("stretch.warp.kes.WT_gfcm_per_cm2: 40 gf·cm/cm² gives LT"),
+            std::string::npos);
+  // G at the edge of plausibility (20 gf/cm/deg) passes, above it is N/m's number.
+  EXPECT_EQ(StretchError(R"({"shear": {"kes": {"G_gf_per_cm_deg": 20}}})"), "");
+  EXPECT_NE(StretchError(R"({"shear": {"kes": {"G_gf_per_cm_deg": 20.5}}})").find("looks like N/m"),
+            std::string::npos);
+  EXPECT_NE(StretchError(R"({"shear": {"kes": {"2HG_gf_per_cm": 1}}})")
+                .find("stretch.shear.kes.G_gf_per_cm_deg: missing"),
+            std::string::npos);
+  EXPECT_NE(StretchError(R"({"shear": {"modulus_N_per_m": 40, "fast": {"EB5_percent": 3}}})")
+                .find("stretch.shear: give one of"),
+            std::string::npos);
+  EXPECT_NE(StretchError(R"({"warp": {"curve": [[0.01, 5], [0.01, 6]]}})").find("stretch.warp.curve[1]"),
+            std::string::npos);
+  EXPECT_NE(StretchError(R"({"warp": {"curve": [[0.01]]}})").find("stretch.warp.curve[0]: must be an array [strain, N_per_m]"),
+            std::string::npos);
+  EXPECT_NE(StretchError(R"({"warp": {"modulus_N_per_m": 0}})").find("stretch.warp.modulus_N_per_m: must be > 0 N/m"),
+            std::string::npos);
+}
+
+// ReadMaterial(MaterialToJson(m)) gives the same membrane, and what was defaulted stays so.
+TEST(MaterialMembrane, SurvivesTheRoundTripWithDefaultsLeftOut) {
+  for (const std::string stretch :
+       {R"({"warp": {"kes": {"EMT_percent": 3.5, "LT": 0.7, "WT_gfcm_per_cm2": 6.1}},
+            "weft": {"curve": [[0.01, 5], [0.02, 20], [0.05, 490]]},
+            "shear": {"kes": {"G_gf_per_cm_deg": 1.1, "2HG_gf_per_cm": 2}}, "compression_ratio": 0.01,
+            "buckling_strain": 0.002})",
+        R"({"weft": {"fast": {"E100_percent": 3}}})", R"({"stiffness_N_per_m": 900, "shear": {"fast": {"EB5_percent": 2}}})",
+        R"({})", R"({"poisson": 0.25})", R"({"stiffness_N_per_m": 1000, "poisson": 0.3, "compression_ratio": 1})"}) {
+    const Material a = WithStretch(stretch);
+    const nlohmann::json written = MaterialToJson(a);
+    const Material b = ParseMaterialJson(written.dump(), "round trip");
+    EXPECT_EQ(b.defaulted, a.defaulted) << stretch;
+    ASSERT_EQ(b.orthotropic.has_value(), a.orthotropic.has_value()) << stretch;
+    if (a.orthotropic) {
+      ExpectSameCurve(b.orthotropic->warp, a.orthotropic->warp, stretch + " warp");
+      ExpectSameCurve(b.orthotropic->weft, a.orthotropic->weft, stretch + " weft");
+      EXPECT_EQ(b.orthotropic->shear_modulus, a.orthotropic->shear_modulus) << stretch;
+    } else {
+      EXPECT_EQ(b.stretch_stiffness, a.stretch_stiffness) << stretch;
+      EXPECT_EQ(b.poisson, a.poisson) << stretch;
+    }
+    EXPECT_EQ(b.compression_ratio, a.compression_ratio) << stretch;
+    EXPECT_EQ(b.buckling_strain, a.buckling_strain) << stretch;
+    for (const std::string& field : a.defaulted) {
+      const std::string key = field.substr(std::string("stretch.").size());
+      EXPECT_FALSE(written.contains("stretch") && written["stretch"].contains(key))
+          << field << " written: " << written.dump();
+    }
+  }
+}
+
+TEST(MaterialMembrane, CodeBuiltMembranesAreWrittenAndChecked) {
+  Material m;
+  m.areal_density = 0.2;
+  m.orthotropic = OrthotropicMembrane{TensileCurve::Linear(1200.0),
+                                      TensileCurveFromKes(5.0, 0.6), 50.0};
+  m.compression_ratio = 0.05;
+  EXPECT_TRUE(m.Check(nullptr));
+  const nlohmann::json j = MaterialToJson(m);
+  EXPECT_EQ(j["stretch"]["warp"], (nlohmann::json{{"modulus_N_per_m", 1200.0}}));
+  EXPECT_TRUE(j["stretch"]["weft"].contains("curve"));
+  EXPECT_FALSE(j["stretch"].contains("poisson"));
+  const Material back = ParseMaterialJson(j.dump(), "code");
+  ExpectSameCurve(back.orthotropic->warp, m.orthotropic->warp, "linear");
+  // A knotted curve is read back through FromPoints: the knots' forces, not the slopes.
+  for (size_t i = 0; i < m.orthotropic->weft.strains().size(); ++i) {
+    const double e = m.orthotropic->weft.strains()[i];
+    EXPECT_NEAR(back.orthotropic->weft.Force(e), m.orthotropic->weft.Force(e),
+                1e-12 * m.orthotropic->weft.Force(e) + 1e-12);
+  }
+  // Check refuses in the parser's words, without the file name.
+  const auto refused = [](Material bad, const std::string& expected) {
+    std::string why;
+    EXPECT_FALSE(bad.Check(&why)) << expected;
+    EXPECT_EQ(why.find(expected), 0u) << why;
+    try {
+      ParseMaterialJson(MaterialToJson(bad).dump(), "fitted law");
+      ADD_FAILURE() << expected << ": the parser took it";
+    } catch (const InputError& e) {
+      EXPECT_EQ("fitted law: " + why, e.what());
+    }
+  };
+  Material bad = m;
+  bad.orthotropic->shear_modulus = -3.0;
+  refused(bad, "stretch.shear.modulus_N_per_m: must be > 0 N/m, got -3");
+  bad = m;
+  bad.buckling_strain = 0.2;
+  refused(bad, "stretch.buckling_strain: must lie in [0, 0.05]");
+  bad = m;
+  bad.compression_ratio = 0.0;
+  refused(bad, "stretch.compression_ratio: must lie in [0.001, 1]");
+  bad = m;
+  bad.orthotropic->warp = TensileCurve::Linear(2e7);
+  refused(bad, "stretch.warp.modulus_N_per_m: suspicious magnitude");
+}
+
+TEST(MaterialMembrane, EachDefaultIsANoteNamingItsFieldValueAndPage) {
+  const Material m = ParseMaterialJson("{" + kLaw + "}", "defaults.json");
+  const std::vector<Note> notes = MaterialDefaultNotes(m);
+  ASSERT_EQ(notes.size(), m.defaulted.size());
+  for (size_t i = 0; i < notes.size(); ++i) {
+    EXPECT_EQ(notes[i].code, "membrane_default");
+    EXPECT_EQ(notes[i].text.find(m.defaulted[i] + " not given: "), 0u) << notes[i].text;
+    EXPECT_NE(notes[i].text.find("(docs/methods/materials.md, Membrane)"), std::string::npos)
+        << notes[i].text;
+  }
+  EXPECT_NE(notes[0].text.find("EMT 4 %"), std::string::npos) << notes[0].text;
+  EXPECT_NE(notes[2].text.find("0.8 gf/cm/deg"), std::string::npos) << notes[2].text;
+  // A file that gives every membrane field has none.
+  EXPECT_TRUE(MaterialDefaultNotes(
+                  WithStretch(R"({"stiffness_N_per_m": 1000, "poisson": 0.3, "compression_ratio": 0.5})"))
+                  .empty());
 }
 
 }  // namespace

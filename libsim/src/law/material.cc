@@ -1,12 +1,16 @@
 #include "textile/sim/law/material.h"
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
+#include <optional>
 #include <fstream>
 #include <sstream>
 #include <utility>
 #include <vector>
 
 #include "textile/sim/core/error.h"
+#include "textile/sim/core/number_text.h"
 #include "textile/sim/io/json_fields.h"
 #include "textile/sim/io/json_text.h"
 #include "textile/sim/law/textile_range.h"
@@ -207,28 +211,297 @@ BendingLaw Law(const JsonFields& f, const json& root, const std::string& key) {
   return BendingLaw::FromSi(sb1, sb2, sc1);
 }
 
-// {"stiffness_N_per_m", "poisson", "compression_ratio"}, each optional, into m.
-void ReadStretch(const JsonFields& f, const json& root, Material* m) {
-  const json& st = f.Object(root["stretch"], "stretch",
-                            "{\"stiffness_N_per_m\", \"poisson\", \"compression_ratio\"}");
-  f.CheckKeys(st, "stretch", {"stiffness_N_per_m", "poisson", "compression_ratio"});
+// ---- The membrane (docs/methods/materials.md, "Membrane") ----
+
+constexpr double kMaxMembraneModulus = 1e7;  // [N/m], as for stretch.stiffness_N_per_m
+// KES values beyond these are another unit's numbers (docs/methods/materials.md, "Membrane").
+constexpr double kMaxKesShear = 20.0;        // G [gf/cm/deg]; 20 gf/cm/deg = 1124 N/m
+constexpr double kMinPercent = 0.1;          // EMT, E100, EB5 [%]: below, a fraction's number
+// WT must agree with LT·½·500 gf/cm·EMT/100 within this (docs/methods/materials.md).
+constexpr double kWtTolerance = 0.05;
+// FAST-3 shear rigidity G = 123 / EB5 [N/m] (EB5 in %).
+constexpr double kFastShearConstant = 123.0;
+
+std::string ShearModulusProblem(double g, const std::string& got) {
+  if (g <= 0.0) return "must be > 0 N/m, got " + got;
+  if (g > kMaxMembraneModulus) return "suspicious magnitude, above 1e7 N/m";
+  return "";
+}
+
+std::string BucklingStrainProblem(double e, const std::string& got) {
+  return e >= 0.0 && e <= kMaxBucklingStrain
+             ? ""
+             : "must lie in [0, 0.05] (a fraction: 0.2 % is 0.002), got " + got;
+}
+
+// EMT, E100 or EB5 [%] (name: "EMT"): in (0, 100], and not a fraction's number.
+std::string PercentProblem(double p, const std::string& got, const std::string& name) {
+  if (p <= 0.0) return "must be > 0 %, got " + got;
+  if (p > 100.0) return "must be at most 100 %, got " + got;
+  if (p < kMinPercent) {
+    return "suspicious magnitude " + got + " %, below 0.1 %: looks like a fraction: " + name +
+           " is in % (4 % is 4)";
+  }
+  return "";
+}
+
+std::string LinearityProblem(double lt, const std::string& got) {
+  return lt > 0.1 && lt < 1.25 ? "" : "must lie in (0.1, 1.25), got " + got;
+}
+
+// The KES tensile energy WT [gf·cm/cm²] of a curve with linearity LT and EMT [%].
+double KesTensileEnergy(double lt, double emt_percent) {
+  return lt * 0.5 * 500.0 * emt_percent / 100.0;
+}
+
+std::string TensileEnergyProblem(double wt, double lt, double emt, const std::string& got) {
+  if (wt <= 0.0) return "must be > 0 gf·cm/cm², got " + got;
+  const double expected = KesTensileEnergy(lt, emt);
+  if (std::abs(wt - expected) <= kWtTolerance * expected) return "";
+  return got + " gf·cm/cm² disagrees with LT·½·500 gf/cm·EMT/100 = " + NumberText(expected) +
+         " gf·cm/cm² (LT " + NumberText(lt) + ", EMT " + NumberText(emt) +
+         " %) by more than 5 %";
+}
+
+std::string KesShearProblem(double g, const std::string& got) {
+  if (g <= 0.0) return "must be > 0 gf/cm/deg, got " + got;
+  if (g > kMaxKesShear) {
+    return "suspicious magnitude " + got +
+           " gf/cm/deg, above 20: looks like N/m: use modulus_N_per_m";
+  }
+  return "";
+}
+
+std::string ShearHysteresisProblem(double h, const std::string& got) {
+  return h < 0.0 ? "must be >= 0 gf/cm, got " + got : "";
+}
+
+// The one key of obj among `forms`, or "<field>: give one of ..." (none or several).
+std::string OneForm(const JsonFields& f, const json& obj, const std::string& field,
+                    const std::vector<std::string>& forms) {
+  std::string all, given;
+  int count = 0;
+  for (const std::string& k : forms) {
+    all += (all.empty() ? "" : ", ") + k;
+    if (obj.contains(k)) {
+      given += (given.empty() ? "" : " and ") + k;
+      ++count;
+    }
+  }
+  if (count == 0) f.Fail(field, "needs one of " + all);
+  if (count > 1) f.Fail(field, "give one of " + all + ", got " + given);
+  for (const std::string& k : forms)
+    if (obj.contains(k)) return k;
+  return "";
+}
+
+// A number obj[key] (field: where.key), its problem refused.
+double ReadNumber(const JsonFields& f, const json& obj, const std::string& where,
+                  const std::string& key,
+                  const std::function<std::string(double, const std::string&)>& problem) {
+  const std::string field = where + "." + key;
+  const json& v = obj.at(key);
+  const double x = f.Number(v, field);
+  Refuse(f, field, problem(x, JsonFields::Brief(v)));
+  return x;
+}
+
+// {"curve": [[strain, N_per_m], ...]}: the knots checked here to name the bad point.
+TensileCurve CurveForm(const JsonFields& f, const json& v, const std::string& field) {
+  if (!v.is_array() || v.empty()) f.Must(field, "be an array of [strain, N_per_m] points", v);
+  std::vector<double> strain, force;
+  double last_strain = 0.0, last_force = 0.0;
+  for (size_t i = 0; i < v.size(); ++i) {
+    const std::string point = JsonFields::Element(field, i);
+    const auto p = f.FixedNumbers<2>(v[i], point, "[strain, N_per_m]");
+    if (p[0] > 1.0) {
+      f.Fail(point, "strain " + NumberText(p[0]) +
+                        " above 1: strain is a fraction (4 % is 0.04)");
+    }
+    if (!(p[0] > last_strain) || !(p[1] > last_force)) {
+      f.Fail(point, "(" + NumberText(p[0]) + ", " + NumberText(p[1]) +
+                        " N/m) is not monotone: strains and forces must increase from (0, 0)");
+    }
+    strain.push_back(last_strain = p[0]);
+    force.push_back(last_force = p[1]);
+  }
+  try {
+    return TensileCurve::FromPoints(strain, force);
+  } catch (const InputError& e) {
+    f.Fail(field, e.what());
+  }
+}
+
+// {"kes": {"EMT_percent", "LT", "WT_gfcm_per_cm2"}}: EMT and LT or WT or both.
+TensileCurve KesTensileForm(const JsonFields& f, const json& v, const std::string& field) {
+  const json& k = f.Object(v, field, "{\"EMT_percent\", \"LT\", \"WT_gfcm_per_cm2\"}");
+  f.CheckKeys(k, field, {"EMT_percent", "LT", "WT_gfcm_per_cm2"});
+  f.Require(k, "EMT_percent", "%, required", field + ".EMT_percent");
+  const double emt = ReadNumber(f, k, field, "EMT_percent", [](double x, const std::string& g) {
+    return PercentProblem(x, g, "EMT");
+  });
+  if (!k.contains("LT") && !k.contains("WT_gfcm_per_cm2"))
+    f.Fail(field, "needs LT or WT_gfcm_per_cm2 (or both) beside EMT_percent");
+  double lt = 0.0;
+  if (k.contains("LT")) lt = ReadNumber(f, k, field, "LT", LinearityProblem);
+  if (k.contains("WT_gfcm_per_cm2")) {
+    const std::string wt_field = field + ".WT_gfcm_per_cm2";
+    const json& v_wt = k.at("WT_gfcm_per_cm2");
+    const double wt = f.Number(v_wt, wt_field);
+    const std::string got = JsonFields::Brief(v_wt);
+    if (k.contains("LT")) {
+      Refuse(f, wt_field, TensileEnergyProblem(wt, lt, emt, got));
+    } else {
+      if (wt <= 0.0) f.Fail(wt_field, "must be > 0 gf·cm/cm², got " + got);
+      lt = wt / KesTensileEnergy(1.0, emt);
+      if (!LinearityProblem(lt, "").empty()) {
+        f.Fail(wt_field, got + " gf·cm/cm² gives LT = WT / (½·500 gf/cm·EMT/100) = " +
+                             NumberText(lt) + ", outside (0.1, 1.25)");
+      }
+    }
+  }
+  return TensileCurveFromKes(emt, lt);
+}
+
+// stretch.warp or stretch.weft: one of modulus_N_per_m, curve, kes, fast.
+TensileCurve TensileForm(const JsonFields& f, const json& v, const std::string& field) {
+  const json& o = f.Object(v, field,
+                           "{\"modulus_N_per_m\"}, {\"curve\"}, {\"kes\"} or {\"fast\"}");
+  f.CheckKeys(o, field, {"modulus_N_per_m", "curve", "kes", "fast"});
+  const std::string form = OneForm(f, o, field, {"modulus_N_per_m", "curve", "kes", "fast"});
+  if (form == "modulus_N_per_m")
+    return TensileCurve::Linear(ReadNumber(f, o, field, form, StretchStiffnessProblem));
+  if (form == "curve") return CurveForm(f, o.at(form), field + ".curve");
+  if (form == "kes") return KesTensileForm(f, o.at(form), field + ".kes");
+  const std::string fast = field + ".fast";
+  const json& k = f.Object(o.at(form), fast, "{\"E100_percent\"}");
+  f.CheckKeys(k, fast, {"E100_percent"});
+  f.Require(k, "E100_percent", "%, required", fast + ".E100_percent");
+  return TensileCurveFromFastE100(
+      ReadNumber(f, k, fast, "E100_percent",
+                 [](double x, const std::string& g) { return PercentProblem(x, g, "E100"); }));
+}
+
+// stretch.shear: one of modulus_N_per_m, kes, fast [N/m per radian].
+double ShearForm(const JsonFields& f, const json& v, const std::string& field) {
+  const json& o = f.Object(v, field, "{\"modulus_N_per_m\"}, {\"kes\"} or {\"fast\"}");
+  f.CheckKeys(o, field, {"modulus_N_per_m", "kes", "fast"});
+  const std::string form = OneForm(f, o, field, {"modulus_N_per_m", "kes", "fast"});
+  if (form == "modulus_N_per_m") return ReadNumber(f, o, field, form, ShearModulusProblem);
+  const std::string sub = field + "." + form;
+  if (form == "kes") {
+    const json& k = f.Object(o.at(form), sub, "{\"G_gf_per_cm_deg\", \"2HG_gf_per_cm\"}");
+    f.CheckKeys(k, sub, {"G_gf_per_cm_deg", "2HG_gf_per_cm"});
+    f.Require(k, "G_gf_per_cm_deg", "gf/cm/deg, required", sub + ".G_gf_per_cm_deg");
+    const double g = ReadNumber(f, k, sub, "G_gf_per_cm_deg", KesShearProblem);
+    // 2HG (the hysteresis at 0.5°) is carried, not used: the static membrane is elastic.
+    if (k.contains("2HG_gf_per_cm")) ReadNumber(f, k, sub, "2HG_gf_per_cm", ShearHysteresisProblem);
+    return KesShearToNewtonPerMetre(g);
+  }
+  const json& k = f.Object(o.at(form), sub, "{\"EB5_percent\"}");
+  f.CheckKeys(k, sub, {"EB5_percent"});
+  f.Require(k, "EB5_percent", "%, required", sub + ".EB5_percent");
+  const double eb5 = ReadNumber(f, k, sub, "EB5_percent", [](double x, const std::string& g) {
+    return PercentProblem(x, g, "EB5");
+  });
+  return kFastShearConstant / eb5;
+}
+
+// compression_ratio and buckling_strain, each optional; a missing ratio is a default.
+void ReadCompression(const JsonFields& f, const json& st, Material* m) {
+  if (st.contains("compression_ratio")) {
+    m->compression_ratio =
+        ReadNumber(f, st, "stretch", "compression_ratio", CompressionRatioProblem);
+    m->stretch_given["compression_ratio"] = m->compression_ratio;
+  } else {
+    m->compression_ratio = kDefaultCompressionRatio;
+    m->defaulted.push_back("stretch.compression_ratio");
+  }
+  if (st.contains("buckling_strain")) {
+    m->buckling_strain = ReadNumber(f, st, "stretch", "buckling_strain", BucklingStrainProblem);
+    m->stretch_given["buckling_strain"] = m->buckling_strain;
+  }
+}
+
+// Rule (i): stiffness_N_per_m and/or poisson, the isotropic membrane.
+void ReadIsotropic(const JsonFields& f, const json& st, Material* m) {
   if (st.contains("stiffness_N_per_m")) {
-    const json& v = st["stiffness_N_per_m"];
-    m->stretch_stiffness = f.Number(v, "stretch.stiffness_N_per_m");
-    Refuse(f, "stretch.stiffness_N_per_m",
-           StretchStiffnessProblem(m->stretch_stiffness, JsonFields::Brief(v)));
+    m->stretch_stiffness =
+        ReadNumber(f, st, "stretch", "stiffness_N_per_m", StretchStiffnessProblem);
+    m->stretch_given["stiffness_N_per_m"] = m->stretch_stiffness;
+  } else {
+    m->defaulted.push_back("stretch.stiffness_N_per_m");
   }
   if (st.contains("poisson")) {
-    const json& v = st["poisson"];
-    m->poisson = f.Number(v, "stretch.poisson");
-    Refuse(f, "stretch.poisson", PoissonProblem(m->poisson, JsonFields::Brief(v)));
+    m->poisson = ReadNumber(f, st, "stretch", "poisson", PoissonProblem);
+    m->stretch_given["poisson"] = m->poisson;
+  } else {
+    m->defaulted.push_back("stretch.poisson");
   }
-  if (st.contains("compression_ratio")) {
-    const json& v = st["compression_ratio"];
-    m->compression_ratio = f.Number(v, "stretch.compression_ratio");
-    Refuse(f, "stretch.compression_ratio",
-           CompressionRatioProblem(m->compression_ratio, JsonFields::Brief(v)));
+}
+
+// Rules (ii), (iii): warp, weft, shear, each given or its default.
+void ReadOrthotropic(const JsonFields& f, const json& st, Material* m) {
+  const bool directional = st.contains("warp") || st.contains("weft");
+  if (st.contains("poisson")) {
+    f.Fail("stretch.poisson",
+           "the orthotropic membrane (stretch.warp, weft, shear) has no Poisson coupling: leave "
+           "poisson out (docs/methods/materials.md, Membrane)");
   }
+  if (st.contains("stiffness_N_per_m") && directional) {
+    f.Fail("stretch.stiffness_N_per_m",
+           "ambiguous beside stretch.warp or stretch.weft: give each direction's "
+           "modulus_N_per_m there");
+  }
+  // stiffness_N_per_m beside shear alone: the modulus of both yarn directions.
+  std::optional<double> both;
+  if (st.contains("stiffness_N_per_m"))
+    both = ReadNumber(f, st, "stretch", "stiffness_N_per_m", StretchStiffnessProblem);
+  OrthotropicMembrane o = DefaultOrthotropicMembrane();
+  for (const char* dir : {"warp", "weft"}) {
+    TensileCurve& curve = std::string(dir) == "warp" ? o.warp : o.weft;
+    const std::string field = std::string("stretch.") + dir;
+    if (st.contains(dir)) {
+      curve = TensileForm(f, st.at(dir), field);
+      m->stretch_given[dir] = st.at(dir);
+    } else if (both) {
+      curve = TensileCurve::Linear(*both);
+      m->stretch_given[dir] = {{"modulus_N_per_m", *both}};
+    } else {
+      m->defaulted.push_back(field);
+    }
+  }
+  if (st.contains("shear")) {
+    o.shear_modulus = ShearForm(f, st.at("shear"), "stretch.shear");
+    m->stretch_given["shear"] = st.at("shear");
+  } else {
+    m->defaulted.push_back("stretch.shear");
+  }
+  m->orthotropic = std::move(o);
+}
+
+// The stretch block (absent: an empty one) into m, by the rules of docs/methods/materials.md.
+void ReadStretch(const JsonFields& f, const json& root, Material* m) {
+  static const json kEmpty = json::object();
+  const json& st =
+      root.contains("stretch")
+          ? f.Object(root.at("stretch"), "stretch",
+                     "{\"warp\", \"weft\", \"shear\", \"compression_ratio\", ...}")
+          : kEmpty;
+  f.CheckKeys(st, "stretch",
+              {"stiffness_N_per_m", "poisson", "warp", "weft", "shear", "compression_ratio",
+               "buckling_strain"});
+  m->stretch_given = json::object();
+  m->defaulted.clear();
+  const bool orthotropic = st.contains("warp") || st.contains("weft") || st.contains("shear") ||
+                           !(st.contains("stiffness_N_per_m") || st.contains("poisson"));
+  if (orthotropic) {
+    ReadOrthotropic(f, st, m);
+  } else {
+    m->orthotropic.reset();
+    ReadIsotropic(f, st, m);
+  }
+  ReadCompression(f, st, m);
 }
 
 // areal_density_gsm: required, > 0 and within the textile range [kg/m² returned].
@@ -257,7 +530,7 @@ Material ParseMaterialJson(const std::string& text, const std::string& source) {
     m.beta = f.Number(root["beta"], "beta");
     Refuse(f, "beta", BetaProblem(m.beta, JsonFields::Brief(root["beta"])));
   }
-  if (root.contains("stretch")) ReadStretch(f, root, &m);
+  ReadStretch(f, root, &m);
   if (root.contains("friction")) {
     m.friction = f.Number(root["friction"], "friction");
     Refuse(f, "friction", FrictionProblem(m.friction, JsonFields::Brief(root["friction"])));
@@ -298,7 +571,119 @@ std::string LawProblem(const BendingLaw& law, const std::string& key) {
   return PabstLawProblem(v[0], v[1], v[2], key, got_b, " (units: kes)");
 }
 
+// The membrane as Material::Check sees it: the stretch block MaterialToJson writes, read back
+// by the parser (the same checks, the same words). "" or "<field>: <problem>".
+std::string StretchProblem(const Material& m) {
+  const json written = MaterialToJson(m);
+  json root = json::object();
+  // Through text, as a file would be: a NaN is written as null.
+  if (written.contains("stretch")) root["stretch"] = json::parse(written["stretch"].dump());
+  Material scratch;
+  try {
+    ReadStretch(JsonFields(""), root, &scratch);
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    return what.rfind(": ", 0) == 0 ? what.substr(2) : what;
+  }
+  return "";
+}
+
+// A tensile curve built in code, in the file's form: a modulus when linear, else its knots
+// (read back through TensileCurve::FromPoints, whose slopes may differ from the curve's).
+json TensileCurveJson(const TensileCurve& c) {
+  const std::vector<double>& e = c.strains();
+  const std::vector<double>& force = c.forces();
+  const std::vector<double>& k = c.slopes();
+  if (e.size() == 2 && k[0] == k[1] && force[1] == k[0] * e[1])
+    return {{"modulus_N_per_m", k[0]}};
+  json points = json::array();
+  for (size_t i = 1; i < e.size(); ++i) points.push_back({e[i], force[i]});
+  return {{"curve", points}};
+}
+
+// The stretch block of MaterialToJson: the fields given (as read, or as built in code), not the
+// defaulted ones unless code changed their value.
+json StretchJson(const Material& m) {
+  json st = json::object();
+  const json& given = m.stretch_given.is_object() ? m.stretch_given : json::object();
+  if (!m.orthotropic) {
+    if (!m.IsDefaulted("stretch.stiffness_N_per_m") ||
+        m.stretch_stiffness != kDefaultStretchStiffness)
+      st["stiffness_N_per_m"] = m.stretch_stiffness;
+    if (!m.IsDefaulted("stretch.poisson") || m.poisson != kDefaultPoisson)
+      st["poisson"] = m.poisson;
+  } else {
+    const OrthotropicMembrane& o = *m.orthotropic;
+    for (const char* dir : {"warp", "weft"}) {
+      if (m.IsDefaulted(std::string("stretch.") + dir)) continue;
+      st[dir] = given.contains(dir) ? given.at(dir)
+                                    : TensileCurveJson(std::string(dir) == "warp" ? o.warp : o.weft);
+    }
+    if (!m.IsDefaulted("stretch.shear"))
+      st["shear"] = given.contains("shear") ? given.at("shear")
+                                            : json{{"modulus_N_per_m", o.shear_modulus}};
+  }
+  // A ratio is written when the file gave it or code set one other than the default.
+  if (given.contains("compression_ratio") || m.compression_ratio != kDefaultCompressionRatio)
+    st["compression_ratio"] = m.compression_ratio;
+  if (given.contains("buckling_strain") || m.buckling_strain != 0.0)
+    st["buckling_strain"] = m.buckling_strain;
+  return st;
+}
+
 }  // namespace
+
+OrthotropicMembrane DefaultOrthotropicMembrane() {
+  return {TensileCurveFromKes(kDefaultWarpEmtPercent, kDefaultLinearity),
+          TensileCurveFromKes(kDefaultWeftEmtPercent, kDefaultLinearity),
+          KesShearToNewtonPerMetre(kDefaultShearKes)};
+}
+
+bool Material::IsDefaulted(const std::string& field) const {
+  return std::find(defaulted.begin(), defaulted.end(), field) != defaulted.end();
+}
+
+std::vector<Note> MaterialDefaultNotes(const Material& m) {
+  const auto text = [](const std::string& field, const std::string& value,
+                       const std::string& what) {
+    return field + " not given: " + value + ", " + what +
+           " (docs/methods/materials.md, Membrane)";
+  };
+  const auto kes_curve = [](double emt) {
+    return "KES EMT " + NumberText(emt) + " %, LT " + NumberText(kDefaultLinearity) +
+           " (small-strain modulus " +
+           NumberText(TensileCurveFromKes(emt, kDefaultLinearity).SmallStrainModulus(), 4) +
+           " N/m)";
+  };
+  std::vector<Note> notes;
+  for (const std::string& field : m.defaulted) {
+    std::string t;
+    if (field == "stretch.warp") {
+      t = text(field, kes_curve(kDefaultWarpEmtPercent),
+               "the warp tensile curve of a typical woven apparel fabric");
+    } else if (field == "stretch.weft") {
+      t = text(field, kes_curve(kDefaultWeftEmtPercent),
+               "the weft tensile curve of a typical woven apparel fabric");
+    } else if (field == "stretch.shear") {
+      t = text(field,
+               "KES G " + NumberText(kDefaultShearKes) + " gf/cm/deg (" +
+                   NumberText(KesShearToNewtonPerMetre(kDefaultShearKes), 3) + " N/m)",
+               "the shear rigidity of a typical woven apparel fabric");
+    } else if (field == "stretch.compression_ratio") {
+      t = text(field, NumberText(kDefaultCompressionRatio),
+               "the membrane's stiffness in compression as a fraction of its tension's");
+    } else if (field == "stretch.stiffness_N_per_m") {
+      t = text(field, NumberText(kDefaultStretchStiffness) + " N/m",
+               "the isotropic membrane's stretch stiffness");
+    } else if (field == "stretch.poisson") {
+      t = text(field, NumberText(kDefaultPoisson), "the isotropic membrane's Poisson ratio");
+    } else {
+      t = field + " not given: its default (docs/methods/materials.md, Membrane)";
+    }
+    notes.push_back({"membrane_default", t});
+  }
+  return notes;
+}
 
 bool Material::Check(std::string* why) const {
   std::string w;
@@ -315,13 +700,7 @@ bool Material::Check(std::string* why) const {
   if (w.empty()) w = LawProblem(bending, "bending");
   if (w.empty() && bending_weft) w = LawProblem(*bending_weft, "bending_weft");
   if (number("beta", beta)) field("beta", BetaProblem(beta, Written(beta)));
-  if (number("stretch.stiffness_N_per_m", stretch_stiffness))
-    field("stretch.stiffness_N_per_m",
-          StretchStiffnessProblem(stretch_stiffness, Written(stretch_stiffness)));
-  if (number("stretch.poisson", poisson)) field("stretch.poisson", PoissonProblem(poisson, Written(poisson)));
-  if (number("stretch.compression_ratio", compression_ratio))
-    field("stretch.compression_ratio",
-          CompressionRatioProblem(compression_ratio, Written(compression_ratio)));
+  if (w.empty()) w = StretchProblem(*this);
   if (number("friction", friction)) field("friction", FrictionProblem(friction, Written(friction)));
   if (why) *why = w;
   return w.empty();
@@ -362,8 +741,7 @@ nlohmann::json MaterialToJson(const Material& m) {
   j["bending"] = LawToJson(m.bending);
   if (m.bending_weft) j["bending_weft"] = LawToJson(*m.bending_weft);
   j["beta"] = m.beta;
-  j["stretch"] = {{"stiffness_N_per_m", m.stretch_stiffness}, {"poisson", m.poisson}};
-  if (m.compression_ratio != 1.0) j["stretch"]["compression_ratio"] = m.compression_ratio;
+  if (json st = StretchJson(m); !st.empty()) j["stretch"] = std::move(st);
   j["friction"] = m.friction;
   for (const auto& [k, v] : m.extra.items()) j[k] = v;
   if (!m.fit.is_null()) j["fit"] = m.fit;

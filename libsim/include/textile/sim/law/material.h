@@ -31,6 +31,24 @@ constexpr double kMinCompressionRatio = 1e-3;
 // The compression ratio a material gets when its file gives none (docs/methods/drapemeter.md,
 // "Compression": why this value).
 constexpr double kDefaultCompressionRatio = 1.0;
+// The largest buckling strain a file takes (stretch.buckling_strain) [-]: 5 %, past any woven
+// fabric's crimp (a larger one is a percentage written as a fraction's number).
+constexpr double kMaxBucklingStrain = 0.05;
+
+// The isotropic membrane's defaults when its file gives stretch.stiffness_N_per_m or
+// stretch.poisson but not both.
+constexpr double kDefaultStretchStiffness = 1000.0;  // [N/m]
+constexpr double kDefaultPoisson = 0.3;              // [-]
+
+// The orthotropic membrane's defaults (docs/methods/materials.md, "Membrane": a woven apparel
+// fabric on KES-FB1 at the standard 500 gf/cm): warp EMT 4 %, weft EMT 6 %, LT 0.65 both,
+// shear rigidity G 0.8 gf/cm/deg (45 N/m per radian).
+constexpr double kDefaultWarpEmtPercent = 4.0;   // [%]
+constexpr double kDefaultWeftEmtPercent = 6.0;   // [%]
+constexpr double kDefaultLinearity = 0.65;       // KES LT [-]
+constexpr double kDefaultShearKes = 0.8;         // KES G [gf/cm/deg]
+// The membrane those constants make (TensileCurveFromKes, KesShearToNewtonPerMetre).
+OrthotropicMembrane DefaultOrthotropicMembrane();
 
 struct Material {
   std::string name;                          // free text
@@ -42,17 +60,25 @@ struct Material {
   // docs/spec/physics.md) with stretch_stiffness and poisson when the file gives only
   // stretch.stiffness_N_per_m / stretch.poisson; orthotropic (membrane_law.h) when it gives
   // stretch.warp, stretch.weft or stretch.shear, or no membrane at all (documented defaults).
-  double stretch_stiffness = 1000.0;  // isotropic membrane stiffness [N/m]
-  double poisson = 0.3;                      // isotropic Poisson ratio [-]
+  double stretch_stiffness = kDefaultStretchStiffness;  // isotropic membrane stiffness [N/m]
+  double poisson = kDefaultPoisson;                      // isotropic Poisson ratio [-]
   std::optional<OrthotropicMembrane> orthotropic;  // set: the orthotropic membrane
   // The fields the file left out whose documented defaults the membrane uses ("stretch.shear",
   // "stretch.compression_ratio", ...), in file order; each run says so (MaterialDefaultNotes).
   std::vector<std::string> defaulted;
+  // The membrane fields the file gave, normalised: "warp", "weft", "shear" as their objects
+  // (stiffness_N_per_m beside shear only becomes {"modulus_N_per_m": k} for warp and weft),
+  // "compression_ratio", "buckling_strain" as numbers. MaterialToJson writes a given form back
+  // as it was read (a KES curve stays its EMT and LT); null for a material built in code, whose
+  // curves are written as a modulus (linear) or their knots. Code that replaces
+  // orthotropic->warp, ->weft or ->shear_modulus erases the field here.
+  nlohmann::json stretch_given;
   // The membrane's stiffness against compression as a fraction of its stretch stiffness [-]
   // (stretch.compression_ratio, kMinCompressionRatio .. 1): 1, the default, is the stabilised
   // StVK of docs/spec/physics.md, as stiff in compression as in tension (membrane.h).
-  double compression_ratio = 1.0;
-  // Strain a yarn takes at full stiffness before buckling (stretch.buckling_strain) [-], ≥ 0.
+  double compression_ratio = kDefaultCompressionRatio;
+  // Strain a yarn takes at full stiffness before buckling (stretch.buckling_strain) [-],
+  // 0 .. kMaxBucklingStrain; 0 (the default, not listed in defaulted) buckles at once.
   double buckling_strain = 0.0;
   double friction = 0.3;                     // Coulomb coefficient against supports [-]
   nlohmann::json fit;                        // the `fit` report when a fit made this file
@@ -72,6 +98,9 @@ struct Material {
                                 orthotropic->weft.SmallStrainModulus())
                        : stretch_stiffness;
   }
+
+  // True when `field` ("stretch.shear") is listed in defaulted.
+  bool IsDefaulted(const std::string& field) const;
 
   // The warp law with β applied (M_β = β M), which every simulation uses.
   BendingLaw EffectiveLaw() const { return bending.Scaled(beta); }

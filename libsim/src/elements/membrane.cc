@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <cassert>
 #include <cmath>
 
 #include "textile/sim/core/error.h"
@@ -366,6 +367,111 @@ bool StvkNeedsProjection(const MembraneLame& l, const Mat32& f) {
   return l.lambda < 0 || e.trace() < 0 || e.determinant() < 0;
 }
 
+// ---- Orthotropic (MembraneModel::kOrthotropic): ψ = W_w(|f1| - 1) + W_f(|f2| - 1) + ½ G γ²,
+// γ = f1·f2, with f1 = F x, f2 = F y the columns of F in the warp-first rest frame.
+
+// One yarn line a: its stretched direction n = f/|f|, strain ε = |f| - 1, and W'(ε), W''(ε).
+struct YarnTerms {
+  Eigen::Vector3d n;
+  double length = 0, force = 0, stiffness = 0;
+};
+
+YarnTerms Yarn(const TensileCurve& curve, const MembraneCompression& c, const Eigen::Vector3d& f) {
+  YarnTerms t;
+  t.length = f.norm();
+  // A yarn collapsed to a point has no direction; any unit n keeps the terms finite.
+  t.n = t.length > 1e-12 ? Eigen::Vector3d(f / t.length) : Eigen::Vector3d::UnitX();
+  t.force = YarnForce(curve, c, t.length - 1.0);
+  t.stiffness = YarnStiffness(curve, c, t.length - 1.0);
+  return t;
+}
+
+double OrthotropicDensity(const OrthotropicMembrane& law, const MembraneCompression& c,
+                          const Mat32& f) {
+  const double gamma = f.col(0).dot(f.col(1));
+  return YarnEnergy(law.warp, c, f.col(0).norm() - 1.0) +
+         YarnEnergy(law.weft, c, f.col(1).norm() - 1.0) + 0.5 * law.shear_modulus * gamma * gamma;
+}
+
+// P = ∂ψ/∂(f1, f2) = (W_w' n1 + G γ f2, W_f' n2 + G γ f1).
+Vec6 OrthotropicStress(const OrthotropicMembrane& law, const MembraneCompression& c,
+                       const Mat32& f) {
+  const YarnTerms warp = Yarn(law.warp, c, f.col(0)), weft = Yarn(law.weft, c, f.col(1));
+  const double g_gamma = law.shear_modulus * f.col(0).dot(f.col(1));
+  Vec6 p;
+  p << warp.force * warp.n + g_gamma * f.col(1), weft.force * weft.n + g_gamma * f.col(0);
+  return p;
+}
+
+// A yarn's block of ∂²ψ/∂F²: W'' n nᵀ + W'/|f| (I - n nᵀ), the geometric part dropped when
+// W' < 0 (a compressed yarn, whose sideways curvature is negative) if `project`.
+Eigen::Matrix3d YarnBlock(const YarnTerms& t, bool project) {
+  const Eigen::Matrix3d nn = t.n * t.n.transpose();
+  const double geometric = project ? std::max(t.force, 0.0) : t.force;
+  return t.stiffness * nn +
+         geometric / std::max(t.length, 1e-12) * (Eigen::Matrix3d::Identity() - nn);
+}
+
+// The shear term's ∂²(½ G γ²)/∂F² = G (q qᵀ + γ S), q = (f2, f1), S = [[0, I], [I, 0]]. In the
+// orthonormal coordinates s = (a + b)/√2, d = (a - b)/√2 of vec(F) = (a, b), S = diag(I, -I)
+// and q = (ŝ |q_s|, d̂ |q_d|), q_s = (f1 + f2)/√2, q_d = (f2 - f1)/√2: the eigenvalues are G γ
+// on s ⊥ ŝ, -G γ on d ⊥ d̂ (twice each) and those of G [[|q_s|² + γ, |q_s||q_d|],
+// [|q_s||q_d|, |q_d|² - γ]] on (ŝ, d̂). With project, the negative ones are left out.
+Mat6 ShearBlock(double shear_modulus, const Mat32& f, bool project) {
+  const Eigen::Vector3d f1 = f.col(0), f2 = f.col(1);
+  const double gamma = f1.dot(f2);
+  Vec6 q;
+  q << f2, f1;
+  Mat6 h = q * q.transpose();
+  h.block<3, 3>(0, 3).diagonal().array() += gamma;
+  h.block<3, 3>(3, 0).diagonal().array() += gamma;
+  if (!project || gamma == 0.0) return shear_modulus * h;
+  const double r = 1.0 / std::sqrt(2.0);
+  const Eigen::Vector3d qs = r * (f1 + f2), qd = r * (f2 - f1);
+  const double ns = qs.norm(), nd = qd.norm();
+  const Eigen::Vector3d us = ns > 0 ? Eigen::Vector3d(qs / ns) : Eigen::Vector3d(qd.unitOrthogonal());
+  const Eigen::Vector3d ud = nd > 0 ? Eigen::Vector3d(qd / nd) : Eigen::Vector3d(qs.unitOrthogonal());
+  // vec(F) of a unit vector u in s or d coordinates: (u, u)/√2 or (u, -u)/√2.
+  auto in_s = [&](const Eigen::Vector3d& u) { Vec6 v; v << r * u, r * u; return v; };
+  auto in_d = [&](const Eigen::Vector3d& u) { Vec6 v; v << r * u, -r * u; return v; };
+  // The two-fold -|γ| eigenspace: d ⊥ d̂ when γ > 0, s ⊥ ŝ when γ < 0.
+  const Eigen::Vector3d axis = gamma > 0 ? ud : us;
+  const Eigen::Matrix3d complement = Eigen::Matrix3d::Identity() - axis * axis.transpose();
+  Mat6 lift = Mat6::Zero();  // the 6×6 projector onto that eigenspace
+  lift.block<3, 3>(0, 0) = lift.block<3, 3>(3, 3) = 0.5 * complement;
+  lift.block<3, 3>(0, 3) = lift.block<3, 3>(3, 0) = (gamma > 0 ? -0.5 : 0.5) * complement;
+  h += std::abs(gamma) * lift;
+  // The 2×2 block on (ŝ, d̂): at most one negative eigenvalue (its determinant may be < 0).
+  Eigen::Matrix2d m;
+  m << ns * ns + gamma, ns * nd, ns * nd, nd * nd - gamma;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig;
+  eig.computeDirect(m);
+  if (eig.eigenvalues()(0) < 0) {
+    const Eigen::Vector2d ab = eig.eigenvectors().col(0);
+    const Vec6 v = ab(0) * in_s(us) + ab(1) * in_d(ud);
+    h -= eig.eigenvalues()(0) * v * v.transpose();
+  }
+  return shear_modulus * h;
+}
+
+// ∂²ψ/∂F²: yarn blocks on the diagonal plus the shear term. project_psd keeps the exact matrix
+// when it is positive definite (a 6×6 Cholesky) and otherwise sums the terms' own projections.
+Mat6 OrthotropicStressDerivative(const OrthotropicMembrane& law, const MembraneCompression& c,
+                                 const Mat32& f, bool project) {
+  const YarnTerms warp = Yarn(law.warp, c, f.col(0)), weft = Yarn(law.weft, c, f.col(1));
+  Mat6 h = ShearBlock(law.shear_modulus, f, false);
+  h.block<3, 3>(0, 0) += YarnBlock(warp, false);
+  h.block<3, 3>(3, 3) += YarnBlock(weft, false);
+  if (!project) return h;
+  // Nothing compressed and no shear: every term is positive semi-definite already.
+  if (warp.force >= 0 && weft.force >= 0 && f.col(0).dot(f.col(1)) == 0.0) return h;
+  if (Eigen::LLT<Mat6>(h).info() == Eigen::Success) return h;
+  Mat6 p = ShearBlock(law.shear_modulus, f, true);
+  p.block<3, 3>(0, 0) += YarnBlock(warp, true);
+  p.block<3, 3>(3, 3) += YarnBlock(weft, true);
+  return p;
+}
+
 }  // namespace
 
 MembraneLame MembraneLame::FromStretch(double stretch_stiffness, double poisson,
@@ -392,6 +498,7 @@ MembraneLame MembraneLame::FromStretch(double stretch_stiffness, double poisson,
 double MembraneEnergy(MembraneModel model, const MembraneLame& lame,
                       const Eigen::Matrix2d& rest_inverse, double rest_area,
                       const Eigen::Matrix3d& x) {
+  assert(model != MembraneModel::kOrthotropic);  // OrthotropicMembraneEnergy
   const Mat32 f = DeformationGradient(rest_inverse, x);
   const double psi = model != MembraneModel::kStVK ? CorotationalDensity(lame, f)
                      : SoftApplies(lame, f)        ? SoftDensity(lame, f)
@@ -430,9 +537,106 @@ Eigen::Matrix<double, 9, 9> MembraneHessian(MembraneModel model, const MembraneL
   return rest_area * g.transpose() * h * g;
 }
 
+double OrthotropicMembraneEnergy(const OrthotropicMembrane& law,
+                                 const MembraneCompression& compression,
+                                 const Eigen::Matrix2d& rest_inverse, double rest_area,
+                                 const Eigen::Matrix3d& x) {
+  return rest_area * OrthotropicDensity(law, compression, DeformationGradient(rest_inverse, x));
+}
+
+Eigen::Matrix<double, 9, 1> OrthotropicMembraneGradient(const OrthotropicMembrane& law,
+                                                        const MembraneCompression& compression,
+                                                        const Eigen::Matrix2d& rest_inverse,
+                                                        double rest_area,
+                                                        const Eigen::Matrix3d& x) {
+  const Vec6 p = OrthotropicStress(law, compression, DeformationGradient(rest_inverse, x));
+  return rest_area * GradientMap(rest_inverse).transpose() * p;
+}
+
+Eigen::Matrix<double, 9, 9> OrthotropicMembraneHessian(const OrthotropicMembrane& law,
+                                                       const MembraneCompression& compression,
+                                                       const Eigen::Matrix2d& rest_inverse,
+                                                       double rest_area, const Eigen::Matrix3d& x,
+                                                       bool project_psd) {
+  const Mat6 h = OrthotropicStressDerivative(law, compression,
+                                             DeformationGradient(rest_inverse, x), project_psd);
+  const Eigen::Matrix<double, 6, 9> g = GradientMap(rest_inverse);
+  return rest_area * g.transpose() * h * g;
+}
+
+Eigen::Matrix2d RestInverse(const Eigen::Matrix3d& corners, int index, double* rest_area) {
+  const Eigen::Vector3d e1 = (corners.row(1) - corners.row(0)).transpose(),
+                        e2 = (corners.row(2) - corners.row(0)).transpose();
+  const Eigen::Vector3d normal = e1.cross(e2);
+  const double area = 0.5 * normal.norm();
+  if (!(area > 1e-14 * std::max(e1.squaredNorm(), e2.squaredNorm())) || !std::isfinite(area)) {
+    throw InputError("membrane: rest triangle " + std::to_string(index) + " is degenerate (area " +
+                     NumberText(area) + " m²)");
+  }
+  // t1: pattern x in the triangle's plane, the warp; the first edge if x is (nearly) normal.
+  const Eigen::Vector3d n = normal.normalized();
+  Eigen::Vector3d t1 = Eigen::Vector3d::UnitX() - n.x() * n;
+  t1 = t1.norm() > 1e-6 ? Eigen::Vector3d(t1.normalized()) : Eigen::Vector3d(e1.normalized());
+  const Eigen::Vector3d t2 = n.cross(t1);
+  Eigen::Matrix2d dm;
+  dm << e1.dot(t1), e2.dot(t1), e1.dot(t2), e2.dot(t2);
+  *rest_area = area;
+  return dm.inverse();
+}
+
 MembraneElements::MembraneElements(const TriangleMesh& rest, double stretch_stiffness,
                                    double poisson, MembraneModel model, double compression)
     : model_(model), lame_(MembraneLame::FromStretch(stretch_stiffness, poisson, compression)) {
+  if (model == MembraneModel::kOrthotropic) {
+    throw InputError("membrane: the orthotropic model needs a material's warp, weft and shear");
+  }
+  BuildRestShapes(rest);
+}
+
+namespace {
+
+// The checks of the compression model and shear modulus the isotropic FromStretch does not make.
+void CheckOrthotropic(const OrthotropicMembrane& law, const MembraneCompression& c) {
+  if (!(law.shear_modulus >= 0) || !std::isfinite(law.shear_modulus)) {
+    throw InputError("membrane: shear modulus must be a finite number ≥ 0 of N/m, got " +
+                     NumberText(law.shear_modulus));
+  }
+  if (!(c.ratio >= kMinCompressionRatio && c.ratio <= 1)) {
+    throw InputError("membrane: compression ratio must lie in [" + NumberText(kMinCompressionRatio) +
+                     ", 1], got " + NumberText(c.ratio));
+  }
+  if (!(c.buckling_strain >= 0) || !std::isfinite(c.buckling_strain)) {
+    throw InputError("membrane: buckling strain must be a finite number ≥ 0, got " +
+                     NumberText(c.buckling_strain));
+  }
+}
+
+}  // namespace
+
+MembraneElements::MembraneElements(const TriangleMesh& rest, const Material& material,
+                                   MembraneModel model)
+    : model_(material.orthotropic ? MembraneModel::kOrthotropic : model),
+      compression_(material.Compression()) {
+  if (material.orthotropic) {
+    orthotropic_ = *material.orthotropic;
+    CheckOrthotropic(orthotropic_, compression_);
+  } else {
+    if (model == MembraneModel::kOrthotropic) {
+      throw InputError("membrane: the orthotropic model needs a material's warp, weft and shear");
+    }
+    // The isotropic soft StVK takes a ratio only (docs/methods/meshing-and-membrane.md).
+    if (material.buckling_strain != 0.0) {
+      throw InputError("membrane: buckling strain " + NumberText(material.buckling_strain) +
+                       " needs the orthotropic membrane (stretch.warp/weft/shear); the isotropic "
+                       "one takes only a compression ratio");
+    }
+    lame_ = MembraneLame::FromStretch(material.stretch_stiffness, material.poisson,
+                                      material.compression_ratio);
+  }
+  BuildRestShapes(rest);
+}
+
+void MembraneElements::BuildRestShapes(const TriangleMesh& rest) {
   num_vertices_ = rest.num_vertices();
   triangles_ = rest.triangles;
   const int nf = rest.num_triangles();
@@ -446,29 +650,11 @@ MembraneElements::MembraneElements(const TriangleMesh& rest, double stretch_stif
                          std::to_string(num_vertices_ - 1));
       }
     }
-    const Eigen::Vector3d x0 = rest.vertices.row(triangles_(f, 0)),
-                          x1 = rest.vertices.row(triangles_(f, 1)),
-                          x2 = rest.vertices.row(triangles_(f, 2));
-    // A frame of the triangle's plane: t1 along the first edge, t2 = n × t1.
-    const Eigen::Vector3d e1 = x1 - x0, e2 = x2 - x0;
-    const Eigen::Vector3d normal = e1.cross(e2);
-    const double area = 0.5 * normal.norm();
-    if (!(area > 1e-14 * std::max(e1.squaredNorm(), e2.squaredNorm())) || !std::isfinite(area)) {
-      throw InputError("membrane: rest triangle " + std::to_string(f) + " is degenerate (area " +
-                       NumberText(area) + " m²)");
-    }
-    const Eigen::Vector3d t1 = e1.normalized(), t2 = normal.normalized().cross(t1);
-    Eigen::Matrix2d dm;
-    dm << e1.dot(t1), e2.dot(t1), 0.0, e2.dot(t2);
-    rest_inverse_[f] = dm.inverse();
-    rest_area_(f) = area;
+    Eigen::Matrix3d corners;
+    for (int k = 0; k < 3; ++k) corners.row(k) = rest.vertices.row(triangles_(f, k));
+    rest_inverse_[f] = RestInverse(corners, f, &rest_area_(f));
   }
 }
-
-MembraneElements::MembraneElements(const TriangleMesh& rest, const Material& material,
-                                   MembraneModel model)
-    : MembraneElements(rest, material.stretch_stiffness, material.poisson, model,
-                       material.compression_ratio) {}
 
 void MembraneElements::CheckSize(Eigen::Ref<const Vertices> x) const {
   if (x.rows() != num_vertices_) {
@@ -487,7 +673,10 @@ double MembraneElements::Energy(Eigen::Ref<const Vertices> x) const {
   CheckSize(x);
   double e = 0;
   for (int f = 0; f < num_triangles(); ++f) {
-    e += MembraneEnergy(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f));
+    e += model_ == MembraneModel::kOrthotropic
+             ? OrthotropicMembraneEnergy(orthotropic_, compression_, rest_inverse_[f],
+                                         rest_area_(f), Corners(x, f))
+             : MembraneEnergy(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f));
   }
   return e;
 }
@@ -497,7 +686,10 @@ void MembraneElements::AddGradient(Eigen::Ref<const Vertices> x, Eigen::Ref<Vert
   CheckSize(grad);
   for (int f = 0; f < num_triangles(); ++f) {
     const Eigen::Matrix<double, 9, 1> g =
-        MembraneGradient(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f));
+        model_ == MembraneModel::kOrthotropic
+            ? OrthotropicMembraneGradient(orthotropic_, compression_, rest_inverse_[f],
+                                          rest_area_(f), Corners(x, f))
+            : MembraneGradient(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f));
     for (int k = 0; k < 3; ++k) grad.row(triangles_(f, k)) += g.segment<3>(3 * k).transpose();
   }
 }
@@ -515,7 +707,11 @@ void MembraneElements::AddHessianTriplets(Eigen::Ref<const Vertices> x,
   triplets->reserve(triplets->size() + 81 * static_cast<std::size_t>(end - first));
   for (int f = first; f < end; ++f) {
     const Eigen::Matrix<double, 9, 9> h =
-        MembraneHessian(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f), project_psd);
+        model_ == MembraneModel::kOrthotropic
+            ? OrthotropicMembraneHessian(orthotropic_, compression_, rest_inverse_[f],
+                                         rest_area_(f), Corners(x, f), project_psd)
+            : MembraneHessian(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f),
+                              project_psd);
     for (int a = 0; a < 3; ++a) {
       for (int b = 0; b < 3; ++b) {
         for (int c = 0; c < 3; ++c) {

@@ -444,6 +444,38 @@ TEST(Membrane, SoftCompressionJustBelowOneIsStvk) {
   }
 }
 
+// The soft StVK with a buckling strain: its own energy, gradient and Hessian against central
+// differences (compressed past ε_b, within it, and mixed), and under uniform strain the plain
+// StVK energy while every principal strain and the area stay above -ε_b.
+TEST(Membrane, SoftCompressionWithBucklingStrain) {
+  const TriangleMesh rest = IrregularPatch(21);
+  const double eb = 0.01;
+  const MembraneElements m(rest, kStiffness, kPoisson, MembraneModel::kStVK, 0.1, eb);
+  for (unsigned seed = 0; seed < 3; ++seed) {
+    EXPECT_LT(RelativeGradientError(m, RandomConfiguration(rest, 0.006, 60 + seed)), 1e-6) << seed;
+    EXPECT_LT(RelativeHessianError(m, RandomConfiguration(rest, 0.006, 70 + seed)), 1e-6) << seed;
+  }
+  const auto strained = [&](double a, double b) {
+    return Affine(rest, (Eigen::Matrix<double, 3, 2>() << a, 0.0, 0.0, b, 0.0, 0.0).finished());
+  };
+  for (const auto& x : {strained(0.95, 0.93), strained(1.02, 0.96), strained(0.96, 0.97)}) {
+    EXPECT_LT(RelativeGradientError(m, x), 1e-6);
+    EXPECT_LT(RelativeHessianError(m, x), 1e-6);
+  }
+  const MembraneElements stvk(rest, kStiffness, kPoisson, MembraneModel::kStVK);
+  const MembraneElements no_buckling(rest, kStiffness, kPoisson, MembraneModel::kStVK, 0.1);
+  // Both principal strains -0.2 %, the area -0.4 %: within ε_b, StVK's energy.
+  const Vertices within = strained(0.998, 0.998);
+  EXPECT_NEAR(m.Energy(within), stvk.Energy(within), 1e-12 * stvk.Energy(within));
+  EXPECT_LT(no_buckling.Energy(within), 0.2 * stvk.Energy(within));
+  // Past it, softer than StVK but stiffer than without the buckling strain.
+  const Vertices past = strained(0.95, 0.96);
+  EXPECT_LT(m.Energy(past), 0.5 * stvk.Energy(past));
+  EXPECT_GT(m.Energy(past), no_buckling.Energy(past));
+  const Eigen::MatrixXd projected = DenseHessian(m, past, true);
+  EXPECT_GT(MinEigenvalue(projected), -1e-10 * projected.cwiseAbs().maxCoeff());
+}
+
 TEST(Membrane, CompressionRatioOutsideItsRangeIsRefused) {
   const TriangleMesh rest = RegularGridMesh(0.1, 0.1, 2, 2);
   for (const double c : {0.0, 5e-4, 1.5, std::nan("")}) {
@@ -835,9 +867,9 @@ TEST(OrthotropicMembrane, MaterialChoosesTheModelAndBadInputIsRefused) {
       Orthotropic(TensileCurve::Linear(1000.0), TensileCurve::Linear(800.0), 45.0, 0.1, 0.01);
   EXPECT_EQ(MembraneElements(rest, ortho, MembraneModel::kCorotationalLinear).model(),
             MembraneModel::kOrthotropic);
-  isotropic.buckling_strain = 0.01;
-  EXPECT_EQ(error([&] { MembraneElements(rest, isotropic, MembraneModel::kStVK); }).substr(0, 68),
-            "membrane: buckling strain 0.01 needs the orthotropic membrane (stret");
+  isotropic.buckling_strain = 1.5;
+  EXPECT_EQ(error([&] { MembraneElements(rest, isotropic, MembraneModel::kStVK); }),
+            "membrane: buckling strain must lie in [0, 1), got 1.5");
   EXPECT_EQ(error([&] { MembraneElements(rest, 1000.0, 0.3, MembraneModel::kOrthotropic); }),
             "membrane: the orthotropic model needs a material's warp, weft and shear");
   Material bad = ortho;

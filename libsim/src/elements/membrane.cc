@@ -79,8 +79,24 @@ Mat6 StvkStressDerivative(const MembraneLame& l, const Mat32& f) {
 }
 
 // ---- StVK soft in compression (MembraneLame::compression = c < 1): ψ = μ (q(E1) + q(E2)) +
-// λ/2 q(E1 + E2) over the principal Green strains, q(t) = w(t) t² with w = 1 for t ≥ 0 and c for
-// t < 0.
+// λ/2 q(E1 + E2) over the principal Green strains, q(t) = t² for t ≥ -b and, past it,
+// b² - 2 b (t + b) + c (t + b)² (C¹), b = MembraneLame::buckling the Green strain of the
+// buckling strain; b = 0: q = w(t) t², w = 1 for t ≥ 0 and c for t < 0.
+
+// q(t) and its derivatives, with q'(t) = 2 w t + κ: w = 1, κ = 0 down to -b; w = c and
+// κ = -2 b (1 - c) past it.
+struct SoftPiece {
+  double q, weight, kappa;
+  double dq(double t) const { return 2 * weight * t + kappa; }
+};
+
+SoftPiece Piece(const MembraneLame& l, double t) {
+  const double b = l.buckling;
+  if (t >= -b) return {t * t, 1.0, 0.0};
+  const double past = t + b;
+  return {b * b - 2 * b * past + l.compression * past * past, l.compression,
+          -2 * b * (1 - l.compression)};
+}
 
 // The principal strains Ei (E1 ≥ E2), their unit eigenvectors vi in the rest frame and the
 // principal second Piola-Kirchhoff stresses Si = ∂ψ/∂Ei = 2μ wi Ei + λ wt tr E.
@@ -88,7 +104,7 @@ struct SoftStrains {
   double strain[2];
   Eigen::Vector2d v[2];
   double stress[2];
-  double weight[2], weight_trace;
+  SoftPiece piece[2], piece_trace;
 };
 
 SoftStrains Soft(const MembraneLame& l, const Mat32& f) {
@@ -98,21 +114,18 @@ SoftStrains Soft(const MembraneLame& l, const Mat32& f) {
   for (int i = 0; i < 2; ++i) {
     t.strain[i] = green.eigenvalues()(1 - i);
     t.v[i] = green.eigenvectors().col(1 - i);
-    t.weight[i] = t.strain[i] < 0 ? l.compression : 1.0;
+    t.piece[i] = Piece(l, t.strain[i]);
   }
   const double tr = t.strain[0] + t.strain[1];
-  t.weight_trace = tr < 0 ? l.compression : 1.0;
+  t.piece_trace = Piece(l, tr);
   for (int i = 0; i < 2; ++i)
-    t.stress[i] = 2 * l.mu * t.weight[i] * t.strain[i] + l.lambda * t.weight_trace * tr;
+    t.stress[i] = l.mu * t.piece[i].dq(t.strain[i]) + 0.5 * l.lambda * t.piece_trace.dq(tr);
   return t;
 }
 
 double SoftDensity(const MembraneLame& l, const Mat32& f) {
   const SoftStrains t = Soft(l, f);
-  const double tr = t.strain[0] + t.strain[1];
-  return l.mu *
-             (t.weight[0] * t.strain[0] * t.strain[0] + t.weight[1] * t.strain[1] * t.strain[1]) +
-         0.5 * l.lambda * t.weight_trace * tr * tr;
+  return l.mu * (t.piece[0].q + t.piece[1].q) + 0.5 * l.lambda * t.piece_trace.q;
 }
 
 // P = F S, S = Σ Si vi viᵀ.
@@ -317,17 +330,21 @@ IsotropicEigenvalues StvkEigenvalues(const MembraneLame& l, double s1, double s2
 // μ w (σ1² + σ1 σ2 + σ2² − 1) when w1 = w2; twist (ψ1 + ψ2)/(σ1 + σ2); out of plane Si.
 IsotropicEigenvalues SoftEigenvalues(const MembraneLame& l, double s1, double s2) {
   IsotropicEigenvalues e;
-  const double c = l.compression;
   const double e1 = 0.5 * (s1 * s1 - 1), e2 = 0.5 * (s2 * s2 - 1), tr = e1 + e2;
-  const double w1 = e1 < 0 ? c : 1.0, w2 = e2 < 0 ? c : 1.0, wt = tr < 0 ? c : 1.0;
-  const double stress1 = 2 * l.mu * w1 * e1 + l.lambda * wt * tr;
-  const double stress2 = 2 * l.mu * w2 * e2 + l.lambda * wt * tr;
+  const SoftPiece p1 = Piece(l, e1), p2 = Piece(l, e2), pt = Piece(l, tr);
+  const double w1 = p1.weight, w2 = p2.weight, wt = pt.weight;
+  const double trace_stress = 0.5 * l.lambda * pt.dq(tr);  // λ/2 q'(tr E)
+  const double stress1 = l.mu * p1.dq(e1) + trace_stress;
+  const double stress2 = l.mu * p2.dq(e2) + trace_stress;
   e.stretch << stress1 + (2 * l.mu * w1 + l.lambda * wt) * s1 * s1, l.lambda * wt * s1 * s2,
       l.lambda * wt * s1 * s2, stress2 + (2 * l.mu * w2 + l.lambda * wt) * s2 * s2;
-  const double shear_mu = w1 == w2 || !(s1 - s2 > 1e-12)
-                              ? 0.5 * (w1 + w2) * (s1 * s1 + s1 * s2 + s2 * s2 - 1)
-                              : (w1 * (s1 * s1 * s1 - s1) - w2 * (s2 * s2 * s2 - s2)) / (s1 - s2);
-  e.shear = l.lambda * wt * tr + l.mu * shear_mu;
+  // (σ1 q'(E1) - σ2 q'(E2)) / (σ1 - σ2), in closed form when both are on one piece.
+  const bool one_piece = w1 == w2 && p1.kappa == p2.kappa;
+  const double shear_mu =
+      one_piece || !(s1 - s2 > 1e-12)
+          ? 0.5 * (w1 + w2) * (s1 * s1 + s1 * s2 + s2 * s2 - 1) + 0.5 * (p1.kappa + p2.kappa)
+          : (s1 * p1.dq(e1) - s2 * p2.dq(e2)) / (s1 - s2);
+  e.shear = trace_stress + l.mu * shear_mu;
   e.twist = (s1 * stress1 + s2 * stress2) / (s1 + s2);
   e.out[0] = stress1;
   e.out[1] = stress2;
@@ -475,7 +492,7 @@ Mat6 OrthotropicStressDerivative(const OrthotropicMembrane& law, const MembraneC
 }  // namespace
 
 MembraneLame MembraneLame::FromStretch(double stretch_stiffness, double poisson,
-                                       double compression) {
+                                       double compression, double buckling_strain) {
   if (!(stretch_stiffness > 0) || !std::isfinite(stretch_stiffness)) {
     throw InputError("membrane: stretch_stiffness must be a positive number of N/m, got " +
                      NumberText(stretch_stiffness));
@@ -488,8 +505,14 @@ MembraneLame MembraneLame::FromStretch(double stretch_stiffness, double poisson,
     throw InputError("membrane: compression ratio must lie in [" + NumberText(kMinCompressionRatio) +
                      ", 1], got " + NumberText(compression));
   }
+  if (!(buckling_strain >= 0 && buckling_strain < 1)) {
+    throw InputError("membrane: buckling strain must lie in [0, 1), got " +
+                     NumberText(buckling_strain));
+  }
   MembraneLame l;
   l.compression = compression;
+  // The Green strain of the engineering strain -ε_b: ½ ((1 - ε_b)² - 1) = -(ε_b - ε_b²/2).
+  l.buckling = buckling_strain - 0.5 * buckling_strain * buckling_strain;
   l.mu = stretch_stiffness / (2 * (1 + poisson));
   l.lambda = stretch_stiffness * poisson / (1 - poisson * poisson);
   return l;
@@ -585,8 +608,10 @@ Eigen::Matrix2d RestInverse(const Eigen::Matrix3d& corners, int index, double* r
 }
 
 MembraneElements::MembraneElements(const TriangleMesh& rest, double stretch_stiffness,
-                                   double poisson, MembraneModel model, double compression)
-    : model_(model), lame_(MembraneLame::FromStretch(stretch_stiffness, poisson, compression)) {
+                                   double poisson, MembraneModel model, double compression,
+                                   double buckling_strain)
+    : model_(model),
+      lame_(MembraneLame::FromStretch(stretch_stiffness, poisson, compression, buckling_strain)) {
   if (model == MembraneModel::kOrthotropic) {
     throw InputError("membrane: the orthotropic model needs a material's warp, weft and shear");
   }
@@ -624,14 +649,8 @@ MembraneElements::MembraneElements(const TriangleMesh& rest, const Material& mat
     if (model == MembraneModel::kOrthotropic) {
       throw InputError("membrane: the orthotropic model needs a material's warp, weft and shear");
     }
-    // The isotropic soft StVK takes a ratio only (docs/methods/meshing-and-membrane.md).
-    if (material.buckling_strain != 0.0) {
-      throw InputError("membrane: buckling strain " + NumberText(material.buckling_strain) +
-                       " needs the orthotropic membrane (stretch.warp/weft/shear); the isotropic "
-                       "one takes only a compression ratio");
-    }
     lame_ = MembraneLame::FromStretch(material.stretch_stiffness, material.poisson,
-                                      material.compression_ratio);
+                                      material.compression_ratio, material.buckling_strain);
   }
   BuildRestShapes(rest);
 }

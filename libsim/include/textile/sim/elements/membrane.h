@@ -30,9 +30,11 @@
 //   μ = k / (2 (1 + ν)),  λ = k ν / (1 - ν²),
 // with e = ε (corotational) or e = E (StVK).
 //
-// Soft in compression (StVK with compression c < 1, the material's stretch.compression_ratio):
-// over the principal Green strains E1, E2, ψ = μ (q(E1) + q(E2)) + λ/2 q(E1 + E2) with q(t) = t²
-// for t ≥ 0 and c t² for t < 0, which is StVK's ψ when c = 1. Woven fabric buckles at a small
+// Soft in compression (StVK with compression c < 1, the material's stretch.compression_ratio,
+// and buckling strain ε_b ≥ 0): over the principal Green strains E1, E2,
+// ψ = μ (q(E1) + q(E2)) + λ/2 q(E1 + E2) with q(t) = t² for t ≥ -b and
+// b² - 2 b (t + b) + c (t + b)² past it (C¹; b = ε_b - ε_b²/2, the Green strain of -ε_b), which is
+// StVK's ψ when c = 1; with ε_b = 0, q = c t² for t < 0. Woven fabric buckles at a small
 // fraction of the load it takes in tension (what cloth tools call a buckling ratio); c is that
 // fraction. The energy is C¹ (its stiffness jumps where a principal strain changes sign); the
 // Hessian comes from the isotropic eigensystem in closed form (membrane.cc), exact or with its
@@ -67,10 +69,13 @@ struct MembraneLame {
   // StVK only: the factor c on the energy of a compressed principal Green strain and of a
   // compressed area (tr E < 0), c = 1: plain StVK. See MembraneModel.
   double compression = 1.0;
-  // Throws InputError unless k > 0 is finite, -1 < ν < 1 (a positive-definite sheet) and
-  // kMinCompressionRatio ≤ compression ≤ 1.
+  // StVK only: b, the Green strain down to which a compressed principal strain keeps the full
+  // stiffness (the buckling strain ε_b as b = ε_b - ε_b²/2) [-].
+  double buckling = 0.0;
+  // Throws InputError unless k > 0 is finite, -1 < ν < 1 (a positive-definite sheet),
+  // kMinCompressionRatio ≤ compression ≤ 1 and 0 ≤ buckling_strain < 1.
   static MembraneLame FromStretch(double stretch_stiffness, double poisson,
-                                  double compression = 1.0);
+                                  double compression = 1.0, double buckling_strain = 0.0);
 };
 
 // One triangle, the building block of MembraneElements.
@@ -124,12 +129,11 @@ class MembraneElements {
   // Throws InputError for a bad stiffness or Poisson ratio, a triangle referring to a missing
   // vertex, or a degenerate rest triangle (naming it), or model kOrthotropic (no yarn laws).
   MembraneElements(const TriangleMesh& rest, double stretch_stiffness, double poisson,
-                   MembraneModel model, double compression = 1.0);
+                   MembraneModel model, double compression = 1.0, double buckling_strain = 0.0);
   // The orthotropic model when material.orthotropic is set (`model` is then ignored), otherwise
   // `model` with material.stretch_stiffness and material.poisson; material.Compression() in both
   // cases. Throws InputError as above, for a compression ratio outside
-  // [kMinCompressionRatio, 1], a negative or non-finite shear modulus or buckling strain, and
-  // for buckling_strain > 0 on an isotropic material (its soft StVK has only the ratio).
+  // [kMinCompressionRatio, 1], a negative or non-finite shear modulus or buckling strain.
   MembraneElements(const TriangleMesh& rest, const Material& material, MembraneModel model);
 
   // @param x  #V×3 current positions [m]. Total membrane energy [J].

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "textile/sim/core/error.h"
+#include "textile/sim/law/membrane_law.h"
 #include "textile/sim/mesh/mesh.h"
 #include "textile/sim/mesh/pattern_mesh.h"
 
@@ -443,6 +444,38 @@ TEST(Membrane, SoftCompressionJustBelowOneIsStvk) {
   }
 }
 
+// The soft StVK with a buckling strain: its own energy, gradient and Hessian against central
+// differences (compressed past ε_b, within it, and mixed), and under uniform strain the plain
+// StVK energy while every principal strain and the area stay above -ε_b.
+TEST(Membrane, SoftCompressionWithBucklingStrain) {
+  const TriangleMesh rest = IrregularPatch(21);
+  const double eb = 0.01;
+  const MembraneElements m(rest, kStiffness, kPoisson, MembraneModel::kStVK, 0.1, eb);
+  for (unsigned seed = 0; seed < 3; ++seed) {
+    EXPECT_LT(RelativeGradientError(m, RandomConfiguration(rest, 0.006, 60 + seed)), 1e-6) << seed;
+    EXPECT_LT(RelativeHessianError(m, RandomConfiguration(rest, 0.006, 70 + seed)), 1e-6) << seed;
+  }
+  const auto strained = [&](double a, double b) {
+    return Affine(rest, (Eigen::Matrix<double, 3, 2>() << a, 0.0, 0.0, b, 0.0, 0.0).finished());
+  };
+  for (const auto& x : {strained(0.95, 0.93), strained(1.02, 0.96), strained(0.96, 0.97)}) {
+    EXPECT_LT(RelativeGradientError(m, x), 1e-6);
+    EXPECT_LT(RelativeHessianError(m, x), 1e-6);
+  }
+  const MembraneElements stvk(rest, kStiffness, kPoisson, MembraneModel::kStVK);
+  const MembraneElements no_buckling(rest, kStiffness, kPoisson, MembraneModel::kStVK, 0.1);
+  // Both principal strains -0.2 %, the area -0.4 %: within ε_b, StVK's energy.
+  const Vertices within = strained(0.998, 0.998);
+  EXPECT_NEAR(m.Energy(within), stvk.Energy(within), 1e-12 * stvk.Energy(within));
+  EXPECT_LT(no_buckling.Energy(within), 0.2 * stvk.Energy(within));
+  // Past it, softer than StVK but stiffer than without the buckling strain.
+  const Vertices past = strained(0.95, 0.96);
+  EXPECT_LT(m.Energy(past), 0.5 * stvk.Energy(past));
+  EXPECT_GT(m.Energy(past), no_buckling.Energy(past));
+  const Eigen::MatrixXd projected = DenseHessian(m, past, true);
+  EXPECT_GT(MinEigenvalue(projected), -1e-10 * projected.cwiseAbs().maxCoeff());
+}
+
 TEST(Membrane, CompressionRatioOutsideItsRangeIsRefused) {
   const TriangleMesh rest = RegularGridMesh(0.1, 0.1, 2, 2);
   for (const double c : {0.0, 5e-4, 1.5, std::nan("")}) {
@@ -511,6 +544,346 @@ TEST(Membrane, BadInputIsRefusedByName) {
   const MembraneElements m(rest, 1000.0, 0.3, MembraneModel::kStVK);
   EXPECT_EQ(error([&] { m.Energy(Vertices::Zero(4, 3)); }),
             "membrane: positions have 4 rows, the mesh has 9 vertices");
+}
+
+// ---- The orthotropic membrane (MembraneModel::kOrthotropic).
+
+// A material with an orthotropic block (nothing parses one yet: built in code).
+Material Orthotropic(const TensileCurve& warp, const TensileCurve& weft, double shear,
+                     double ratio = 1.0, double buckling_strain = 0.0) {
+  Material m;
+  m.orthotropic = OrthotropicMembrane{warp, weft, shear};
+  m.compression_ratio = ratio;
+  m.buckling_strain = buckling_strain;
+  return m;
+}
+
+// The rest mesh under the uniform gradient a, each vertex displaced by up to `noise` [m], then
+// rotated and moved rigidly.
+Vertices Deformed(const TriangleMesh& rest, const Eigen::Matrix<double, 3, 2>& a, double noise,
+                  unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-noise, noise);
+  const Eigen::Matrix3d r = RandomRotation(rng);
+  Vertices x = Affine(rest, a);
+  for (int v = 0; v < x.rows(); ++v) x.row(v) += Eigen::RowVector3d(u(rng), u(rng), u(rng));
+  x = x * r.transpose();
+  x.rowwise() += Eigen::RowVector3d(0.3, -0.2, 0.1);
+  return x;
+}
+
+Eigen::Matrix<double, 3, 2> Gradient3x2(double f11, double f12, double f21, double f22) {
+  return (Eigen::Matrix<double, 3, 2>() << f11, f12, f21, f22, 0.0, 0.0).finished();
+}
+
+// The states the orthotropic tests visit: both yarns stretched; both compressed past a
+// buckling strain of 1 %; sheared by about 0.2 rad; a random mix. Vertex noise 0.3 mm against
+// ~33 mm edges moves strains by ~1 %, so no yarn sits within a finite-difference step of a kink
+// (ε = 0, ε = -ε_b) except by chance.
+std::vector<std::pair<std::string, Vertices>> OrthotropicStates(const TriangleMesh& rest) {
+  return {{"tension", Deformed(rest, Gradient3x2(1.04, 0.0, 0.0, 1.03), 3e-4, 1)},
+          {"compression", Deformed(rest, Gradient3x2(0.95, 0.0, 0.0, 0.94), 3e-4, 2)},
+          {"shear", Deformed(rest, Gradient3x2(1.0, 0.1, 0.1, 1.0), 3e-4, 3)},
+          {"mixed", RandomConfiguration(rest, 0.006, 4)}};
+}
+
+TEST(OrthotropicMembrane, GradientAndHessianMatchCentralDifferences) {
+  const TriangleMesh rest = IrregularPatch(11);
+  const Material linear = Orthotropic(TensileCurve::Linear(1500.0), TensileCurve::Linear(600.0),
+                                      80.0, 0.1, 0.01);
+  // KES curves (EMT 5 % and 8 %; LT 0.65 and 0.45, the second with the power-law form), stiff in
+  // compression: the curves' nonlinearity on its own.
+  const Material kes = Orthotropic(TensileCurveFromKes(5.0, 0.65), TensileCurveFromKes(8.0, 0.45),
+                                   45.0);
+  for (const auto& [label, material] : {std::pair{"linear", linear}, std::pair{"kes", kes}}) {
+    const MembraneElements m(rest, material, MembraneModel::kStVK);
+    ASSERT_EQ(m.model(), MembraneModel::kOrthotropic);
+    for (const auto& [state, x] : OrthotropicStates(rest)) {
+      EXPECT_LT(RelativeGradientError(m, x), 1e-6) << label << ", " << state;
+      EXPECT_LT(RelativeHessianError(m, x), 1e-6) << label << ", " << state;
+    }
+  }
+}
+
+TEST(OrthotropicMembrane, ProjectedHessianIsPsdAndExactWhereNothingIsCompressed) {
+  const TriangleMesh rest = IrregularPatch(12);
+  const MembraneElements m(
+      rest, Orthotropic(TensileCurveFromKes(5.0, 0.65), TensileCurve::Linear(600.0), 80.0, 0.05, 0.005),
+      MembraneModel::kStVK);
+  int indefinite = 0;
+  for (const auto& [state, x] : OrthotropicStates(rest)) {
+    const Eigen::MatrixXd raw = DenseHessian(m, x, false), projected = DenseHessian(m, x, true);
+    const double scale = raw.cwiseAbs().maxCoeff();
+    // Eigen-solver round-off on a matrix of norm ~scale.
+    EXPECT_GT(MinEigenvalue(projected), -1e-10 * scale) << state;
+    if (MinEigenvalue(raw) < -1e-6 * scale) ++indefinite;
+  }
+  EXPECT_GE(indefinite, 2);  // compression and the mix: the projection was exercised
+  // Stretched along both yarns without shear, and stretched with a little shear where the
+  // tension's stiffness dominates: the projection leaves the exact Hessian alone.
+  for (const Vertices& x : {Affine(rest, Gradient3x2(1.04, 0.0, 0.0, 1.03)),
+                            Deformed(rest, Gradient3x2(1.04, 0.0, 0.0, 1.03), 3e-4, 5)}) {
+    const Eigen::MatrixXd raw = DenseHessian(m, x, false);
+    EXPECT_LT((DenseHessian(m, x, true) - raw).cwiseAbs().maxCoeff(),
+              1e-12 * raw.cwiseAbs().maxCoeff());
+  }
+}
+
+// The shear term's closed-form projection against the eigen-solve: yarns a billion times softer
+// than the shear (stretched, so not projected themselves), F random. Clamping moves a matrix by
+// at most the perturbation, so the yarns' terms bound the difference (~1e-9 of the shear's).
+TEST(OrthotropicMembrane, ShearProjectionIsTheEigenSolvesClampedMatrix) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const OrthotropicMembrane law{TensileCurve::Linear(1e-6), TensileCurve::Linear(1e-6), 1000.0};
+  Eigen::Matrix2d dm;
+  dm << 0.01, 0.004, 0.0, 0.009;
+  const Eigen::Matrix2d b = dm.inverse();
+  Eigen::Matrix<double, 6, 9> g = Eigen::Matrix<double, 6, 9>::Zero();
+  for (int j = 0; j < 2; ++j) {
+    const double c[3] = {-(b(0, j) + b(1, j)), b(0, j), b(1, j)};
+    for (int a = 0; a < 3; ++a) g.block<3, 3>(3 * j, 3 * a) = c[a] * Eigen::Matrix3d::Identity();
+  }
+  const Eigen::Matrix<double, 6, 6> left = (g * g.transpose()).inverse();
+  for (int trial = 0; trial < 50; ++trial) {
+    // Yarn stretches 1.02..1.3, shear angles up to ±0.6 rad (both signs of γ).
+    const double l1 = 1.16 + 0.14 * unit(rng), l2 = 1.16 + 0.14 * unit(rng), t = 0.6 * unit(rng);
+    const Eigen::Matrix3d r = RandomRotation(rng);
+    const Eigen::Matrix<double, 3, 2> f =
+        r.leftCols<2>() *
+        (Eigen::Matrix2d() << l1, l2 * std::sin(t), 0.0, l2 * std::cos(t)).finished();
+    Eigen::Matrix3d x;
+    x.row(0).setZero();
+    x.row(1) = (f * dm.col(0)).transpose();
+    x.row(2) = (f * dm.col(1)).transpose();
+    const Eigen::Matrix<double, 9, 9> raw = OrthotropicMembraneHessian(law, {}, b, 1.0, x, false);
+    const Eigen::Matrix<double, 9, 9> projected =
+        OrthotropicMembraneHessian(law, {}, b, 1.0, x, true);
+    const Eigen::Matrix<double, 6, 6> h = left * g * raw * g.transpose() * left;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(0.5 * (h + h.transpose()));
+    const Eigen::Matrix<double, 6, 6> clamped =
+        eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *
+        eig.eigenvectors().transpose();
+    const Eigen::Matrix<double, 9, 9> expected = g.transpose() * clamped * g;
+    EXPECT_LT((projected - expected).cwiseAbs().maxCoeff(), 1e-8 * raw.cwiseAbs().maxCoeff())
+        << "trial " << trial << ", shear angle " << t;
+  }
+}
+
+// Sum of the gradient over the vertices with the given pattern coordinate at `value` [N].
+Eigen::Vector3d EdgeForce(const TriangleMesh& rest, const Vertices& g, int axis, double value,
+                          bool skip_corners = false) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int v = 0; v < rest.num_vertices(); ++v) {
+    if (std::abs(rest.vertices(v, axis) - value) > 1e-12) continue;
+    const double other = rest.vertices(v, 1 - axis);
+    const double other_max = rest.vertices.col(1 - axis).maxCoeff();
+    if (skip_corners && (other < 1e-12 || other > other_max - 1e-12)) continue;
+    sum += g.row(v).transpose();
+  }
+  return sum;
+}
+
+// Stretched along one yarn with the other's length held, which is where a free lateral edge
+// settles (the yarns are uncoupled): the end carries the curve's force per width, no lateral
+// force anywhere, and the energy is the curve's energy times the area.
+TEST(OrthotropicMembrane, StripsReproduceTheWarpAndWeftCurves) {
+  const double width = 0.2, height = 0.05;
+  const TriangleMesh strip = CrissCrossGridMesh(width, height, 8, 2);
+  const TensileCurve warp = TensileCurveFromKes(5.0, 0.65), weft = TensileCurveFromKes(8.0, 0.45);
+  const MembraneElements m(strip, Orthotropic(warp, weft, 45.0), MembraneModel::kStVK);
+  for (const double eps : {0.01, 0.03, 0.07}) {  // 0.07: past the warp's EMT
+    // Along x (warp): the right end at x = width carries warp.Force(ε) · height along x.
+    const Vertices along_x = Affine(strip, Gradient3x2(1 + eps, 0.0, 0.0, 1.0));
+    const Vertices gx = Gradient(m, along_x);
+    const Eigen::Vector3d end_x = EdgeForce(strip, gx, 0, width);
+    const double tol = 1e-9 * warp.Force(eps) * height;  // round-off on sums of ~10 forces
+    EXPECT_NEAR(end_x.x(), warp.Force(eps) * height, tol) << "warp, ε " << eps;
+    EXPECT_LT(gx.col(1).cwiseAbs().maxCoeff(), tol) << "warp: no lateral force, ε " << eps;
+    EXPECT_NEAR(m.Energy(along_x), warp.Energy(eps) * width * height,
+                1e-12 * warp.Energy(eps) * width * height);
+    // Along y (weft): the top at y = height carries weft.Force(ε) · width along y.
+    const Vertices along_y = Affine(strip, Gradient3x2(1.0, 0.0, 0.0, 1 + eps));
+    const Vertices gy = Gradient(m, along_y);
+    const Eigen::Vector3d end_y = EdgeForce(strip, gy, 1, height);
+    EXPECT_NEAR(end_y.y(), weft.Force(eps) * width, 1e-9 * weft.Force(eps) * width)
+        << "weft, ε " << eps;
+    EXPECT_LT(gy.col(0).cwiseAbs().maxCoeff(), 1e-9 * weft.Force(eps) * width);
+    EXPECT_GT(warp.Force(eps), 0.0);
+  }
+}
+
+// f1 = (cos θ, sin θ), f2 = (sin θ, cos θ): both yarns keep their length, γ = f1·f2 = sin 2θ.
+// The energy is ½ G γ² per area and the right end (normal x) carries the shear traction G γ f2
+// per width; its corners also take half an edge of the top and bottom tractions G γ f1, so they
+// are left out of the sum (an interior end of height - dy).
+TEST(OrthotropicMembrane, ShearedSheetGivesGGammaPerWidth) {
+  const double width = 0.1, height = 0.1, shear = 60.0;
+  const int ny = 4;
+  const TriangleMesh sheet = CrissCrossGridMesh(width, height, 4, ny);
+  const MembraneElements m(
+      sheet, Orthotropic(TensileCurve::Linear(1000.0), TensileCurve::Linear(800.0), shear),
+      MembraneModel::kStVK);
+  for (const double theta : {0.01, 0.1}) {
+    const double gamma = std::sin(2 * theta);
+    const Eigen::Matrix<double, 3, 2> a =
+        Gradient3x2(std::cos(theta), std::sin(theta), std::sin(theta), std::cos(theta));
+    const Vertices x = Affine(sheet, a);
+    EXPECT_NEAR(m.Energy(x), 0.5 * shear * gamma * gamma * width * height,
+                1e-12 * 0.5 * shear * gamma * gamma * width * height);
+    const Eigen::Vector3d end = EdgeForce(sheet, Gradient(m, x), 0, width, /*skip_corners=*/true);
+    const Eigen::Vector3d expected = shear * gamma * (height - height / ny) * a.col(1);
+    EXPECT_LT((end - expected).norm(), 1e-9 * expected.norm()) << "θ " << theta;
+  }
+}
+
+TEST(OrthotropicMembrane, InvariantUnderRigidMotion) {
+  const TriangleMesh rest = IrregularPatch(14);
+  const MembraneElements m(rest,
+                           Orthotropic(TensileCurveFromKes(5.0, 0.65),
+                                       TensileCurve::Linear(600.0), 80.0, 0.1, 0.01),
+                           MembraneModel::kStVK);
+  std::mt19937 rng(15);
+  for (const auto& [state, x] : OrthotropicStates(rest)) {
+    const Eigen::Matrix3d r = RandomRotation(rng);
+    Vertices y = x * r.transpose();
+    y.rowwise() += Eigen::RowVector3d(1.0, -2.0, 0.5);
+    EXPECT_NEAR(m.Energy(y), m.Energy(x), 1e-12 * m.Energy(x)) << state;
+    const Vertices gx = Gradient(m, x), gy = Gradient(m, y);
+    EXPECT_LT((gy - gx * r.transpose()).cwiseAbs().maxCoeff(), 1e-9 * gx.cwiseAbs().maxCoeff())
+        << state;
+  }
+  EXPECT_LT(std::abs(m.Energy(RandomConfiguration(rest, 0.0, 16))), 1e-20);  // rigid: nothing
+}
+
+// Warp = weft = k, G = k/2 is the corotational linear sheet with ν = 0 to first order in the
+// strain: ½ k (ε11² + ε22²) + ½ G (2 ε12)² = μ |ε|², μ = k/2. At strains ~1e-4 the models'
+// nonlinear terms differ by ~1e-4 of the energy.
+TEST(OrthotropicMembrane, EqualYarnsAndHalfShearAreTheLinearSheetAtSmallStrain) {
+  const TriangleMesh rest = IrregularPatch(17);
+  const double k = 1000.0;
+  const MembraneElements ortho(
+      rest, Orthotropic(TensileCurve::Linear(k), TensileCurve::Linear(k), k / 2),
+      MembraneModel::kStVK);
+  const MembraneElements linear(rest, k, 0.0, MembraneModel::kCorotationalLinear);
+  for (unsigned seed = 0; seed < 3; ++seed) {
+    const Vertices x = RandomConfiguration(rest, 3e-6, 40 + seed);  // 3 µm on ~33 mm edges
+    EXPECT_NEAR(ortho.Energy(x), linear.Energy(x), 1e-3 * linear.Energy(x)) << seed;
+    const Vertices go = Gradient(ortho, x), gl = Gradient(linear, x);
+    EXPECT_LT((go - gl).cwiseAbs().maxCoeff(), 1e-3 * gl.cwiseAbs().maxCoeff()) << seed;
+  }
+}
+
+TEST(OrthotropicMembrane, StifferWarpGivesAStifferResponseAlongX) {
+  const TriangleMesh rest = IrregularPatch(18);
+  const MembraneElements m(
+      rest, Orthotropic(TensileCurve::Linear(2000.0), TensileCurve::Linear(500.0), 45.0),
+      MembraneModel::kStVK);
+  const double along_x = m.Energy(Affine(rest, Gradient3x2(1.01, 0.0, 0.0, 1.0)));
+  const double along_y = m.Energy(Affine(rest, Gradient3x2(1.0, 0.0, 0.0, 1.01)));
+  EXPECT_NEAR(along_x / along_y, 4.0, 1e-9);  // the moduli's ratio
+  // A 45° stretch loads both yarns alike: between the two.
+  const double c = 1 + 0.01 / std::sqrt(2.0), s = 0.01 / std::sqrt(2.0);
+  const double diagonal = m.Energy(Affine(rest, Gradient3x2(c, s, s, c)));
+  EXPECT_LT(diagonal, along_x);
+  EXPECT_GT(diagonal, along_y);
+}
+
+// The rest frame's first axis is pattern x in the triangle's plane: a sheet tilted about x (its
+// triangles' planes still hold x) stretched along x is loaded in the warp only, whichever edge
+// comes first; a sheet standing in the y-z plane (x normal to every triangle) falls back to the
+// first edge and still has a finite, rigid-motion-free energy.
+TEST(OrthotropicMembrane, RestFrameFollowsPatternX) {
+  TriangleMesh rest = IrregularPatch(19);
+  const double tilt = 0.6;
+  const Eigen::Matrix3d about_x = Eigen::AngleAxisd(tilt, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  TriangleMesh tilted = rest;
+  tilted.vertices = rest.vertices * about_x.transpose();
+  const TensileCurve warp = TensileCurve::Linear(2000.0), weft = TensileCurve::Linear(500.0);
+  const MembraneElements m(tilted, Orthotropic(warp, weft, 45.0), MembraneModel::kStVK);
+  Vertices x = tilted.vertices;
+  x.col(0) *= 1.02;
+  EXPECT_NEAR(m.Energy(x), warp.Energy(0.02) * 0.01, 1e-12 * warp.Energy(0.02) * 0.01);
+  TriangleMesh standing = rest;
+  standing.vertices.col(2) = rest.vertices.col(0);
+  standing.vertices.col(0).setZero();
+  const MembraneElements fallback(standing, Orthotropic(warp, weft, 45.0), MembraneModel::kStVK);
+  EXPECT_LT(std::abs(fallback.Energy(standing.vertices)), 1e-20);
+  const double stretched = fallback.Energy(standing.vertices * 1.01);
+  EXPECT_TRUE(std::isfinite(stretched));
+  EXPECT_GT(stretched, 0.0);
+}
+
+// The isotropic models do not care about the rest frame: their energies in the pattern-x frame
+// match those in the first-edge frame (the frame before this one) to round-off, on a flat and a
+// tilted rest mesh.
+TEST(Membrane, IsotropicEnergiesDoNotDependOnTheRestFrame) {
+  TriangleMesh rest = IrregularPatch(20);
+  TriangleMesh tilted = rest;
+  tilted.vertices =
+      rest.vertices *
+      Eigen::AngleAxisd(0.8, Eigen::Vector3d(1, 2, 0.5).normalized()).toRotationMatrix().transpose();
+  for (const TriangleMesh* mesh : {&rest, &tilted}) {
+    for (const MembraneModel model : kModels) {
+      for (const double c : {1.0, 0.2}) {
+        if (model != MembraneModel::kStVK && c != 1.0) continue;
+        const MembraneElements m(*mesh, kStiffness, kPoisson, model, c);
+        const MembraneLame lame = MembraneLame::FromStretch(kStiffness, kPoisson, c);
+        const Vertices x = RandomConfiguration(*mesh, 0.006, 50);
+        double first_edge = 0;
+        for (int f = 0; f < mesh->num_triangles(); ++f) {
+          Eigen::Matrix3d rest_corners, corners;
+          for (int k = 0; k < 3; ++k) {
+            rest_corners.row(k) = mesh->vertices.row(mesh->triangles(f, k));
+            corners.row(k) = x.row(mesh->triangles(f, k));
+          }
+          const Eigen::Vector3d e1 = (rest_corners.row(1) - rest_corners.row(0)).transpose(),
+                                e2 = (rest_corners.row(2) - rest_corners.row(0)).transpose();
+          const Eigen::Vector3d t1 = e1.normalized(), t2 = e1.cross(e2).normalized().cross(t1);
+          Eigen::Matrix2d dm;
+          dm << e1.dot(t1), e2.dot(t1), 0.0, e2.dot(t2);
+          first_edge += MembraneEnergy(model, lame, dm.inverse(), 0.5 * e1.cross(e2).norm(), corners);
+        }
+        EXPECT_NEAR(m.Energy(x), first_edge, 1e-12 * first_edge) << Name(model) << ", c " << c;
+      }
+    }
+  }
+}
+
+TEST(OrthotropicMembrane, MaterialChoosesTheModelAndBadInputIsRefused) {
+  const TriangleMesh rest = RegularGridMesh(0.1, 0.1, 2, 2);
+  auto error = [&](const std::function<void()>& f) -> std::string {
+    try {
+      f();
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "(no InputError)";
+  };
+  Material isotropic;
+  EXPECT_EQ(MembraneElements(rest, isotropic, MembraneModel::kCorotationalLinear).model(),
+            MembraneModel::kCorotationalLinear);
+  const Material ortho =
+      Orthotropic(TensileCurve::Linear(1000.0), TensileCurve::Linear(800.0), 45.0, 0.1, 0.01);
+  EXPECT_EQ(MembraneElements(rest, ortho, MembraneModel::kCorotationalLinear).model(),
+            MembraneModel::kOrthotropic);
+  isotropic.buckling_strain = 1.5;
+  EXPECT_EQ(error([&] { MembraneElements(rest, isotropic, MembraneModel::kStVK); }),
+            "membrane: buckling strain must lie in [0, 1), got 1.5");
+  EXPECT_EQ(error([&] { MembraneElements(rest, 1000.0, 0.3, MembraneModel::kOrthotropic); }),
+            "membrane: the orthotropic model needs a material's warp, weft and shear");
+  Material bad = ortho;
+  bad.orthotropic->shear_modulus = -1.0;
+  EXPECT_EQ(error([&] { MembraneElements(rest, bad, MembraneModel::kStVK); }),
+            "membrane: shear modulus must be a finite number ≥ 0 of N/m, got -1");
+  bad = ortho;
+  bad.compression_ratio = 0.0;
+  EXPECT_EQ(error([&] { MembraneElements(rest, bad, MembraneModel::kStVK); }).substr(0, 50),
+            "membrane: compression ratio must lie in [0.001, 1]");
+  bad = ortho;
+  bad.buckling_strain = -0.01;
+  EXPECT_EQ(error([&] { MembraneElements(rest, bad, MembraneModel::kStVK); }),
+            "membrane: buckling strain must be a finite number ≥ 0, got -0.01");
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <cassert>
 #include <cmath>
 
 #include "textile/sim/core/error.h"
@@ -78,8 +79,24 @@ Mat6 StvkStressDerivative(const MembraneLame& l, const Mat32& f) {
 }
 
 // ---- StVK soft in compression (MembraneLame::compression = c < 1): ψ = μ (q(E1) + q(E2)) +
-// λ/2 q(E1 + E2) over the principal Green strains, q(t) = w(t) t² with w = 1 for t ≥ 0 and c for
-// t < 0.
+// λ/2 q(E1 + E2) over the principal Green strains, q(t) = t² for t ≥ -b and, past it,
+// b² - 2 b (t + b) + c (t + b)² (C¹), b = MembraneLame::buckling the Green strain of the
+// buckling strain; b = 0: q = w(t) t², w = 1 for t ≥ 0 and c for t < 0.
+
+// q(t) and its derivatives, with q'(t) = 2 w t + κ: w = 1, κ = 0 down to -b; w = c and
+// κ = -2 b (1 - c) past it.
+struct SoftPiece {
+  double q, weight, kappa;
+  double dq(double t) const { return 2 * weight * t + kappa; }
+};
+
+SoftPiece Piece(const MembraneLame& l, double t) {
+  const double b = l.buckling;
+  if (t >= -b) return {t * t, 1.0, 0.0};
+  const double past = t + b;
+  return {b * b - 2 * b * past + l.compression * past * past, l.compression,
+          -2 * b * (1 - l.compression)};
+}
 
 // The principal strains Ei (E1 ≥ E2), their unit eigenvectors vi in the rest frame and the
 // principal second Piola-Kirchhoff stresses Si = ∂ψ/∂Ei = 2μ wi Ei + λ wt tr E.
@@ -87,7 +104,7 @@ struct SoftStrains {
   double strain[2];
   Eigen::Vector2d v[2];
   double stress[2];
-  double weight[2], weight_trace;
+  SoftPiece piece[2], piece_trace;
 };
 
 SoftStrains Soft(const MembraneLame& l, const Mat32& f) {
@@ -97,21 +114,18 @@ SoftStrains Soft(const MembraneLame& l, const Mat32& f) {
   for (int i = 0; i < 2; ++i) {
     t.strain[i] = green.eigenvalues()(1 - i);
     t.v[i] = green.eigenvectors().col(1 - i);
-    t.weight[i] = t.strain[i] < 0 ? l.compression : 1.0;
+    t.piece[i] = Piece(l, t.strain[i]);
   }
   const double tr = t.strain[0] + t.strain[1];
-  t.weight_trace = tr < 0 ? l.compression : 1.0;
+  t.piece_trace = Piece(l, tr);
   for (int i = 0; i < 2; ++i)
-    t.stress[i] = 2 * l.mu * t.weight[i] * t.strain[i] + l.lambda * t.weight_trace * tr;
+    t.stress[i] = l.mu * t.piece[i].dq(t.strain[i]) + 0.5 * l.lambda * t.piece_trace.dq(tr);
   return t;
 }
 
 double SoftDensity(const MembraneLame& l, const Mat32& f) {
   const SoftStrains t = Soft(l, f);
-  const double tr = t.strain[0] + t.strain[1];
-  return l.mu *
-             (t.weight[0] * t.strain[0] * t.strain[0] + t.weight[1] * t.strain[1] * t.strain[1]) +
-         0.5 * l.lambda * t.weight_trace * tr * tr;
+  return l.mu * (t.piece[0].q + t.piece[1].q) + 0.5 * l.lambda * t.piece_trace.q;
 }
 
 // P = F S, S = Σ Si vi viᵀ.
@@ -316,17 +330,21 @@ IsotropicEigenvalues StvkEigenvalues(const MembraneLame& l, double s1, double s2
 // μ w (σ1² + σ1 σ2 + σ2² − 1) when w1 = w2; twist (ψ1 + ψ2)/(σ1 + σ2); out of plane Si.
 IsotropicEigenvalues SoftEigenvalues(const MembraneLame& l, double s1, double s2) {
   IsotropicEigenvalues e;
-  const double c = l.compression;
   const double e1 = 0.5 * (s1 * s1 - 1), e2 = 0.5 * (s2 * s2 - 1), tr = e1 + e2;
-  const double w1 = e1 < 0 ? c : 1.0, w2 = e2 < 0 ? c : 1.0, wt = tr < 0 ? c : 1.0;
-  const double stress1 = 2 * l.mu * w1 * e1 + l.lambda * wt * tr;
-  const double stress2 = 2 * l.mu * w2 * e2 + l.lambda * wt * tr;
+  const SoftPiece p1 = Piece(l, e1), p2 = Piece(l, e2), pt = Piece(l, tr);
+  const double w1 = p1.weight, w2 = p2.weight, wt = pt.weight;
+  const double trace_stress = 0.5 * l.lambda * pt.dq(tr);  // λ/2 q'(tr E)
+  const double stress1 = l.mu * p1.dq(e1) + trace_stress;
+  const double stress2 = l.mu * p2.dq(e2) + trace_stress;
   e.stretch << stress1 + (2 * l.mu * w1 + l.lambda * wt) * s1 * s1, l.lambda * wt * s1 * s2,
       l.lambda * wt * s1 * s2, stress2 + (2 * l.mu * w2 + l.lambda * wt) * s2 * s2;
-  const double shear_mu = w1 == w2 || !(s1 - s2 > 1e-12)
-                              ? 0.5 * (w1 + w2) * (s1 * s1 + s1 * s2 + s2 * s2 - 1)
-                              : (w1 * (s1 * s1 * s1 - s1) - w2 * (s2 * s2 * s2 - s2)) / (s1 - s2);
-  e.shear = l.lambda * wt * tr + l.mu * shear_mu;
+  // (σ1 q'(E1) - σ2 q'(E2)) / (σ1 - σ2), in closed form when both are on one piece.
+  const bool one_piece = w1 == w2 && p1.kappa == p2.kappa;
+  const double shear_mu =
+      one_piece || !(s1 - s2 > 1e-12)
+          ? 0.5 * (w1 + w2) * (s1 * s1 + s1 * s2 + s2 * s2 - 1) + 0.5 * (p1.kappa + p2.kappa)
+          : (s1 * p1.dq(e1) - s2 * p2.dq(e2)) / (s1 - s2);
+  e.shear = trace_stress + l.mu * shear_mu;
   e.twist = (s1 * stress1 + s2 * stress2) / (s1 + s2);
   e.out[0] = stress1;
   e.out[1] = stress2;
@@ -366,10 +384,115 @@ bool StvkNeedsProjection(const MembraneLame& l, const Mat32& f) {
   return l.lambda < 0 || e.trace() < 0 || e.determinant() < 0;
 }
 
+// ---- Orthotropic (MembraneModel::kOrthotropic): ψ = W_w(|f1| - 1) + W_f(|f2| - 1) + ½ G γ²,
+// γ = f1·f2, with f1 = F x, f2 = F y the columns of F in the warp-first rest frame.
+
+// One yarn line a: its stretched direction n = f/|f|, strain ε = |f| - 1, and W'(ε), W''(ε).
+struct YarnTerms {
+  Eigen::Vector3d n;
+  double length = 0, force = 0, stiffness = 0;
+};
+
+YarnTerms Yarn(const TensileCurve& curve, const MembraneCompression& c, const Eigen::Vector3d& f) {
+  YarnTerms t;
+  t.length = f.norm();
+  // A yarn collapsed to a point has no direction; any unit n keeps the terms finite.
+  t.n = t.length > 1e-12 ? Eigen::Vector3d(f / t.length) : Eigen::Vector3d::UnitX();
+  t.force = YarnForce(curve, c, t.length - 1.0);
+  t.stiffness = YarnStiffness(curve, c, t.length - 1.0);
+  return t;
+}
+
+double OrthotropicDensity(const OrthotropicMembrane& law, const MembraneCompression& c,
+                          const Mat32& f) {
+  const double gamma = f.col(0).dot(f.col(1));
+  return YarnEnergy(law.warp, c, f.col(0).norm() - 1.0) +
+         YarnEnergy(law.weft, c, f.col(1).norm() - 1.0) + 0.5 * law.shear_modulus * gamma * gamma;
+}
+
+// P = ∂ψ/∂(f1, f2) = (W_w' n1 + G γ f2, W_f' n2 + G γ f1).
+Vec6 OrthotropicStress(const OrthotropicMembrane& law, const MembraneCompression& c,
+                       const Mat32& f) {
+  const YarnTerms warp = Yarn(law.warp, c, f.col(0)), weft = Yarn(law.weft, c, f.col(1));
+  const double g_gamma = law.shear_modulus * f.col(0).dot(f.col(1));
+  Vec6 p;
+  p << warp.force * warp.n + g_gamma * f.col(1), weft.force * weft.n + g_gamma * f.col(0);
+  return p;
+}
+
+// A yarn's block of ∂²ψ/∂F²: W'' n nᵀ + W'/|f| (I - n nᵀ), the geometric part dropped when
+// W' < 0 (a compressed yarn, whose sideways curvature is negative) if `project`.
+Eigen::Matrix3d YarnBlock(const YarnTerms& t, bool project) {
+  const Eigen::Matrix3d nn = t.n * t.n.transpose();
+  const double geometric = project ? std::max(t.force, 0.0) : t.force;
+  return t.stiffness * nn +
+         geometric / std::max(t.length, 1e-12) * (Eigen::Matrix3d::Identity() - nn);
+}
+
+// The shear term's ∂²(½ G γ²)/∂F² = G (q qᵀ + γ S), q = (f2, f1), S = [[0, I], [I, 0]]. In the
+// orthonormal coordinates s = (a + b)/√2, d = (a - b)/√2 of vec(F) = (a, b), S = diag(I, -I)
+// and q = (ŝ |q_s|, d̂ |q_d|), q_s = (f1 + f2)/√2, q_d = (f2 - f1)/√2: the eigenvalues are G γ
+// on s ⊥ ŝ, -G γ on d ⊥ d̂ (twice each) and those of G [[|q_s|² + γ, |q_s||q_d|],
+// [|q_s||q_d|, |q_d|² - γ]] on (ŝ, d̂). With project, the negative ones are left out.
+Mat6 ShearBlock(double shear_modulus, const Mat32& f, bool project) {
+  const Eigen::Vector3d f1 = f.col(0), f2 = f.col(1);
+  const double gamma = f1.dot(f2);
+  Vec6 q;
+  q << f2, f1;
+  Mat6 h = q * q.transpose();
+  h.block<3, 3>(0, 3).diagonal().array() += gamma;
+  h.block<3, 3>(3, 0).diagonal().array() += gamma;
+  if (!project || gamma == 0.0) return shear_modulus * h;
+  const double r = 1.0 / std::sqrt(2.0);
+  const Eigen::Vector3d qs = r * (f1 + f2), qd = r * (f2 - f1);
+  const double ns = qs.norm(), nd = qd.norm();
+  const Eigen::Vector3d us = ns > 0 ? Eigen::Vector3d(qs / ns) : Eigen::Vector3d(qd.unitOrthogonal());
+  const Eigen::Vector3d ud = nd > 0 ? Eigen::Vector3d(qd / nd) : Eigen::Vector3d(qs.unitOrthogonal());
+  // vec(F) of a unit vector u in s or d coordinates: (u, u)/√2 or (u, -u)/√2.
+  auto in_s = [&](const Eigen::Vector3d& u) { Vec6 v; v << r * u, r * u; return v; };
+  auto in_d = [&](const Eigen::Vector3d& u) { Vec6 v; v << r * u, -r * u; return v; };
+  // The two-fold -|γ| eigenspace: d ⊥ d̂ when γ > 0, s ⊥ ŝ when γ < 0.
+  const Eigen::Vector3d axis = gamma > 0 ? ud : us;
+  const Eigen::Matrix3d complement = Eigen::Matrix3d::Identity() - axis * axis.transpose();
+  Mat6 lift = Mat6::Zero();  // the 6×6 projector onto that eigenspace
+  lift.block<3, 3>(0, 0) = lift.block<3, 3>(3, 3) = 0.5 * complement;
+  lift.block<3, 3>(0, 3) = lift.block<3, 3>(3, 0) = (gamma > 0 ? -0.5 : 0.5) * complement;
+  h += std::abs(gamma) * lift;
+  // The 2×2 block on (ŝ, d̂): at most one negative eigenvalue (its determinant may be < 0).
+  Eigen::Matrix2d m;
+  m << ns * ns + gamma, ns * nd, ns * nd, nd * nd - gamma;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig;
+  eig.computeDirect(m);
+  if (eig.eigenvalues()(0) < 0) {
+    const Eigen::Vector2d ab = eig.eigenvectors().col(0);
+    const Vec6 v = ab(0) * in_s(us) + ab(1) * in_d(ud);
+    h -= eig.eigenvalues()(0) * v * v.transpose();
+  }
+  return shear_modulus * h;
+}
+
+// ∂²ψ/∂F²: yarn blocks on the diagonal plus the shear term. project_psd keeps the exact matrix
+// when it is positive definite (a 6×6 Cholesky) and otherwise sums the terms' own projections.
+Mat6 OrthotropicStressDerivative(const OrthotropicMembrane& law, const MembraneCompression& c,
+                                 const Mat32& f, bool project) {
+  const YarnTerms warp = Yarn(law.warp, c, f.col(0)), weft = Yarn(law.weft, c, f.col(1));
+  Mat6 h = ShearBlock(law.shear_modulus, f, false);
+  h.block<3, 3>(0, 0) += YarnBlock(warp, false);
+  h.block<3, 3>(3, 3) += YarnBlock(weft, false);
+  if (!project) return h;
+  // Nothing compressed and no shear: every term is positive semi-definite already.
+  if (warp.force >= 0 && weft.force >= 0 && f.col(0).dot(f.col(1)) == 0.0) return h;
+  if (Eigen::LLT<Mat6>(h).info() == Eigen::Success) return h;
+  Mat6 p = ShearBlock(law.shear_modulus, f, true);
+  p.block<3, 3>(0, 0) += YarnBlock(warp, true);
+  p.block<3, 3>(3, 3) += YarnBlock(weft, true);
+  return p;
+}
+
 }  // namespace
 
 MembraneLame MembraneLame::FromStretch(double stretch_stiffness, double poisson,
-                                       double compression) {
+                                       double compression, double buckling_strain) {
   if (!(stretch_stiffness > 0) || !std::isfinite(stretch_stiffness)) {
     throw InputError("membrane: stretch_stiffness must be a positive number of N/m, got " +
                      NumberText(stretch_stiffness));
@@ -382,8 +505,14 @@ MembraneLame MembraneLame::FromStretch(double stretch_stiffness, double poisson,
     throw InputError("membrane: compression ratio must lie in [" + NumberText(kMinCompressionRatio) +
                      ", 1], got " + NumberText(compression));
   }
+  if (!(buckling_strain >= 0 && buckling_strain < 1)) {
+    throw InputError("membrane: buckling strain must lie in [0, 1), got " +
+                     NumberText(buckling_strain));
+  }
   MembraneLame l;
   l.compression = compression;
+  // The Green strain of the engineering strain -ε_b: ½ ((1 - ε_b)² - 1) = -(ε_b - ε_b²/2).
+  l.buckling = buckling_strain - 0.5 * buckling_strain * buckling_strain;
   l.mu = stretch_stiffness / (2 * (1 + poisson));
   l.lambda = stretch_stiffness * poisson / (1 - poisson * poisson);
   return l;
@@ -392,6 +521,7 @@ MembraneLame MembraneLame::FromStretch(double stretch_stiffness, double poisson,
 double MembraneEnergy(MembraneModel model, const MembraneLame& lame,
                       const Eigen::Matrix2d& rest_inverse, double rest_area,
                       const Eigen::Matrix3d& x) {
+  assert(model != MembraneModel::kOrthotropic);  // OrthotropicMembraneEnergy
   const Mat32 f = DeformationGradient(rest_inverse, x);
   const double psi = model != MembraneModel::kStVK ? CorotationalDensity(lame, f)
                      : SoftApplies(lame, f)        ? SoftDensity(lame, f)
@@ -430,9 +560,102 @@ Eigen::Matrix<double, 9, 9> MembraneHessian(MembraneModel model, const MembraneL
   return rest_area * g.transpose() * h * g;
 }
 
+double OrthotropicMembraneEnergy(const OrthotropicMembrane& law,
+                                 const MembraneCompression& compression,
+                                 const Eigen::Matrix2d& rest_inverse, double rest_area,
+                                 const Eigen::Matrix3d& x) {
+  return rest_area * OrthotropicDensity(law, compression, DeformationGradient(rest_inverse, x));
+}
+
+Eigen::Matrix<double, 9, 1> OrthotropicMembraneGradient(const OrthotropicMembrane& law,
+                                                        const MembraneCompression& compression,
+                                                        const Eigen::Matrix2d& rest_inverse,
+                                                        double rest_area,
+                                                        const Eigen::Matrix3d& x) {
+  const Vec6 p = OrthotropicStress(law, compression, DeformationGradient(rest_inverse, x));
+  return rest_area * GradientMap(rest_inverse).transpose() * p;
+}
+
+Eigen::Matrix<double, 9, 9> OrthotropicMembraneHessian(const OrthotropicMembrane& law,
+                                                       const MembraneCompression& compression,
+                                                       const Eigen::Matrix2d& rest_inverse,
+                                                       double rest_area, const Eigen::Matrix3d& x,
+                                                       bool project_psd) {
+  const Mat6 h = OrthotropicStressDerivative(law, compression,
+                                             DeformationGradient(rest_inverse, x), project_psd);
+  const Eigen::Matrix<double, 6, 9> g = GradientMap(rest_inverse);
+  return rest_area * g.transpose() * h * g;
+}
+
+Eigen::Matrix2d RestInverse(const Eigen::Matrix3d& corners, int index, double* rest_area) {
+  const Eigen::Vector3d e1 = (corners.row(1) - corners.row(0)).transpose(),
+                        e2 = (corners.row(2) - corners.row(0)).transpose();
+  const Eigen::Vector3d normal = e1.cross(e2);
+  const double area = 0.5 * normal.norm();
+  if (!(area > 1e-14 * std::max(e1.squaredNorm(), e2.squaredNorm())) || !std::isfinite(area)) {
+    throw InputError("membrane: rest triangle " + std::to_string(index) + " is degenerate (area " +
+                     NumberText(area) + " m²)");
+  }
+  // t1: pattern x in the triangle's plane, the warp; the first edge if x is (nearly) normal.
+  const Eigen::Vector3d n = normal.normalized();
+  Eigen::Vector3d t1 = Eigen::Vector3d::UnitX() - n.x() * n;
+  t1 = t1.norm() > 1e-6 ? Eigen::Vector3d(t1.normalized()) : Eigen::Vector3d(e1.normalized());
+  const Eigen::Vector3d t2 = n.cross(t1);
+  Eigen::Matrix2d dm;
+  dm << e1.dot(t1), e2.dot(t1), e1.dot(t2), e2.dot(t2);
+  *rest_area = area;
+  return dm.inverse();
+}
+
 MembraneElements::MembraneElements(const TriangleMesh& rest, double stretch_stiffness,
-                                   double poisson, MembraneModel model, double compression)
-    : model_(model), lame_(MembraneLame::FromStretch(stretch_stiffness, poisson, compression)) {
+                                   double poisson, MembraneModel model, double compression,
+                                   double buckling_strain)
+    : model_(model),
+      lame_(MembraneLame::FromStretch(stretch_stiffness, poisson, compression, buckling_strain)) {
+  if (model == MembraneModel::kOrthotropic) {
+    throw InputError("membrane: the orthotropic model needs a material's warp, weft and shear");
+  }
+  BuildRestShapes(rest);
+}
+
+namespace {
+
+// The checks of the compression model and shear modulus the isotropic FromStretch does not make.
+void CheckOrthotropic(const OrthotropicMembrane& law, const MembraneCompression& c) {
+  if (!(law.shear_modulus >= 0) || !std::isfinite(law.shear_modulus)) {
+    throw InputError("membrane: shear modulus must be a finite number ≥ 0 of N/m, got " +
+                     NumberText(law.shear_modulus));
+  }
+  if (!(c.ratio >= kMinCompressionRatio && c.ratio <= 1)) {
+    throw InputError("membrane: compression ratio must lie in [" + NumberText(kMinCompressionRatio) +
+                     ", 1], got " + NumberText(c.ratio));
+  }
+  if (!(c.buckling_strain >= 0) || !std::isfinite(c.buckling_strain)) {
+    throw InputError("membrane: buckling strain must be a finite number ≥ 0, got " +
+                     NumberText(c.buckling_strain));
+  }
+}
+
+}  // namespace
+
+MembraneElements::MembraneElements(const TriangleMesh& rest, const Material& material,
+                                   MembraneModel model)
+    : model_(material.orthotropic ? MembraneModel::kOrthotropic : model),
+      compression_(material.Compression()) {
+  if (material.orthotropic) {
+    orthotropic_ = *material.orthotropic;
+    CheckOrthotropic(orthotropic_, compression_);
+  } else {
+    if (model == MembraneModel::kOrthotropic) {
+      throw InputError("membrane: the orthotropic model needs a material's warp, weft and shear");
+    }
+    lame_ = MembraneLame::FromStretch(material.stretch_stiffness, material.poisson,
+                                      material.compression_ratio, material.buckling_strain);
+  }
+  BuildRestShapes(rest);
+}
+
+void MembraneElements::BuildRestShapes(const TriangleMesh& rest) {
   num_vertices_ = rest.num_vertices();
   triangles_ = rest.triangles;
   const int nf = rest.num_triangles();
@@ -446,29 +669,11 @@ MembraneElements::MembraneElements(const TriangleMesh& rest, double stretch_stif
                          std::to_string(num_vertices_ - 1));
       }
     }
-    const Eigen::Vector3d x0 = rest.vertices.row(triangles_(f, 0)),
-                          x1 = rest.vertices.row(triangles_(f, 1)),
-                          x2 = rest.vertices.row(triangles_(f, 2));
-    // A frame of the triangle's plane: t1 along the first edge, t2 = n × t1.
-    const Eigen::Vector3d e1 = x1 - x0, e2 = x2 - x0;
-    const Eigen::Vector3d normal = e1.cross(e2);
-    const double area = 0.5 * normal.norm();
-    if (!(area > 1e-14 * std::max(e1.squaredNorm(), e2.squaredNorm())) || !std::isfinite(area)) {
-      throw InputError("membrane: rest triangle " + std::to_string(f) + " is degenerate (area " +
-                       NumberText(area) + " m²)");
-    }
-    const Eigen::Vector3d t1 = e1.normalized(), t2 = normal.normalized().cross(t1);
-    Eigen::Matrix2d dm;
-    dm << e1.dot(t1), e2.dot(t1), 0.0, e2.dot(t2);
-    rest_inverse_[f] = dm.inverse();
-    rest_area_(f) = area;
+    Eigen::Matrix3d corners;
+    for (int k = 0; k < 3; ++k) corners.row(k) = rest.vertices.row(triangles_(f, k));
+    rest_inverse_[f] = RestInverse(corners, f, &rest_area_(f));
   }
 }
-
-MembraneElements::MembraneElements(const TriangleMesh& rest, const Material& material,
-                                   MembraneModel model)
-    : MembraneElements(rest, material.stretch_stiffness, material.poisson, model,
-                       material.compression_ratio) {}
 
 void MembraneElements::CheckSize(Eigen::Ref<const Vertices> x) const {
   if (x.rows() != num_vertices_) {
@@ -487,7 +692,10 @@ double MembraneElements::Energy(Eigen::Ref<const Vertices> x) const {
   CheckSize(x);
   double e = 0;
   for (int f = 0; f < num_triangles(); ++f) {
-    e += MembraneEnergy(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f));
+    e += model_ == MembraneModel::kOrthotropic
+             ? OrthotropicMembraneEnergy(orthotropic_, compression_, rest_inverse_[f],
+                                         rest_area_(f), Corners(x, f))
+             : MembraneEnergy(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f));
   }
   return e;
 }
@@ -497,7 +705,10 @@ void MembraneElements::AddGradient(Eigen::Ref<const Vertices> x, Eigen::Ref<Vert
   CheckSize(grad);
   for (int f = 0; f < num_triangles(); ++f) {
     const Eigen::Matrix<double, 9, 1> g =
-        MembraneGradient(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f));
+        model_ == MembraneModel::kOrthotropic
+            ? OrthotropicMembraneGradient(orthotropic_, compression_, rest_inverse_[f],
+                                          rest_area_(f), Corners(x, f))
+            : MembraneGradient(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f));
     for (int k = 0; k < 3; ++k) grad.row(triangles_(f, k)) += g.segment<3>(3 * k).transpose();
   }
 }
@@ -515,7 +726,11 @@ void MembraneElements::AddHessianTriplets(Eigen::Ref<const Vertices> x,
   triplets->reserve(triplets->size() + 81 * static_cast<std::size_t>(end - first));
   for (int f = first; f < end; ++f) {
     const Eigen::Matrix<double, 9, 9> h =
-        MembraneHessian(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f), project_psd);
+        model_ == MembraneModel::kOrthotropic
+            ? OrthotropicMembraneHessian(orthotropic_, compression_, rest_inverse_[f],
+                                         rest_area_(f), Corners(x, f), project_psd)
+            : MembraneHessian(model_, lame_, rest_inverse_[f], rest_area_(f), Corners(x, f),
+                              project_psd);
     for (int a = 0; a < 3; ++a) {
       for (int b = 0; b < 3; ++b) {
         for (int c = 0; c < 3; ++c) {

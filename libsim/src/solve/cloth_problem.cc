@@ -80,7 +80,7 @@ ClothProblem::ClothProblem(const TriangleMesh& rest, const Material& material,
   // Without gravity the penalty still needs a scale: use standard gravity's.
   const double g_scale = g > 0.0 ? g : 9.80665;
   penalty_ = masses_ * (g_scale / options_.contact.sink_under_own_weight);
-  tangential_stiffness_ = options_.contact.tangential_ratio * material.stretch_stiffness;
+  tangential_stiffness_ = options_.contact.tangential_ratio * material.MembraneModulus();
   // Only the chosen discretisation is built; both take the hinges and their seam multipliers.
   const BendingLaw warp = material.EffectiveLaw().Scaled(options_.bending_scale);
   const std::optional<BendingLaw> weft = WeftLaw(material, options_.bending_scale);

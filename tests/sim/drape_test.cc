@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -598,6 +599,24 @@ TEST(Drape, AMembraneSoftInCompressionDrapesLower) {
   EXPECT_GT(r.drape_coefficient, 0.0);
   EXPECT_LT(r.drape_coefficient, PlainDrape().drape_coefficient - 0.08);
   EXPECT_GE(r.nodes, 5.0);
+}
+
+// A material file without a membrane drapes on the documented defaults, and the result says so
+// (one membrane_default note per defaulted field); a file that gives the membrane has no such note.
+TEST(Drape, DefaultedMembraneIsNotedInTheResult) {
+  const std::string bending =
+      R"("areal_density_gsm": 200, "bending": {"units": "kes", "b1": 0.1, "b2": 0.0892, "c1": -0.0092})";
+  const Material defaulted = ParseMaterialJson("{" + bending + "}", "defaulted.json");
+  const DrapeResult r = SimulateDrape(defaulted, Coarse());
+  ASSERT_TRUE(r.converged) << r.message;
+  const auto count = std::count_if(r.notes.begin(), r.notes.end(),
+                                   [](const Note& n) { return n.code == "membrane_default"; });
+  EXPECT_EQ(count, static_cast<long>(defaulted.defaulted.size()));
+  EXPECT_GE(count, 3);  // warp, weft and shear at least
+  EXPECT_FALSE(HasNote(PlainDrape().notes, "membrane_default"));
+  const Material given = ParseMaterialJson(
+      "{" + bending + R"(, "stretch": {"stiffness_N_per_m": 1000, "poisson": 0.3, "compression_ratio": 1}})", "given.json");
+  EXPECT_TRUE(MaterialDefaultNotes(given).empty());
 }
 
 TEST(Drape, SeamRaisesDcAndCarriesItsMass) {

@@ -831,6 +831,8 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
   bool rim_capped = false;
   if (o.rim_auto) AutoRimElementSize(material, o, o.rim_extrapolation, &rim_capped);
   result.notes = drape_internal::DrapeNotes(o, result, rim_capped);
+  // A membrane the file did not give is a guess the DC depends on: the run says which parts.
+  for (Note& n : MaterialDefaultNotes(material)) result.notes.push_back(std::move(n));
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

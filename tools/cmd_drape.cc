@@ -623,9 +623,9 @@ void RegisterDrape(CLI::App& app) {
                   "docs/methods/drapemeter.md, \"Contact stiffness\")");
   sub->add_option("--compression-ratio", a->compression_ratio,
                   "The membrane's stiffness against compression as a fraction of its stretch "
-                  "stiffness (0.001 to 1; default the material's stretch.compression_ratio, 1: "
-                  "as stiff as in tension); fabric buckles far more easily, and the DC drops with "
-                  "it (docs/methods/drapemeter.md, \"Compression ratio\")");
+                  "stiffness (0.001 to 1; default the material's stretch.compression_ratio, or "
+                  "0.01 when it gives none; 1: as stiff as in tension, the DC rises with it; "
+                  "docs/methods/drapemeter.md, \"Compression\")");
   sub->add_option("--specimen-mm", a->specimen_mm, "Specimen radius [mm] (default 150)");
   sub->add_option("--support-mm", a->support_mm, "Support radius [mm] (default 90)");
   sub->add_option(

@@ -322,7 +322,8 @@ TEST(MaterialCheck, NamesTheFieldAndTheRange) {
 }
 
 TEST(MaterialCheck, AcceptsTheSamplesAndTheDefaults) {
-  for (const char* name : {"pabst-fig8", "pabst-dress", "pabst-interlining", "knee-spline"}) {
+  for (const char* name :
+       {"pabst-fig8", "pabst-fig8-kes", "pabst-dress", "pabst-interlining", "knee-spline"}) {
     std::string why = "unset";
     EXPECT_TRUE(ReadMaterial(kSamples + name + ".json").Check(&why)) << name << ": " << why;
     EXPECT_EQ(why, "") << name;
@@ -440,6 +441,26 @@ TEST(MaterialMembrane, ReadsEveryTensileForm) {
   EXPECT_TRUE(Lists(fast, "stretch.weft"));
   EXPECT_FALSE(Lists(fast, "stretch.warp"));
   EXPECT_FALSE(Lists(fast, "stretch.shear"));
+}
+
+// The shipped KES sample: the Fig. 8 fabric's bending with a lab's KES-FB1 membrane block. Its
+// WT agrees with LT and EMT (the parser checks within 5 %), and the only default it takes is the
+// in-plane compression, which KES-FB1 does not measure.
+TEST(MaterialMembrane, TheKesSampleIsTheFig8FabricWithAMeasuredLikeMembrane) {
+  const Material kes = ReadMaterial(kSamples + "pabst-fig8-kes.json");
+  const Material fig8 = ReadMaterial(kSamples + "pabst-fig8.json");
+  EXPECT_EQ(kes.areal_density, fig8.areal_density);
+  EXPECT_EQ(kes.bending.b1(), fig8.bending.b1());
+  EXPECT_EQ(kes.bending.b2(), fig8.bending.b2());
+  EXPECT_EQ(kes.bending.c1(), fig8.bending.c1());
+  ASSERT_TRUE(kes.orthotropic.has_value());
+  ExpectSameCurve(kes.orthotropic->warp, TensileCurveFromKes(3.5, 0.68), "warp");
+  ExpectSameCurve(kes.orthotropic->weft, TensileCurveFromKes(5.8, 0.62), "weft");
+  EXPECT_EQ(kes.orthotropic->shear_modulus, KesShearToNewtonPerMetre(0.72));
+  EXPECT_EQ(kes.defaulted, std::vector<std::string>{"stretch.compression_ratio"});
+  EXPECT_EQ(kes.compression_ratio, kDefaultCompressionRatio);
+  // The weft is the more extensible direction, as in a woven apparel fabric.
+  EXPECT_LT(kes.orthotropic->weft.Force(0.02), kes.orthotropic->warp.Force(0.02));
 }
 
 TEST(MaterialMembrane, StiffnessBesideShearAloneIsBothYarnModuli) {

@@ -29,8 +29,10 @@ namespace textile {
 // a drape compresses the sheet.
 constexpr double kMinCompressionRatio = 1e-3;
 // The compression ratio a material gets when its file gives none (docs/methods/drapemeter.md,
-// "Compression": why this value).
-constexpr double kDefaultCompressionRatio = 1.0;
+// "Compression": why this value): a woven sheet buckles at a small fraction of the load it takes
+// in tension, and no lab instrument measures it in-plane. 1 is the spec's StVK, as stiff in
+// compression as in tension, kept as an option (stretch.compression_ratio, --compression-ratio).
+constexpr double kDefaultCompressionRatio = 0.01;
 // The largest buckling strain a file takes (stretch.buckling_strain) [-]: 5 %, past any woven
 // fabric's crimp (a larger one is a percentage written as a fraction's number).
 constexpr double kMaxBucklingStrain = 0.05;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -40,6 +41,7 @@ struct DrapeArgs {
   std::optional<double> seam_refine_mm;
   std::optional<double> compression_ratio;
   std::string rim_mm = "auto";        // a length [mm], 0 (off) or "auto" (the default)
+  std::string start_modes;            // "MIN-MAX"; empty: DrapeOptions' harmonics
   std::optional<double> rim_band_mm;  // default: 20 mm, or a third of a smaller overhang
   std::optional<double> shift_mm;     // --seams shifted only; default 50 mm
   double specimen_mm = 150.0, support_mm = 90.0, perturbation_mm = 2.0;
@@ -136,6 +138,14 @@ DrapeOptions Options(const DrapeArgs& a) {
   // Reduced exactly to (-180, 180]: past about 1e16 degrees a product with π/180 has no
   // fraction of a turn left, and cos and sin of it say nothing.
   o.frame_angle = std::remainder(finite(a.frame_deg, "--frame-deg"), 360.0) * kDegree;
+  if (!a.start_modes.empty()) {
+    try {
+      ParseStartModes(a.start_modes, &o);
+    } catch (const InputError& e) {
+      // The library's "start_modes: ..." named as the flag.
+      throw InputError("--start-modes" + std::string(e.what()).substr(std::strlen("start_modes")));
+    }
+  }
   if (a.seeds < 1 || a.seeds > 1000) throw InputError("--seeds: must be in 1..1000");
   o.seeds = a.seeds;
   o.first_seed = a.first_seed;
@@ -393,6 +403,7 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
                 {"seams", DrapeSeamsName(o.seams)},
                 {"perturbation_mm", units::MToMm(o.perturbation)},
                 {"frame_deg", o.frame_angle / kDegree},
+                {"start_modes", {o.min_harmonic, o.max_harmonic}},
                 {"resolution_mm", units::MToMm(o.element_size)},
                 {"rim_mm", units::MToMm(o.rim_element_size)},
                 {"rim_band_mm", o.rim_element_size > 0.0 ? nlohmann::json(units::MToMm(o.rim_band))
@@ -636,6 +647,10 @@ void RegisterDrape(CLI::App& app) {
                   "Offset of the shifted seam from the centre [mm] (default 50)");
   sub->add_option("--perturbation-mm", a->perturbation_mm,
                   "Start perturbation at the rim [mm] (default 2)");
+  sub->add_option("--start-modes", a->start_modes,
+                  "The start perturbation's angular harmonics MIN-MAX (default 3-8); a wider band "
+                  "lets the fabric, not the start, choose the node count "
+                  "(docs/methods/drapemeter.md, \"Nodes\")");
   sub->add_option("--frame-deg", a->frame_deg,
                   "Rotate seams and perturbation about the centre [deg]");
   sub->add_option("--tolerance", a->tolerance,

@@ -202,3 +202,36 @@ TEST(ChooseDrapeRim, NeedsADensity) {
 
 }  // namespace
 }  // namespace textile
+
+namespace textile {
+namespace {
+
+// The start's harmonics from "MIN-MAX"; anything else is refused naming the text, and the
+// options are left as they were.
+TEST(DrapeStartModes, ParseMinMaxAndRefuseTheRest) {
+  DrapeOptions o;
+  ParseStartModes("2-12", &o);
+  EXPECT_EQ(o.min_harmonic, 2);
+  EXPECT_EQ(o.max_harmonic, 12);
+  ParseStartModes("5-5", &o);
+  EXPECT_EQ(o.min_harmonic, 5);
+  EXPECT_EQ(o.max_harmonic, 5);
+  for (const char* bad : {"", "3", "-3", "3-", "9-3", "0-8", "3-65", "3-8-9", "a-b", "3 - 8",
+                          "99999-99999", "1e1-20"}) {
+    DrapeOptions p;
+    try {
+      ParseStartModes(bad, &p);
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(std::string("start_modes: '") + bad + "'", 0), 0u)
+          << e.what();
+    }
+    EXPECT_EQ(p.min_harmonic, DrapeOptions{}.min_harmonic) << bad;
+    EXPECT_EQ(p.max_harmonic, DrapeOptions{}.max_harmonic) << bad;
+    std::string why;
+    EXPECT_TRUE(p.Check(&why)) << why;
+  }
+}
+
+}  // namespace
+}  // namespace textile

@@ -57,6 +57,7 @@ TEST(CliDrape, PlainDrapeWritesResultOutlinePngAndObj) {
     EXPECT_NEAR(j[figure + "_sd_mm"].get<double>(), std::abs(ra - rb) / std::sqrt(2.0), 1e-9) << figure;
   }
   EXPECT_EQ(j["scene"]["mount"], "clamped");
+  EXPECT_EQ(j["scene"]["start_modes"], nlohmann::json::parse("[3, 8]"));
   // The solver report: a factorisation per Newton step at least, the exact-Hessian steps among
   // them, a residual under the tolerance.
   for (const auto& seed : j["seeds"]) {
@@ -466,6 +467,20 @@ TEST(CliDrape, CompressionRatioOverridesTheMaterialsAndIsReported) {
   EXPECT_EQ(s["scene"]["compression_ratio"].get<double>(), 1.0);
   EXPECT_EQ(s["scene"]["compression_ratio_from"], "--compression-ratio");
   EXPECT_GT(s["drape_coefficient"].get<double>(), p["drape_coefficient"].get<double>() + 0.08);
+}
+
+// --start-modes widens the start perturbation's band of harmonics; the result records it, and a
+// different start on the same fabric is a different first seed's drape (docs/methods/drapemeter.md,
+// "Nodes").
+TEST(CliDrape, StartModesAreTheStartsHarmonicsAndAreRecorded) {
+  const auto dir = Scratch("CliDrape.StartModes");
+  const auto r = Textile("drape " + kFig8 + kCoarse + " --start-modes 2-12 -o " +
+                         (dir / "w.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(ReadAll(dir / "w.json"));
+  EXPECT_EQ(j["scene"]["start_modes"], nlohmann::json::parse("[2, 12]"));
+  EXPECT_GT(j["drape_coefficient"].get<double>(), 0.0);
+  EXPECT_LT(j["drape_coefficient"].get<double>(), 1.0);
 }
 
 TEST(CliDrape, RestingMountSettlesAndACutShortRunFailsCleanly) {

@@ -265,6 +265,21 @@ DrapeSeams ParseDrapeSeams(const std::string& name) {
   throw InputError("seams: '" + name + "' is not none, weft, weft+warp or shifted");
 }
 
+void ParseStartModes(const std::string& text, DrapeOptions* o) {
+  const std::string why =
+      "start_modes: '" + text + "' is not MIN-MAX with 1 <= MIN <= MAX <= 64 (e.g. 3-8)";
+  const size_t dash = text.find('-');
+  if (dash == std::string::npos || dash == 0 || dash + 1 == text.size() ||
+      text.find_first_not_of("0123456789-") != std::string::npos ||
+      text.find('-', dash + 1) != std::string::npos || text.size() > 5) {
+    throw InputError(why);
+  }
+  const int lo = std::stoi(text.substr(0, dash)), hi = std::stoi(text.substr(dash + 1));
+  if (lo < 1 || hi < lo || hi > 64) throw InputError(why);
+  o->min_harmonic = lo;
+  o->max_harmonic = hi;
+}
+
 SolveOptions DefaultDrapeSolveOptions() {
   SolveOptions s;
   s.tolerance = 1e-4;

@@ -166,6 +166,10 @@ struct DrapeOptions {
   bool Check(std::string* why) const;
 };
 
+// The start's harmonics as "MIN-MAX" ("3-8"), 1 ≤ MIN ≤ MAX ≤ 64, into o->min_harmonic and
+// o->max_harmonic. InputError naming the text.
+void ParseStartModes(const std::string& text, DrapeOptions* o);
+
 // The shadow of a draped specimen: a raster mask and the polar outline.
 struct DrapeShadow {
   double area = 0.0;                      // A_shadow, holes filled [m²]

@@ -244,7 +244,9 @@ void Run(const AcpmArgs& a) {
             << " µN·m = " << Num(units::SiRigidityToMgCm(r.plain_rigidity))
             << " mg·cm = " << Num(units::SiRigidityToGfCm(r.plain_rigidity)) << " gf·cm\n"
             << "device time " << Num(r.device_time, 4) << " s; computed in " << Num(ms, 3)
-            << " ms (" << r.solves << " solves)\n"
+            << " ms (" << r.solves << " solves)\n";
+  for (const Note& n : r.membrane_defaults) std::cout << "note: " << n.text << "\n";
+  std::cout
             << "wrote " << a.out << (a.png.empty() ? "" : ", " + a.png)
             << (a.obj.empty() ? "" : ", " + a.obj) << "\n";
 }

@@ -161,6 +161,26 @@ TEST(CliAcpm, SeamAlongRunsOnTheShellModel) {
   EXPECT_TRUE(fs::exists(dir / "r.json"));
 }
 
+// The shell model bends a sheet with a membrane, so a run on it names the membrane's defaulted
+// fields (the KES sample gives all but the in-plane compression), printed and in the result;
+// the elastica has no membrane and says nothing of it.
+TEST(CliAcpm, TheShellNamesTheMembranesDefaultsAndTheElasticaDoesNot) {
+  const auto dir = Scratch("CliAcpm.MembraneDefaults");
+  const auto shell = Textile("acpm --material samples/materials/pabst-fig8-kes.json --model shell -o " +
+                             (dir / "s.json").string());
+  ASSERT_EQ(shell.exit_code, 0) << shell.err;
+  EXPECT_NE(shell.out.find("note: stretch.compression_ratio not given: 0.01"), std::string::npos)
+      << shell.out;
+  const auto s = nlohmann::json::parse(ReadAll(dir / "s.json"));
+  ASSERT_TRUE(s.contains("membrane_defaults")) << s.dump();
+  ASSERT_EQ(s["membrane_defaults"].size(), 1u);
+  EXPECT_EQ(s["membrane_defaults"][0]["code"], "membrane_default");
+  const auto elastica = Textile("acpm " + kFig8 + " -o " + (dir / "e.json").string());
+  ASSERT_EQ(elastica.exit_code, 0) << elastica.err;
+  EXPECT_EQ(elastica.out.find("not given"), std::string::npos) << elastica.out;
+  EXPECT_FALSE(nlohmann::json::parse(ReadAll(dir / "e.json")).contains("membrane_defaults"));
+}
+
 TEST(CliAcpm, RefusesBadInput) {
   const auto dir = Scratch("CliAcpm.Bad");
   const std::string out = " -o " + (dir / "r.json").string();

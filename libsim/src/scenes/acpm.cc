@@ -8,6 +8,7 @@
 #include "textile/sim/scenes/acpm_shell.h"
 #include "textile/sim/elastica/elastica.h"
 #include "textile/sim/core/error.h"
+#include "textile/sim/io/json_text.h"
 #include "textile/sim/law/material.h"
 #include "textile/sim/core/units.h"
 
@@ -366,6 +367,7 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
   result.profile_y = crossings.profile_y;
   result.solves = crossings.solves;
   result.notes = crossings.notes;
+  if (result.model == AcpmModelKind::kShell) result.membrane_defaults = MaterialDefaultNotes(material);
   result.shape = std::move(crossings.shape);
   return result;
 }
@@ -425,6 +427,7 @@ nlohmann::json AcpmResultToJson(const AcpmResult& r, const Material& material,
   j["side_profile"] = {{"ray", r.profile_ray}, {"x_mm", x}, {"y_mm", y}};
   j["solves"] = r.solves;
   if (!r.notes.empty()) j["notes"] = r.notes;
+  if (!r.membrane_defaults.empty()) j["membrane_defaults"] = NotesJson(r.membrane_defaults);
   return j;
 }
 

@@ -32,6 +32,8 @@
 #include <string>
 #include <vector>
 
+#include "textile/sim/core/note.h"
+
 #include "textile/sim/scenes/acpm_types.h"
 #include "textile/sim/mesh/mesh.h"
 
@@ -65,6 +67,9 @@ struct AcpmResult {
   std::vector<double> profile_x, profile_y;  // side profile at that crossing [m]
   int solves = 0;
   std::string notes;
+  // The membrane's defaulted fields (MaterialDefaultNotes) when the shell model answered, whose
+  // sample has a membrane; empty for the elastica, which has none.
+  std::vector<Note> membrane_defaults;
   TriangleMesh shape;  // the sample at that crossing (AcpmCrossings::shape), for --obj
 
   // One line: model, crossing range, factor range, device time.

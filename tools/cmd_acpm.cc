@@ -246,8 +246,7 @@ void Run(const AcpmArgs& a) {
             << "device time " << Num(r.device_time, 4) << " s; computed in " << Num(ms, 3)
             << " ms (" << r.solves << " solves)\n";
   for (const Note& n : r.membrane_defaults) std::cout << "note: " << n.text << "\n";
-  std::cout
-            << "wrote " << a.out << (a.png.empty() ? "" : ", " + a.png)
+  std::cout << "wrote " << a.out << (a.png.empty() ? "" : ", " + a.png)
             << (a.obj.empty() ? "" : ", " + a.obj) << "\n";
 }
 

@@ -367,7 +367,8 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
   result.profile_y = crossings.profile_y;
   result.solves = crossings.solves;
   result.notes = crossings.notes;
-  if (result.model == AcpmModelKind::kShell) result.membrane_defaults = MaterialDefaultNotes(material);
+  if (result.model == AcpmModelKind::kShell)
+    result.membrane_defaults = MaterialDefaultNotes(material);
   result.shape = std::move(crossings.shape);
   return result;
 }

@@ -33,7 +33,6 @@
 #include <vector>
 
 #include "textile/sim/core/note.h"
-
 #include "textile/sim/scenes/acpm_types.h"
 #include "textile/sim/mesh/mesh.h"
 

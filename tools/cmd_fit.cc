@@ -240,10 +240,8 @@ void Run(const FitArgs& a) {
     Plot(a, profiles, o, rho, clapp, *plot_file);
   }
 
-  Material m;
+  Material m = LawOnlyMaterial(o.law, rho);
   m.name = a.name.empty() ? "fitted from " + InputStem(a.inputs.front()) : a.name;
-  m.areal_density = rho;
-  m.bending = o.law;
   m.fit = o.report;
   material_file.Write(MaterialToJson(m).dump(2) + "\n");
   outputs.Commit();

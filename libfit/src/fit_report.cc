@@ -49,9 +49,7 @@ std::string JoinNotes(const std::vector<std::string>& notes) {
 
 std::optional<Material> FittedLawMaterial(const BendingLaw& law, double areal_density,
                                           std::string* why) {
-  Material m;
-  m.areal_density = areal_density;
-  m.bending = law;
+  Material m = LawOnlyMaterial(law, areal_density);
   std::string problem;
   if (!m.Check(&problem)) {
     if (why) *why = "fitted law: " + problem;

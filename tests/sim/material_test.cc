@@ -463,6 +463,30 @@ TEST(MaterialMembrane, TheKesSampleIsTheFig8FabricWithAMeasuredLikeMembrane) {
   EXPECT_LT(kes.orthotropic->weft.Force(0.02), kes.orthotropic->warp.Force(0.02));
 }
 
+// A material of a law alone (what a fit writes) reads as a file without `stretch`: the membrane's
+// documented defaults, each listed; the file it makes claims no membrane, and reads back the same.
+TEST(MaterialMembrane, ALawOnlyMaterialLeavesTheMembraneToItsDefaults) {
+  const BendingLaw law = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+  const Material m = LawOnlyMaterial(law, 0.2);
+  const Material file = ParseMaterialJson(
+      R"({"areal_density_gsm": 200, "bending": {"units": "kes", "b1": 0.1, "b2": 0.0892, "c1": -0.0092}})",
+      "law-only.json");
+  EXPECT_EQ(m.areal_density, 0.2);
+  EXPECT_EQ(m.bending.b1(), law.b1());
+  EXPECT_EQ(m.defaulted, file.defaulted);
+  EXPECT_GE(m.defaulted.size(), 4u);  // warp, weft, shear, compression ratio
+  ASSERT_TRUE(m.orthotropic.has_value());
+  ExpectSameCurve(m.orthotropic->warp, file.orthotropic->warp, "warp");
+  ExpectSameCurve(m.orthotropic->weft, file.orthotropic->weft, "weft");
+  EXPECT_EQ(m.orthotropic->shear_modulus, file.orthotropic->shear_modulus);
+  EXPECT_EQ(m.compression_ratio, kDefaultCompressionRatio);
+  EXPECT_EQ(MaterialDefaultNotes(m).size(), m.defaulted.size());
+  const nlohmann::json j = MaterialToJson(m);
+  EXPECT_FALSE(j.contains("stretch")) << j.dump();
+  EXPECT_EQ(ParseMaterialJson(j.dump(), "again.json").defaulted, m.defaulted);
+  EXPECT_TRUE(m.Check(nullptr));
+}
+
 TEST(MaterialMembrane, StiffnessBesideShearAloneIsBothYarnModuli) {
   const Material m = WithStretch(R"({"stiffness_N_per_m": 800, "shear": {"modulus_N_per_m": 40}})");
   ASSERT_TRUE(m.orthotropic.has_value());

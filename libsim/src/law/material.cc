@@ -514,6 +514,14 @@ double ReadArealDensity(const JsonFields& f, const json& root) {
 
 }  // namespace
 
+Material LawOnlyMaterial(const BendingLaw& law, double areal_density) {
+  Material m;
+  m.areal_density = areal_density;
+  m.bending = law;
+  ReadStretch(JsonFields("defaults"), json::object(), &m);  // no stretch block: every default
+  return m;
+}
+
 Material ParseMaterialJson(const std::string& text, const std::string& source) {
   const JsonFields f(source);
   const json root = ParseJsonText(text, source);

@@ -29,7 +29,8 @@
 namespace textile {
 
 // A fitted law as the material every simulation of it takes (areal density [kg/m²], other
-// fields the defaults), if a material file would take it (Material::Check): a fit to a straight
+// fields the defaults: LawOnlyMaterial, whose membrane is listed as defaulted), if a material
+// file would take it (Material::Check): a fit to a straight
 // or vertical strip, or Clapp's regression on a poor polynomial, can run to constants no fabric
 // has. Else none, and *why (if non-null) says, as a file named "fitted law" is refused:
 // "fitted law: bending.b1: suspicious magnitude ...".

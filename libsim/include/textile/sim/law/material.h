@@ -114,6 +114,12 @@ struct Material {
 // the value and docs/methods/materials.md; none when the file gave every membrane field.
 std::vector<Note> MaterialDefaultNotes(const Material& material);
 
+// A material of a law and an areal density [kg/m²] alone, as a file with only
+// `areal_density_gsm` and `bending` reads: its membrane the documented defaults, each listed in
+// `defaulted` (MaterialDefaultNotes names them in every run; MaterialToJson leaves them out).
+// What a fit knows of a fabric; no membrane is claimed that nobody measured.
+Material LawOnlyMaterial(const BendingLaw& law, double areal_density);
+
 // Parses material JSON text; `source` names the file in messages. Throws InputError.
 Material ParseMaterialJson(const std::string& text, const std::string& source);
 // Reads a material file. Throws InputError (unreadable file or any invalid field).

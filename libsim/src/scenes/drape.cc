@@ -286,6 +286,10 @@ SolveOptions DefaultDrapeSolveOptions() {
   s.max_iterations = 3000;
   s.max_seconds = 600.0;  // wall time: generous, the machine may be shared
   s.expand_steps = true;  // the same equilibria in 0.4-1× the steps (docs/methods/drapemeter.md, "Solver")
+  // The exact Hessian tried from a relative residual of 10 down, not 1: soft in compression (the
+  // default membrane) it is positive definite early, and the same drapes took 0.6-0.95× the base
+  // steps (docs/methods/drapemeter.md, "Solver", item 1).
+  s.exact_below = kDrapeExactBelow;
   return s;
 }
 

@@ -62,6 +62,10 @@ DrapeMount ParseDrapeMount(const std::string& name);  // InputError naming the v
 std::string DrapeSeamsName(DrapeSeams seams);         // "none" | "weft" | "weft+warp" | "shifted"
 DrapeSeams ParseDrapeSeams(const std::string& name);  // InputError naming the value
 
+// The relative residual below which a drape's Newton steps try the exact Hessian first
+// (SolveOptions::exact_below; DefaultDrapeSolveOptions).
+constexpr double kDrapeExactBelow = 10.0;
+
 // The solver settings a drape starts from: Newton + CHOLMOD, relative residual 1e-4 (DC is
 // stable to ~1e-4 there; docs/methods/drapemeter.md), 3000 iterations, 600 s.
 SolveOptions DefaultDrapeSolveOptions();

@@ -355,7 +355,7 @@ TEST(BendingElements, VolinoAndIsometricAreTheSameEnergyOnceCalibrated) {
   EXPECT_NEAR(volino.Energy(x), ibm.Energy(x), 1e-12 * ibm.Energy(x));
 }
 
-TEST(BendingElements, WarpWeftBlendFollowsTheRestEdgeAngle) {
+TEST(BendingElements, WarpWeftBlendFollowsTheBendingDirectionAcrossTheRestEdge) {
   std::mt19937 rng(47);
   const TriangleMesh rest = SmallPattern(&rng);
   const auto hinges = BuildHinges(rest);
@@ -364,7 +364,8 @@ TEST(BendingElements, WarpWeftBlendFollowsTheRestEdgeAngle) {
   const Vertices x = Perturbed(rest.vertices, 0.003, &rng);
   for (int h = 0; h < b.num_hinges(); ++h) {
     const Eigen::Vector3d e = rest.vertices.row(hinges[h].v[3]) - rest.vertices.row(hinges[h].v[2]);
-    const BlendedLaw blended(warp, weft, std::atan2(e.y(), e.x()));
+    // The hinge bends across its edge: the bending direction is the edge's normal in plane.
+    const BlendedLaw blended(warp, weft, std::atan2(e.y(), e.x()) + 0.5 * M_PI);
     const double expected = b.area_weight(h) * blended.Energy(b.HingeCurvature(x, h));
     EXPECT_NEAR(b.HingeEnergy(x, h), expected, 1e-14 * expected) << "hinge " << h;
   }

@@ -704,7 +704,9 @@ BendingElements::BendingElements(const TriangleMesh& rest, const std::vector<Hin
     r.v = hinge.v;
     r.rest_angle = HingeBendAngle(x0, x1, x2, x3);
     r.inv_height = 1.0 / height;
-    r.warp_weight = anisotropic_ ? e.x() * e.x() / (l * l) : 1.0;  // cos²φ, φ from the x axis
+    // cos²φ, φ the bending direction's angle to the warp (x): the curvature runs across the
+    // edge, so an edge along the weft (y) bends a warp strip, with the warp law.
+    r.warp_weight = anisotropic_ ? e.y() * e.y() / (l * l) : 1.0;
     edge_length_[h] = l;
     const double area_weight = l * height;  // A_h = |ē| h̄e = Ā0 + Ā1
     const double b1 = r.warp_weight * warp_.b1() + (1.0 - r.warp_weight) * weft_.b1();

@@ -119,9 +119,11 @@ class BendingElements {
   // @param rest        rest mesh: #V×3 rest positions [m] (flat patterns: z = 0; a curved
   //                    rest state is allowed), #F×3 triangles. CheckMesh is the caller's job.
   // @param hinges      the bending elements, usually BuildHinges(rest) (#H)
-  // @param warp, weft  moment-curvature laws [SI], β already applied; a hinge whose rest edge
-  //                    makes angle φ with the warp direction (the pattern's x axis) uses
-  //                    BlendedLaw(warp, weft, φ). Pass weft = nullopt for an isotropic fabric.
+  // @param warp, weft  moment-curvature laws [SI], β already applied: the warp law bends a
+  //                    strip cut along the warp (the pattern's x axis), curvature along x. A
+  //                    hinge bends across its rest edge: one whose edge makes angle ψ with the
+  //                    weft (y) uses BlendedLaw(warp, weft, ψ), an edge along y the warp law.
+  //                    Pass weft = nullopt for an isotropic fabric.
   // @param stiffness_multiplier  per-hinge factor S (seam factor of eq. 6), #H values > 0,
   //                    or empty for S = 1 everywhere
   // Throws InputError naming the hinge: bad options, multiplier count or value, vertex ids
@@ -190,7 +192,7 @@ class BendingElements {
   double rest_edge_length(int h) const { return edge_length_[h]; }                   // |ē| [m]
   double area_weight(int h) const { return edge_length_[h] / rest_[h].inv_height; }  // A_h [m²]
   double stiffness_multiplier(int h) const { return multiplier_[h]; }                // S
-  double warp_weight(int h) const { return rest_[h].warp_weight; }                   // cos²φ
+  double warp_weight(int h) const { return rest_[h].warp_weight; }                   // cos²ψ
   // Bend angle θ [rad], hinge curvature κ = (θ - θ̄)/h̄e [1/m] and energy [J] of hinge h.
   double BendAngle(const Vertices& x, int h) const;
   double HingeCurvature(const Vertices& x, int h) const;
@@ -203,7 +205,7 @@ class BendingElements {
     double rest_angle;   // θ̄ [rad]
     double inv_height;   // 1/h̄e [1/m]
     double weight;       // Pabst: S A_h [m²]; Bridson: S k_h [J]; linear: S k_h [N/m]
-    double warp_weight;  // cos²φ of BlendedLaw
+    double warp_weight;  // cos²ψ of BlendedLaw
   };
   // Linear models: R = Σ alpha[i] x_v[i], rest value R̄.
   struct LinearRest {

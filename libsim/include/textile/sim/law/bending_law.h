@@ -147,12 +147,14 @@ class BendingLaw {
   std::shared_ptr<const Spline> spline_;  // null for a Pabst law; immutable, so shared by copies
 };
 
-// Warp/weft anisotropy (docs/spec/physics.md): a hinge whose edge makes angle φ with the warp
-// direction bends with M(κ) = cos²φ M_warp(κ) + sin²φ M_weft(κ). The blend of two laws is again
+// Warp/weft anisotropy (docs/spec/physics.md): bending whose direction (the curvature's, across
+// a hinge's edge) makes angle φ with the warp follows M(κ) = cos²φ M_warp(κ) + sin²φ M_weft(κ):
+// the warp law is the bending of a strip cut along the warp, as a lab measures it. The blend of two laws is again
 // odd, C1 and strictly increasing; its inverse is found by safeguarded Newton.
 class BlendedLaw {
  public:
-  // phi: angle between the hinge edge and the warp direction [rad].
+  // phi: angle between the bending direction (the curvature's: across a hinge's edge) and the
+  // warp [rad]; 0 is a strip cut along the warp, π/2 one cut along the weft.
   BlendedLaw(const BendingLaw& warp, const BendingLaw& weft, double phi);
   double Moment(double kappa) const;      // [N]
   double Stiffness(double kappa) const;   // [N·m]

@@ -45,7 +45,7 @@ bool ShowProgress(bool always = false);
 //   const bool kRegistered = AddCommand(40, RegisterFit);
 // `order` sorts them in --help (the pipeline order: law 10, synth-profile 20, calibrate 25,
 // extract 30, render-photo 35, fit 40, fit-seam 45, acpm 50, drape 60, render-shadow 62,
-// drape-measure 65, validate 70, bench 90).
+// drape-measure 65, validate 70, export 80, bench 90).
 using CommandRegistrar = void (*)(CLI::App& app);
 bool AddCommand(int order, CommandRegistrar registrar);
 // Adds every registered subcommand to app, in order, and makes every option and argument of

@@ -706,7 +706,9 @@ BendingElements::BendingElements(const TriangleMesh& rest, const std::vector<Hin
     r.inv_height = 1.0 / height;
     // cos²φ, φ the bending direction's angle to the warp (x): the curvature runs across the
     // edge, so an edge along the weft (y) bends a warp strip, with the warp law.
-    r.warp_weight = anisotropic_ ? e.y() * e.y() / (l * l) : 1.0;
+    // In the pattern plane: a curved rest edge's z does not count towards either yarn.
+    const double in_plane = e.x() * e.x() + e.y() * e.y();
+    r.warp_weight = !anisotropic_ ? 1.0 : in_plane > 0.0 ? e.y() * e.y() / in_plane : 0.5;
     edge_length_[h] = l;
     const double area_weight = l * height;  // A_h = |ē| h̄e = Ā0 + Ā1
     const double b1 = r.warp_weight * warp_.b1() + (1.0 - r.warp_weight) * weft_.b1();

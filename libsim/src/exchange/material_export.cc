@@ -3,6 +3,7 @@
 #include "textile/sim/exchange/material_export.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -57,7 +58,9 @@ nlohmann::json ArcsimBendingTable(const Material& m) {
   nlohmann::json table = nlohmann::json::array();
   for (const BlendedLaw& law : by_edge) {
     nlohmann::json row = nlohmann::json::array();
-    for (double k : kArcsimBendingCurvatures) row.push_back(SecantStiffness(law, k));
+    for (double alpha : kArcsimBendingAlpha)
+      row.push_back(kArcsimStiffnessPerSecant *
+                    SecantStiffness(law, kArcsimCurvaturePerAlpha * alpha));
     table.push_back(row);
   }
   return table;
@@ -151,7 +154,8 @@ void AddPcbNotes(const Material& m, const std::vector<Direction>& dirs, std::vec
       notes->push_back({"pcb_bending_quadratic",
                         key + ": the law's quadratic branch, exact up to kappa0 = " +
                             NumberText(units::SiCurvatureToKes(q.kappa_fit), 4) +
-                            " /cm; past it the law is linear and the fork's moment falls below it"});
+                            " /cm; past it the law is linear and the fork's moment " +
+                            (d.law.c1() < 0.0 ? "falls below it" : "rises above it")});
     }
     if (!m.bending_weft) return;
   }
@@ -172,8 +176,8 @@ ExportedMaterial ExportArcsim(const Material& m, const ExportOptions& o) {
   AddStretching(m, o, &j, &e.notes);
   AddPcbNotes(m, dirs, &e.notes);
   e.notes.push_back({"arcsim_curvature_samples",
-                     "bending: secant stiffness M/kappa at ARCSim's 0, 5, 10, 15, 20 /m; ARCSim "
-                     "holds the last beyond 20 /m (0.2 /cm)"});
+                     "bending: 4 M(kappa)/kappa at kappa = 0, 10, 20, 30, 40 /m (ARCSim's alpha = "
+                     "kappa/2 = 0-20 /m); ARCSim holds the last beyond 40 /m (0.4 /cm)"});
   e.text = j.dump(2) + "\n";
   return e;
 }
@@ -226,7 +230,7 @@ ExportedMaterial ExportU3m(const Material& m, const ExportOptions& o) {
       {"material_type", nullptr},
       {"construction", nullptr}};
   nlohmann::json material = {
-      {"id", ContentUuid4(custom.dump())},
+      {"id", ""},
       {"name", m.name},
       {"description", "Bending measured by cantilever and fitted by textile (moment-curvature "
                       "law of Pabst et al. 2008); the law is in custom.textile"},
@@ -237,7 +241,14 @@ ExportedMaterial ExportU3m(const Material& m, const ExportOptions& o) {
       {"side", nullptr},
       {"physics", physics},
       {"metadata", nullptr}};
-  const nlohmann::json j = {{"schema", "1.1"}, {"material", material}, {"custom", {{"textile", custom}}}};
+  nlohmann::json j = {{"schema", "1.1"}, {"material", material}, {"custom", {{"textile", custom}}}};
+  // The id hashes everything exported but the id, the times and the producer's version: the
+  // same material and thickness give the same id whenever and by whichever version.
+  nlohmann::json hashed = j;
+  hashed["material"].erase("created");
+  hashed["material"].erase("modified");
+  hashed["custom"]["textile"].erase("producer");
+  j["material"]["id"] = ContentUuid4(hashed.dump());
   if (!o.thickness_mm)
     e.notes.push_back({"thickness_unknown",
                        "physics.thickness is null: a cantilever does not measure it "
@@ -279,8 +290,11 @@ ExportedMaterial ExportCsv(const Material& m) {
           << Cell(c.rigidity_mg_cm());
     } else {
       out << ",,";
-      e.notes.push_back({"no_bending_length",
-                         std::string(d.name) + ": no bending length: " + crossing.message});
+      // One note for a material with one law: its three directions are the same strip.
+      if (m.bending_weft || d.angle_deg == 0.0)
+        e.notes.push_back({"no_bending_length",
+                           std::string(m.bending_weft ? d.name : "warp, weft and bias") +
+                               ": no bending length: " + crossing.message});
     }
     out << ',' << Cell(units::SiToGsm(m.areal_density)) << ',';
     if (moduli) {
@@ -402,14 +416,16 @@ std::string ExportTimestamp() {
   std::time_t t = std::time(nullptr);
   if (const char* env = std::getenv("SOURCE_DATE_EPOCH"); env && *env) {
     char* end = nullptr;
+    errno = 0;
     const long long v = std::strtoll(env, &end, 10);
-    if (*end != '\0' || v < 0)
+    // 253402300799 is 9999-12-31T23:59:59Z, the last time ISO 8601's four-digit year writes.
+    if (*end != '\0' || errno == ERANGE || v < 0 || v > 253402300799LL)
       throw InputError(std::string("SOURCE_DATE_EPOCH: '") + env +
-                       "' is not a whole number of seconds >= 0");
+                       "' is not a whole number of seconds from 0 to 253402300799");
     t = static_cast<std::time_t>(v);
   }
   std::tm tm{};
-  gmtime_r(&t, &tm);
+  if (gmtime_r(&t, &tm) == nullptr) throw ComputeError("the clock's time is not a date");
   char s[32];
   std::strftime(s, sizeof s, "%Y-%m-%dT%H:%M:%SZ", &tm);
   return s;
@@ -417,6 +433,8 @@ std::string ExportTimestamp() {
 
 ExportedMaterial ExportMaterial(const Material& material, ExportFormat format,
                                 const ExportOptions& options) {
+  if (options.thickness_mm && format != ExportFormat::kU3m)
+    throw InputError("--thickness-mm: only U3M carries a thickness");
   switch (format) {
     case ExportFormat::kArcsim:
       return ExportArcsim(material, options);

@@ -57,12 +57,16 @@ ExportedMaterial ExportMaterial(const Material& material, ExportFormat format,
 
 // The pieces, for tests and library users.
 
-// ARCSim's bending curvatures: column j of its "bending" table is read at α = 5 j /m
-// (dde.cpp, "samples are per 0.05 cm^-1"), j = 0..4.
-constexpr std::array<double, 5> kArcsimBendingCurvatures = {0.0, 5.0, 10.0, 15.0, 20.0};  // [1/m]
+// ARCSim's bending table. dde.cpp reads column j at α = 5 j /m (its comment: "samples are per
+// 0.05 cm^-1"), where α = θ l / (2 (A₀ + A₁)) is half the hinge curvature κ = θ / h̄ of Pabst
+// eq. 2; physics.cpp's hinge energy is ke l² θ² / (8 (A₀ + A₁)), a quarter of Pabst's ½ B κ² A
+// for ke = B, and its moment ke κ / 4. The hinge ARCSim builds from the table bends as the law
+// when column j holds ke_j = 4 M(κ_j) / κ_j at κ_j = 2 α_j = 10 j /m (4 B(0) at j = 0).
+constexpr std::array<double, 5> kArcsimBendingAlpha = {0.0, 5.0, 10.0, 15.0, 20.0};  // [1/m]
+constexpr double kArcsimCurvaturePerAlpha = 2.0;    // κ = 2 α
+constexpr double kArcsimStiffnessPerSecant = 4.0;  // ke = 4 M(κ) / κ
 
-// The secant stiffness M(κ)/κ [N·m] of a law, B(0) at κ = 0: ARCSim's bending force is
-// ke(α)·θ, a moment ke·κ, so its table holds M/κ, not dM/dκ.
+// The secant stiffness M(κ)/κ [N·m] of a law, B(0) at κ = 0.
 double SecantStiffness(const BendingLaw& law, double kappa);
 double SecantStiffness(const BlendedLaw& law, double kappa);
 

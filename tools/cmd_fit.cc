@@ -13,6 +13,7 @@
 #include "common/profile_inputs.h"
 #include "textile/fit/clapp.h"
 #include "textile/fit/direct_fit.h"
+#include "textile/fit/fit_material.h"
 #include "textile/fit/fit_report.h"
 #include "textile/fit/profile.h"
 #include "textile/fit/profile_compare.h"
@@ -36,69 +37,7 @@ struct FitArgs {
   PhotoFlags photo;  // photos among the inputs are extracted first
 };
 
-// "pabst-fig8_L040mm" for .../pabst-fig8_L040mm.profile.csv (extract's and synth-profile's
-// names) and for a photo .../pabst-fig8_L040mm.jpg.
-std::string InputStem(const std::string& path) {
-  std::string stem = std::filesystem::path(path).stem().string();
-  const std::string suffix = ".profile";
-  if (stem.size() > suffix.size() && stem.ends_with(suffix))
-    stem.resize(stem.size() - suffix.size());
-  return stem;
-}
-
-struct Outcome {
-  BendingLaw law = BendingLaw::FromKes(1, 1, 0);
-  nlohmann::json report;
-  std::vector<ProfileComparison> comparisons;  // per profile, for the plot
-  double kappa_max = 0.0;
-  std::string brief;
-  std::string notes;  // what the user should know about a fit that succeeded ("; "-joined)
-};
-
-// A fit can only hand out a law that a material file accepts: Clapp's regression, for one,
-// can wander to constants no fabric has when the polynomial is poor.
-void CheckFittedLaw(const BendingLaw& law, double rho, const std::string& method) {
-  if (std::string why; !FittedLawMaterial(law, rho, &why))
-    throw ComputeError("fit (" + method + ") gave an implausible law: " + why);
-}
-
-Outcome RunDirect(const FitArgs& a, const std::vector<Profile>& profiles, double rho) {
-  DirectFitOptions o;
-  o.fit_offset = !a.thickness_given && !a.no_offset;
-  o.offset = a.thickness_given ? units::MmToM(a.thickness_mm) / 2.0 : 0.0;
-  o.fit_rotation = a.fit_rotation;
-  o.robust_scale = units::MmToM(a.robust_mm);
-  std::vector<std::string> notes;
-  const DirectFitSummary fit = FitDirectCheckingTilt(profiles, rho, o, &notes, &o);
-  if (!fit.converged) throw ComputeError("fit: " + fit.message);
-  Outcome out;
-  for (const std::string& n : notes) out.notes += (out.notes.empty() ? "" : "; ") + n;
-  out.law = *fit.law;
-  out.kappa_max = fit.kappa_max;
-  out.brief = fit.BriefReport();
-  for (size_t i = 0; i < profiles.size(); ++i) {
-    out.comparisons.push_back(CompareWithElastica(
-        out.law, rho, profiles[i], fit.profiles[i].overhang, fit.offset, fit.rotation));
-  }
-  CheckFittedLaw(out.law, rho, "direct");
-  out.report = FitReportJson(fit, o, rho, notes, {.robust_scale_mm = a.robust_mm});
-  return out;
-}
-
-Outcome RunClapp(const std::vector<Profile>& profiles, double rho) {
-  const ClappResult fit = FitClapp(profiles, rho);
-  if (!fit.success || !fit.law) throw ComputeError("fit (clapp): " + fit.message);
-  Outcome out;
-  out.law = *fit.law;
-  out.kappa_max = fit.kappa_max;
-  out.brief = fit.BriefReport();
-  out.comparisons = GradeClappFit(fit, profiles, rho);
-  CheckFittedLaw(out.law, rho, "clapp");
-  out.report = FitReportJson(fit, profiles, out.comparisons, rho);
-  return out;
-}
-
-void Plot(const FitArgs& a, const std::vector<Profile>& profiles, const Outcome& o, double rho,
+void Plot(const FitArgs& a, const std::vector<Profile>& profiles, const FittedMaterial& o,
           const std::optional<ClappResult>& clapp, AtomicFile& out) {
   namespace chart = textile::chart;
   chart::Panel prof{.title = "Profiles: measured and fitted",
@@ -127,7 +66,7 @@ void Plot(const FitArgs& a, const std::vector<Profile>& profiles, const Outcome&
     models.push_back(model);
   }
   for (auto& m : models) prof.series.push_back(std::move(m));
-  prof.notes = {"rms " + Num(o.report["rms_mm"].get<double>(), 3) + " mm"};
+  prof.notes = {"rms " + Num(o.material.fit["rms_mm"].get<double>(), 3) + " mm"};
 
   chart::Panel mk{.title = "Moment-curvature", .x_label = "κ [1/cm]", .y_label = "M [gf·cm/cm]"};
   const double kmax = o.kappa_max;
@@ -140,7 +79,7 @@ void Plot(const FitArgs& a, const std::vector<Profile>& profiles, const Outcome&
     }
     return s;
   };
-  mk.series.push_back(curve(o.law, a.method == "direct" ? "direct fit" : "Clapp fit", false));
+  mk.series.push_back(curve(o.material.bending, a.method == "direct" ? "direct fit" : "Clapp fit", false));
   if (clapp && clapp->law) {
     chart::Series pts{.label = "Clapp (κ, M) points",
                       .style = chart::Series::Style::kMarkers,
@@ -152,43 +91,36 @@ void Plot(const FitArgs& a, const std::vector<Profile>& profiles, const Outcome&
     mk.series.push_back(pts);
     if (a.method == "direct") mk.series.push_back(curve(*clapp->law, "Clapp's law", true));
   }
-  mk.notes = {"b1 = " + Num(o.law.b1_kes(), 4) + " gf·cm",
-              "b2 = " + Num(o.law.b2_kes(), 4) + " gf·cm",
-              "c1 = " + Num(o.law.c1_kes(), 4) + " gf·cm²",
-              "κ0 = " + Num(units::SiCurvatureToKes(o.law.kappa0()), 4) + " /cm"};
+  const BendingLaw& law = o.material.bending;
+  mk.notes = {"b1 = " + Num(law.b1_kes(), 4) + " gf·cm",
+              "b2 = " + Num(law.b2_kes(), 4) + " gf·cm",
+              "c1 = " + Num(law.c1_kes(), 4) + " gf·cm²",
+              "κ0 = " + Num(units::SiCurvatureToKes(law.kappa0()), 4) + " /cm"};
   chart::WritePng({.title = "textile fit (" + a.method + "), " + Num(a.gsm) + " g/m²",
                    .width_px = 1300,
                    .height_px = 600,
                    .columns = 2,
                    .panels = {prof, mk}},
                   out);
-  (void)rho;
+}
+
+FitMaterialOptions Options(const FitArgs& a) {
+  FitMaterialOptions o;
+  if (!std::isfinite(a.gsm) || a.gsm <= 0.0) throw InputError("--gsm must be a number > 0 (g/m²)");
+  o.areal_density = units::GsmToSi(a.gsm);
+  o.method = a.method == "clapp" ? FitMethod::kClapp : FitMethod::kDirect;
+  if (a.thickness_given) o.thickness = units::MmToM(a.thickness_mm);
+  o.no_offset = a.no_offset;
+  o.fit_rotation = a.fit_rotation;
+  o.robust_scale_mm = a.robust_mm;
+  o.robust_given = a.robust_given;
+  o.name = a.name;
+  CheckFitMaterialOptions(o);
+  return o;
 }
 
 void Run(const FitArgs& a) {
-  if (!std::isfinite(a.gsm) || a.gsm <= 0.0) throw InputError("--gsm must be a number > 0 (g/m²)");
-  if (a.gsm < 1.0 || a.gsm > 1e4)
-    throw InputError("--gsm " + Num(a.gsm) + " g/m² is implausible (1 .. 10000)");
-  if (!(a.robust_mm == 0.0 || (a.robust_mm >= 0.001 && a.robust_mm <= 100.0)))
-    throw InputError("--robust-mm must be 0 (off) or in [0.001, 100] mm");
-  if (a.thickness_given && !(a.thickness_mm > 0.0 && a.thickness_mm <= 6.0))
-    throw InputError(
-        "--thickness-mm must lie in (0, 6] mm (a thicker strip's mid-line starts above what a "
-        "profile may rise), got " +
-        Num(a.thickness_mm));
-  if (a.thickness_given && a.no_offset)
-    throw InputError("--thickness-mm and --no-offset contradict each other (offset t/2 vs 0)");
-  // Clapp's polynomial takes the profiles as they are: no offset, rotation or robust loss.
-  if (a.method == "clapp") {
-    for (const auto& [given, flag] :
-         {std::pair{a.thickness_given, "--thickness-mm"}, std::pair{a.no_offset, "--no-offset"},
-          std::pair{a.fit_rotation, "--fit-rotation"}, std::pair{a.robust_given, "--robust-mm"}})
-      if (given)
-        throw InputError(
-            std::string(flag) +
-            ": an option of the direct fit; --method clapp fits the profiles as they are");
-  }
-  const double rho = units::GsmToSi(a.gsm);
+  const FitMaterialOptions options = Options(a);
   // Check the outputs before the work (photos included), so that a bad path fails fast; they appear
   // together.
   std::vector<std::pair<std::string, std::string>> inputs{{"--rig", a.photo.rig_file}};
@@ -218,31 +150,29 @@ void Run(const FitArgs& a) {
     }
     for (const auto& w : r.warnings) photo_warnings += "; " + in.source + ": " + w.text;
   }
-  Outcome o;
+  FittedMaterial o;
   try {
-    o = a.method == "direct" ? RunDirect(a, profiles, rho) : RunClapp(profiles, rho);
+    o = FitMaterial(profiles, options);
   } catch (const ComputeError& e) {
     if (photo_warnings.empty()) throw;
     throw ComputeError(e.what() + std::string(" (extraction warnings") + photo_warnings + ")");
   }
 
-  o.report["inputs"] = a.inputs;
-  if (!photos.empty()) o.report["photos"] = photos;
-  o.report["areal_density_gsm"] = a.gsm;
+  Material& m = o.material;
+  m.fit["inputs"] = a.inputs;
+  if (!photos.empty()) m.fit["photos"] = photos;
+  m.fit["areal_density_gsm"] = a.gsm;
 
   std::optional<ClappResult> clapp;
   if (!a.plot.empty()) {
     try {
-      clapp = FitClapp(profiles, rho);
+      clapp = FitClapp(profiles, options.areal_density);
     } catch (const InputError&) {
       // Clapp's points are only decoration here; a profile it cannot use is not an error.
     }
-    Plot(a, profiles, o, rho, clapp, *plot_file);
+    Plot(a, profiles, o, clapp, *plot_file);
   }
 
-  Material m = LawOnlyMaterial(o.law, rho);
-  m.name = a.name.empty() ? "fitted from " + InputStem(a.inputs.front()) : a.name;
-  m.fit = o.report;
   material_file.Write(MaterialToJson(m).dump(2) + "\n");
   outputs.Commit();
 
@@ -251,19 +181,23 @@ void Run(const FitArgs& a) {
     return;
   }
   std::cout << extracted.str() << o.brief << "\n";
-  std::cout << "law: b1 = " << Num(o.law.b1_kes(), 5) << " gf·cm, b2 = " << Num(o.law.b2_kes(), 5)
-            << " gf·cm, c1 = " << Num(o.law.c1_kes(), 5)
-            << " gf·cm²  (kappa0 = " << Num(units::SiCurvatureToKes(o.law.kappa0()), 4)
+  const BendingLaw& law = m.bending;
+  const nlohmann::json& report = m.fit;
+  std::cout << "law: b1 = " << Num(law.b1_kes(), 5) << " gf·cm, b2 = " << Num(law.b2_kes(), 5)
+            << " gf·cm, c1 = " << Num(law.c1_kes(), 5)
+            << " gf·cm²  (kappa0 = " << Num(units::SiCurvatureToKes(law.kappa0()), 4)
             << " /cm)\n";
-  std::cout << "profile rms: " << Num(o.report["rms_mm"].get<double>(), 3) << " mm\n";
-  if (o.report.contains("bending_length_mm")) {
+  std::cout << "profile rms: " << Num(report["rms_mm"].get<double>(), 3) << " mm\n";
+  if (report.contains("bending_length_mm")) {
     std::cout << "classic 41.5° test of this law: c = "
-              << Num(o.report["bending_length_mm"].get<double>(), 4)
-              << " mm, G = " << Num(o.report["flexural_rigidity_uNm"].get<double>(), 4)
-              << " µN·m = " << Num(o.report["flexural_rigidity_mgcm"].get<double>(), 4)
-              << " mg·cm (G/b1 = " << Num(o.report["G_over_b1"].get<double>(), 3) << ")\n";
+              << Num(report["bending_length_mm"].get<double>(), 4)
+              << " mm, G = " << Num(report["flexural_rigidity_uNm"].get<double>(), 4)
+              << " µN·m = " << Num(report["flexural_rigidity_mgcm"].get<double>(), 4)
+              << " mg·cm (G/b1 = " << Num(report["G_over_b1"].get<double>(), 3) << ")\n";
   }
-  if (!o.notes.empty()) std::cout << "note: " << o.notes << "\n";
+  std::string notes;
+  for (const std::string& n : o.notes) notes += (notes.empty() ? "" : "; ") + n;
+  if (!notes.empty()) std::cout << "note: " << notes << "\n";
   std::cout << "wrote " << a.out << (a.plot.empty() ? "" : " and " + a.plot) << "\n";
 }
 

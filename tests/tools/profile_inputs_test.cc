@@ -20,8 +20,6 @@ namespace textile {
 namespace {
 
 namespace fs = std::filesystem;
-using cli::LoadProfileInputs;
-using cli::PhotoInputOptions;
 using testing::Scratch;
 
 // A dark strip leaving the left border, bending down: extractable at any scale.

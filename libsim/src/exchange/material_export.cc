@@ -14,6 +14,7 @@
 
 #include <Eigen/Dense>
 
+#include "textile/sim/core/content_hash.h"
 #include "textile/sim/core/error.h"
 #include "textile/sim/core/number_text.h"
 #include "textile/sim/core/units.h"
@@ -318,18 +319,6 @@ ExportedMaterial ExportCsv(const Material& m) {
   return e;
 }
 
-// ---- Hash -----------------------------------------------------------------------------------
-
-// FNV-1a, 64 bits, from a seed: two seeds give the UUID's 128 bits.
-std::uint64_t Fnv1a(const std::string& s, std::uint64_t seed) {
-  std::uint64_t h = seed;
-  for (unsigned char c : s) {
-    h ^= c;
-    h *= 1099511628211ULL;
-  }
-  return h;
-}
-
 }  // namespace
 
 ExportFormat ParseExportFormat(const std::string& name) {
@@ -400,8 +389,9 @@ std::optional<MembraneModuli> MeasuredMembraneModuli(const Material& m) {
 }
 
 std::string ContentUuid4(const std::string& content) {
-  std::uint64_t hi = Fnv1a(content, 14695981039346656037ULL);
-  std::uint64_t lo = Fnv1a(content, hi ^ 0x9e3779b97f4a7c15ULL);
+  const ContentHash h = HashContent(content);
+  std::uint64_t hi = h.hi;
+  std::uint64_t lo = h.lo;
   hi = (hi & ~0xF000ULL) | 0x4000ULL;                        // version 4 (bits 12-15)
   lo = (lo & 0x3FFFFFFFFFFFFFFFULL) | 0x8000000000000000ULL;  // variant 10
   char s[37];

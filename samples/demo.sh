@@ -56,4 +56,11 @@ echo "== 6. Closing the loop: photos -> fit -> the same cantilevers simulated ->
 "$textile" validate samples/photos/pabst-fig8_L0{40,60,80}mm.jpg --rig "$out/pabst-fig8.rig.json" \
   --gsm 200 -o "$out/validate" 2>/dev/null
 echo
+echo "== 7. A specimen series: warp, weft, face, back -> statistics, a lab report (textile batch, report)"
+echo "   samples/series/manifest.csv: two fabrics, seven specimens (six of profiles, one photo)"
+"$textile" batch samples/series/manifest.csv -o "$out/series" --jobs 2 2>/dev/null
+awk -F, '{ printf "   %-12s %-9s %-3s %-13s %-13s %-13s %-13s %s\n", $1, $2, $3, $5, $6, $17, $20, $26 }' \
+  "$out/series/summary.csv"
+"$textile" report "$out/series" -o "$out/series/report.html"
+echo
 echo "Pictures and outputs: $out"

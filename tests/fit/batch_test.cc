@@ -51,7 +51,7 @@ std::map<std::string, std::string> Tree(const fs::path& dir) {
 }
 
 fs::path Scratch(const std::string& name) {
-  const fs::path d = fs::path(TEXTILE_BINARY_DIR) / "test_scratch" / ("batch_" + name);
+  fs::path d = fs::path(TEXTILE_BINARY_DIR) / "test_scratch" / ("batch_" + name);
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
@@ -123,6 +123,10 @@ TEST(BatchManifest, EachMistakeNamesItsLineAndColumn) {
   EXPECT_NE(ParseError(std::string("fab\0ric", 7)).find("not a text file"), std::string::npos);
   EXPECT_EQ(ParseError("\xEF\xBB\xBF" + kHeader + "f,s,warp,face,a.csv,200\n"), "")
       << "a spreadsheet's byte-order mark is no column name";
+  EXPECT_NE(ParseError("fabric,specimen,direction,side,inputs,gsm,validate\n"
+                       "f,s,warp,face,a.csv,200,maybe\n")
+                .find("column validate: 'maybe'"),
+            std::string::npos);
   EXPECT_EQ(ParseError(kHeader + "f,s,warp,face,a.csv,200\n"), "");
 }
 

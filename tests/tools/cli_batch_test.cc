@@ -38,6 +38,11 @@ TEST(CliBatch, TheShippedSeriesGivesASummaryAndAMaterialPerFabric) {
       nlohmann::json::parse(ReadAll(d / "out/interlining/photo-1/material.json"));
   EXPECT_EQ(photo["fit"]["photos"][0]["photo"], "../photos/pabst-interlining_L100mm.jpg");
   EXPECT_NEAR(photo["bending"]["b1"].get<double>(), 0.517, 0.05);
+  EXPECT_TRUE(fs::exists(d / "out/interlining/photo-1/pabst-interlining_L100mm.overlay.png"));
+  // The rows that ask for validation carry its verdicts; the others none.
+  EXPECT_EQ(s["specimens"][0]["validation"]["held_out"], "pass");
+  EXPECT_EQ(s["specimens"][6]["validation"]["goodness_of_fit"], "pass");
+  EXPECT_TRUE(s["specimens"][1]["validation"].is_null());
   EXPECT_TRUE(fs::exists(d / "out/fig8/material.json"));
   EXPECT_TRUE(fs::exists(d / "out/interlining/material.json"));
 }

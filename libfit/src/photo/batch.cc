@@ -3,6 +3,8 @@
 // ResumeOrFit (SpecimenInputHash, ReadCompleteSpecimen, FitSpecimen, WriteSpecimen), and
 // WriteSummary.
 
+#include <unistd.h>
+
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +13,9 @@
 #include <thread>
 
 #include "textile/fit/fit_material.h"
+#include "textile/fit/validate.h"
+#include "textile/photo/extract.h"
+#include "textile/photo/image_codecs.h"
 #include "textile/photo/batch.h"
 #include "textile/photo/profile_inputs.h"
 #include "textile/sim/core/content_hash.h"
@@ -69,7 +74,10 @@ json RowJson(const ManifestRow& r) {
           {"rig", r.rig.empty() ? json() : json(r.rig)},
           {"mm_per_px", r.mm_per_px ? json(*r.mm_per_px) : json()},
           {"width_mm", r.width_mm ? json(*r.width_mm) : json()},
-          {"notes", r.notes}};
+          {"notes", r.notes},
+          {"validate", r.validate == SpecimenValidation::kNone       ? "no"
+                       : r.validate == SpecimenValidation::kElastica ? "yes"
+                                                                     : "shell"}};
 }
 
 // An error message as the manifest spells the paths: the same bytes from any working folder.
@@ -84,8 +92,10 @@ std::string AsSpelled(std::string message, const ManifestRow& row) {
   return message;
 }
 
-// The specimen's material when its folder is complete and remembers `hash`; else none.
-std::optional<Material> ReadCompleteSpecimen(const fs::path& dir, const std::string& hash) {
+// The specimen's material (and its validation, into *validation) when its folder is complete
+// and remembers `hash`; else none.
+std::optional<Material> ReadCompleteSpecimen(const fs::path& dir, const std::string& hash,
+                                             json* validation) {
   std::error_code ec;
   if (!fs::is_regular_file(dir / kSpecimenRecord, ec) ||
       !fs::is_regular_file(dir / kSpecimenMaterial, ec))
@@ -94,6 +104,7 @@ std::optional<Material> ReadCompleteSpecimen(const fs::path& dir, const std::str
     const json record = json::parse(ReadBytes((dir / kSpecimenRecord).string()));
     if (record.value("status", "") != "fitted" || record.value("input_hash", "") != hash)
       return std::nullopt;
+    *validation = record.value("validation", json());
     return ReadMaterial((dir / kSpecimenMaterial).string());
   } catch (const std::exception&) {
     return std::nullopt;  // a damaged folder is fitted again
@@ -111,7 +122,10 @@ void WriteSpecimen(const std::string& out_dir, const SpecimenOutcome& o) {
   } else {
     fs::remove(dir / kSpecimenMaterial, ec);
   }
+  for (const auto& [name, png] : o.overlays)
+    WriteAtomically(dir / name, std::string(png.begin(), png.end()));
   json record = RowJson(*o.row);
+  record["validation"] = o.validation;
   record["status"] = o.status == SpecimenStatus::kFailed ? "failed" : "fitted";
   record["error"] = o.error.empty() ? json() : json(o.error);
   record["exit_code"] = o.exit_code;
@@ -137,9 +151,11 @@ SpecimenOutcome ResumeOrFit(const ManifestRow& row, const BatchOptions& options)
   }
   const fs::path dir = SpecimenDir(options.out_dir, row);
   if (options.resume) {
-    if (std::optional<Material> m = ReadCompleteSpecimen(dir, hash)) {
+    json validation;
+    if (std::optional<Material> m = ReadCompleteSpecimen(dir, hash, &validation)) {
       SpecimenOutcome o;
       o.row = &row;
+      o.validation = std::move(validation);
       o.status = SpecimenStatus::kResumed;
       o.material = std::move(m);
       o.input_hash = hash;
@@ -164,7 +180,9 @@ void PrepareOutDir(const BatchOptions& o) {
     throw InputError("-o " + o.out_dir + ": exists and is not a folder");
   fs::create_directories(o.out_dir, ec);
   if (ec) throw InputError("-o " + o.out_dir + ": cannot make the folder (" + ec.message() + ")");
-  const fs::path probe = fs::path(o.out_dir) / ".textile-batch-probe";
+  // One probe a process: shards of one manifest may start into one folder at once.
+  const fs::path probe =
+      fs::path(o.out_dir) / (".textile-batch-probe-" + std::to_string(::getpid()));
   if (!std::ofstream(probe)) throw InputError("-o " + o.out_dir + ": cannot write in the folder");
   fs::remove(probe, ec);
 }
@@ -199,6 +217,30 @@ void WriteSummary(const std::string& out_dir, BatchResult* r) {
   r->summary_written = true;
 }
 
+// The extraction overlay of a photo input, as a thumbnail PNG named after the photo.
+std::pair<std::string, std::vector<unsigned char>> OverlayPng(const LoadedProfile& in,
+                                                              const std::string& as_spelled) {
+  const cv::Mat overlay = DrawExtractionOverlay(in.photo, *in.extraction, kBatchOverlaySidePx);
+  std::vector<unsigned char> png;
+  if (!image_codecs::Encode(".png", overlay, &png))
+    throw ComputeError(as_spelled + ": cannot encode its overlay");
+  return {fs::path(as_spelled).stem().string() + ".overlay.png", std::move(png)};
+}
+
+// validate.h's verdicts on the specimen's profiles: ComputeError when the validation itself
+// could not be completed.
+json ValidationJson(const std::vector<Profile>& profiles, double rho, SpecimenValidation how) {
+  ValidationOptions v;
+  v.run_shell = how == SpecimenValidation::kShell;
+  const ValidationSummary s = ValidateFit(profiles, rho, v);
+  if (!s.completed) throw ComputeError("validation: " + s.message);
+  return {{"models", v.run_shell ? "elastica, shell" : "elastica"},
+          {"goodness_of_fit", s.pass ? "pass" : "fail"},
+          {"held_out", HoldoutVerdictName(s.holdout_verdict)},
+          {"pass", s.AllPass()},
+          {"reason", s.AllPass() ? json() : json(s.FailureReason())}};
+}
+
 }  // namespace
 
 const char* SpecimenStatusName(SpecimenStatus s) {
@@ -226,9 +268,11 @@ SpecimenOutcome FitSpecimen(const ManifestRow& row) {
     PhotoInputOptions photo;
     if (!row.rig_path.empty()) photo.rig_path = row.rig_path;
     photo.mm_per_px = row.mm_per_px;
+    photo.keep_photos = true;
     const std::vector<LoadedProfile> loaded = LoadProfileInputs(row.paths, photo);
     std::vector<Profile> profiles;
     json photos = json::array();
+    SpecimenOutcome o;
     for (size_t i = 0; i < loaded.size(); ++i) {
       profiles.push_back(loaded[i].profile);
       profiles.back().source = row.inputs[i];
@@ -236,6 +280,7 @@ SpecimenOutcome FitSpecimen(const ManifestRow& row) {
       json p = ExtractionJson(loaded[i]);
       p["photo"] = row.inputs[i];
       photos.push_back(p);
+      o.overlays.push_back(OverlayPng(loaded[i], row.inputs[i]));
     }
     FitMaterialOptions fit;
     fit.areal_density = units::GsmToSi(row.gsm);
@@ -247,7 +292,8 @@ SpecimenOutcome FitSpecimen(const ManifestRow& row) {
     m.fit["inputs"] = row.inputs;
     if (!photos.empty()) m.fit["photos"] = photos;
     m.fit["areal_density_gsm"] = row.gsm;
-    SpecimenOutcome o;
+    if (row.validate != SpecimenValidation::kNone)
+      o.validation = ValidationJson(profiles, fit.areal_density, row.validate);
     o.row = &row;
     o.status = SpecimenStatus::kFitted;
     o.material = std::move(m);

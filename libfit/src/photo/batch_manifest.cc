@@ -21,7 +21,7 @@ namespace textile {
 const std::vector<std::string> kManifestRequiredColumns = {"fabric",    "specimen", "direction",
                                                            "side",      "inputs",   "gsm"};
 const std::vector<std::string> kManifestOptionalColumns = {"rig", "mm_per_px", "width_mm",
-                                                           "notes"};
+                                                           "notes", "validate"};
 
 const char* DirectionName(StripDirection d) {
   switch (d) {
@@ -100,7 +100,7 @@ std::map<std::string, size_t> ColumnIndex(const std::vector<std::string>& header
     if (!known(kManifestRequiredColumns) && !known(kManifestOptionalColumns))
       throw InputError(source + " line 1: unknown column '" + header[i] +
                        "' (columns: fabric, specimen, direction, side, inputs, gsm, rig, "
-                       "mm_per_px, width_mm, notes)");
+                       "mm_per_px, width_mm, notes, validate)");
     if (!index.emplace(name, i).second)
       throw InputError(source + " line 1: column '" + name + "' is given twice");
   }
@@ -154,6 +154,13 @@ FabricSide SideCell(const std::string& cell, const CellPlace& at) {
   Fail(at, "unknown side '" + cell + "' (face or back)");
 }
 
+SpecimenValidation ValidateCell(const std::string& cell, const CellPlace& at) {
+  if (cell.empty() || cell == "no") return SpecimenValidation::kNone;
+  if (cell == "yes") return SpecimenValidation::kElastica;
+  if (cell == "shell") return SpecimenValidation::kShell;
+  Fail(at, "'" + cell + "' (no, yes for the elastica, or shell for the elastica and the shell)");
+}
+
 std::string Resolve(const std::string& path, const std::string& base_dir) {
   const fs::path p(path);
   return p.is_absolute() || base_dir.empty() ? p.string() : (fs::path(base_dir) / p).string();
@@ -201,6 +208,7 @@ ManifestRow ParseRow(const std::vector<std::string>& cells,
     Fail(at(scale), "give a rig or a scale, not both (the rig already maps pixels to mm)");
   if (!cell(width).empty()) r.width_mm = PositiveInRange(cell(width), at(width), "mm", 1.0, 1000.0);
   r.notes = cell("notes");
+  r.validate = ValidateCell(cell("validate"), at("validate"));
   return r;
 }
 

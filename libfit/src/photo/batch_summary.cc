@@ -146,7 +146,8 @@ json SpecimenJson(const SpecimenOutcome& o) {
             {"error", o.error.empty() ? json() : json(o.error)}};
   for (const Quantity& q : Quantities())
     j[Key(q)] = o.material ? OrNull(q.value(*o.material)) : json();
-  if (o.material) j["rms_mm"] = OrNull(FitNumber(*o.material, "rms_mm"));
+  j["rms_mm"] = o.material ? OrNull(FitNumber(*o.material, "rms_mm")) : json();
+  j["validation"] = o.validation;
   return j;
 }
 

@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "textile/sim/law/material.h"
@@ -33,6 +34,11 @@ enum class FabricSide { kFace, kBack };
 
 const char* DirectionName(StripDirection d);  // "warp", "weft", "bias"
 const char* SideName(FabricSide s);           // "face", "back"
+
+// What `validate` asks of a specimen (docs/guide/validate.md): nothing (empty or "no"), the
+// elastica ("yes": goodness of fit, and held-out prediction when it has two or more profiles),
+// or the elastica and the 3D shell ("shell", some seconds a profile).
+enum class SpecimenValidation { kNone, kElastica, kShell };
 
 // One row of the manifest: one specimen (one strip, one or more photos or profiles of it).
 struct ManifestRow {
@@ -48,6 +54,7 @@ struct ManifestRow {
   std::optional<double> mm_per_px;    // plain scale (photos), or none
   std::optional<double> width_mm;     // strip width [mm], carried into the records
   std::string notes;                  // free text, carried into the records
+  SpecimenValidation validate = SpecimenValidation::kNone;  // the `validate` column
 };
 
 struct Manifest {
@@ -57,7 +64,7 @@ struct Manifest {
 
 // The manifest's columns: required ones first. Any order in the file; named by the header.
 extern const std::vector<std::string> kManifestRequiredColumns;  // fabric .. gsm
-extern const std::vector<std::string> kManifestOptionalColumns;  // rig, mm_per_px, width_mm, notes
+extern const std::vector<std::string> kManifestOptionalColumns;  // rig .. notes, validate
 
 // Parses manifest text (CSV, header first; a field may be "quoted", with "" for a quote).
 // `base_dir` resolves relative inputs and rigs. Throws InputError naming the row and column:
@@ -91,6 +98,11 @@ struct SpecimenOutcome {
   int exit_code = 0;                // 2 bad input, 3 computation failed (kFailed)
   std::optional<Material> material;  // the fitted material (kFitted, kResumed)
   std::string input_hash;           // HashContent of the row and its inputs' bytes
+  // The verdicts when the row asked for validation: {goodness_of_fit: pass|fail, held_out:
+  // none|pass|fail, pass, reason}; null otherwise.
+  nlohmann::json validation;
+  // The photos' extraction overlays, as PNG bytes named "<photo stem>.overlay.png" (kFitted).
+  std::vector<std::pair<std::string, std::vector<unsigned char>>> overlays;
 };
 
 struct BatchProgress {
@@ -118,15 +130,19 @@ struct BatchResult {
 // materials. Throws InputError for options or a DIR it cannot write, before any specimen runs.
 BatchResult RunBatch(const Manifest& manifest, const BatchOptions& options);
 
+// Long side of the overlay thumbnails a photo specimen keeps [px].
+inline constexpr int kBatchOverlaySidePx = 640;
+
 // ---- The stages, exposed for tests ------------------------------------------------------
 
 // The fingerprint a specimen's outputs remember: the row's fields and every input's bytes (and
 // the rig file's). Throws InputError when an input cannot be read.
 std::string SpecimenInputHash(const ManifestRow& row);
 
-// Fits one specimen (photos extracted with the row's rig or scale), never throwing: failures
-// come back as kFailed with the error and its exit code. The material's fit report has no
-// `seconds` and names the inputs as the manifest spells them.
+// Fits one specimen (photos extracted with the row's rig or scale, each with an overlay of at
+// most kBatchOverlaySidePx), validates it when the row asks, never throwing: failures come back
+// as kFailed with the error and its exit code. The material's fit report has no `seconds` and
+// names the inputs as the manifest spells them.
 SpecimenOutcome FitSpecimen(const ManifestRow& row);
 
 // n, mean, sample sd (n - 1; null below n = 2) and CV = sd / |mean| of a set of values.
@@ -137,9 +153,10 @@ struct SeriesStats {
 };
 SeriesStats Stats(const std::vector<double>& values);
 
-// summary.json: {"directions": [{fabric, direction, n, n_failed, b1_gfcm: {mean, sd, cv}, ...}],
-// "fabrics": [{fabric, overall_rigidity_uNm, overall_rigidity_mgcm, material}], "specimens":
-// [{fabric, specimen, direction, side, status, error}]}, fabrics and directions in manifest order.
+// summary.json: {"directions": [{fabric, direction, n, n_failed, b1_gfcm: {n, n_unobserved, mean,
+// sd, cv}, ...}], "fabrics": [{fabric, overall_rigidity_uNm, overall_rigidity_mgcm, material}],
+// "specimens": [{fabric, specimen, direction, side, line, status, error, b1_gfcm ..., rms_mm,
+// validation}]}, fabrics in manifest order, directions warp, weft, bias.
 nlohmann::json SummaryJson(const std::vector<SpecimenOutcome>& specimens);
 // summary.csv from SummaryJson: one row a fabric and direction.
 std::string SummaryCsv(const nlohmann::json& summary);

@@ -18,6 +18,7 @@
 #include "textile/fit/profile.h"
 #include "textile/fit/profile_compare.h"
 #include "textile/sim/core/error.h"
+#include "textile/sim/core/join_text.h"
 #include "textile/sim/law/material.h"
 #include "textile/sim/core/units.h"
 
@@ -195,9 +196,7 @@ void Run(const FitArgs& a) {
               << " µN·m = " << Num(report["flexural_rigidity_mgcm"].get<double>(), 4)
               << " mg·cm (G/b1 = " << Num(report["G_over_b1"].get<double>(), 3) << ")\n";
   }
-  std::string notes;
-  for (const std::string& n : o.notes) notes += (notes.empty() ? "" : "; ") + n;
-  if (!notes.empty()) std::cout << "note: " << notes << "\n";
+  if (!o.notes.empty()) std::cout << "note: " << JoinText(o.notes, "; ") << "\n";
   std::cout << "wrote " << a.out << (a.plot.empty() ? "" : " and " + a.plot) << "\n";
 }
 

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "textile/sim/elastica/cantilever_outputs.h"
+#include "textile/sim/core/join_text.h"
 #include "textile/sim/core/units.h"
 
 namespace textile {
@@ -39,12 +40,6 @@ json ProfilesJson(const std::vector<ProfileFitReport>& profiles) {
   return per;
 }
 
-std::string JoinNotes(const std::vector<std::string>& notes) {
-  std::string joined;
-  for (const std::string& n : notes) joined += (joined.empty() ? "" : "; ") + n;
-  return joined;
-}
-
 }  // namespace
 
 std::optional<Material> FittedLawMaterial(const BendingLaw& law, double areal_density,
@@ -62,7 +57,7 @@ std::optional<Material> FittedLawMaterial(const BendingLaw& law, double areal_de
 nlohmann::json FitReportJson(const DirectFitSummary& fit, const DirectFitOptions& options,
                              double areal_density, const std::vector<std::string>& notes,
                              const FitReportOptions& report) {
-  const std::string note = JoinNotes(notes);
+  const std::string note = JoinText(notes, "; ");
   json j = {
       {"method", "direct"},
       {"b1_sd", OrNull(units::SiStiffnessToKes(fit.b1_sd))},

@@ -16,6 +16,7 @@
 
 #include "textile/sim/core/content_hash.h"
 #include "textile/sim/core/error.h"
+#include "textile/sim/core/join_text.h"
 #include "textile/sim/core/number_text.h"
 #include "textile/sim/core/units.h"
 #include "textile/sim/elastica/cantilever_outputs.h"
@@ -100,12 +101,6 @@ std::vector<std::string> MissingMembraneFields(const Material& m) {
   return missing;
 }
 
-std::string Join(const std::vector<std::string>& items) {
-  std::string s;
-  for (const std::string& i : items) s += (s.empty() ? "" : ", ") + i;
-  return s;
-}
-
 bool IsLinearCurve(const TensileCurve& c) { return c.strains().size() <= 1; }
 
 void AddStretching(const Material& m, const ExportOptions& o, nlohmann::json* out,
@@ -113,11 +108,11 @@ void AddStretching(const Material& m, const ExportOptions& o, nlohmann::json* ou
   const std::vector<std::string> missing = MissingMembraneFields(m);
   if (!missing.empty()) {
     if (o.strict)
-      throw InputError(Join(missing) +
+      throw InputError(JoinText(missing, ", ") +
                        ": ARCSim's stretching needs the membrane measured; the material leaves it "
                        "to defaults (drop --strict to export without stretching)");
     notes->push_back({"stretching_left_out",
-                      "stretching left out: the material does not give " + Join(missing) +
+                      "stretching left out: the material does not give " + JoinText(missing, ", ") +
                           " (its simulations use documented defaults); add ARCSim's stretching "
                           "from your own tensile data"});
     return;
@@ -310,7 +305,7 @@ ExportedMaterial ExportCsv(const Material& m) {
   if (!moduli)
     e.notes.push_back({"membrane_not_measured",
                        "tensile and shear moduli left empty: the material does not give " +
-                           Join(MissingMembraneFields(m))});
+                           JoinText(MissingMembraneFields(m), ", ")});
   if (m.bending_weft)
     e.notes.push_back({"bias_blend",
                        "bias: the 45 degree blend of the warp and weft laws, M = (M_warp + "

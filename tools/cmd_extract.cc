@@ -35,6 +35,7 @@ void Run(const ExtractArgs& a) {
   const PhotoInputOptions options = a.photo.Options();
   const Rig rig = RigFromOptions(options, "extract");
   ExtractOptions o = options.extract;
+  CheckTipForPhotos(o, a.photos.size());
   if (a.overlay_px < 200 || a.overlay_px > 20000)
     throw InputError("--overlay-px must lie in [200, 20000]");
   if (!(std::isfinite(a.max_seconds) && a.max_seconds >= 0.0))

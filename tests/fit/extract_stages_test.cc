@@ -265,6 +265,64 @@ TEST(ExtractStages, FindTipEndPlacesTheTip) {
   EXPECT_FALSE(HasNote(run.state.summary.warnings, "tip_end_unclear"));
 }
 
+TEST(ExtractStages, AGivenTipCutsTheLineOrContinuesItAndAFarOneIsRefused) {
+  const SyntheticPhoto photo = testing::Render(BorderScene());
+  StagedRun found(photo.gray);
+  ASSERT_FALSE(found.Through("FindTipEnd"));
+  const std::vector<Eigen::Vector2d> line = found.state.trace;
+  ASSERT_GT(line.size(), 40u);
+
+  // A tip back along the line: the line ends there, the points beyond it are gone.
+  ExtractOptions back;
+  back.tip_px = line[line.size() - 30];
+  StagedRun cut(photo.gray, back);
+  ASSERT_FALSE(cut.Through("FindTipEnd"));
+  EXPECT_EQ(cut.state.trace.back(), *back.tip_px);
+  EXPECT_EQ(cut.state.summary.tip_px, *back.tip_px);
+  EXPECT_LT(cut.state.trace.size(), line.size() - 20);
+  EXPECT_FALSE(HasNote(cut.state.summary.warnings, "tip_end_unclear"));
+
+  // A tip beyond the end, on the line's continuation: the line is continued to it.
+  const Eigen::Vector2d end = line.back(), along = (line.back() - line[line.size() - 10]).normalized();
+  ExtractOptions ahead;
+  ahead.tip_px = end + 15.0 * along;
+  StagedRun longer(photo.gray, ahead);
+  ASSERT_FALSE(longer.Through("FindTipEnd"));
+  EXPECT_EQ(longer.state.trace.back(), *ahead.tip_px);
+
+  // A tip well off the line is a mistake, named.
+  ExtractOptions off;
+  off.tip_px = end + 40.0 * Eigen::Vector2d(along.y(), -along.x());
+  StagedRun refused(photo.gray, off);
+  try {
+    refused.Through("FindTipEnd");
+    ADD_FAILURE() << "a tip 40 px off the line was taken";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--tip-px"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ExtractStages, AnInferredTipNamesTipPxWithWhereItWasTaken) {
+  const SyntheticPhoto photo = testing::Render(BorderScene());
+  ExtractOptions unchecked;  // the physics check needs the profile, which comes later
+  unchecked.check_shape = false;
+  StagedRun run(photo.gray, unchecked);
+  ASSERT_FALSE(run.Through("FindTipEnd"));
+  run.state.summary.warnings.push_back({"tip_end_unclear", "as FindTipEnd writes it"});
+  run.state.summary.tip_px = Eigen::Vector2d(812.25, 640.5);
+  const ExtractionConfidence c = extract_internal::AssessConfidence(run.state);
+  EXPECT_EQ(c.tip, "inferred");
+  ASSERT_FALSE(c.guesses.empty());
+  EXPECT_NE(c.guesses.back().find("at 812.25,640.5 px"), std::string::npos) << c.guesses.back();
+  EXPECT_NE(c.guesses.back().find("--tip-px X,Y"), std::string::npos) << c.guesses.back();
+
+  ExtractOptions given = unchecked;
+  given.tip_px = run.state.trace.back();
+  StagedRun told(photo.gray, given);
+  ASSERT_FALSE(told.Through("FindTipEnd"));
+  EXPECT_EQ(extract_internal::AssessConfidence(told.state).tip, "given");
+}
+
 TEST(ExtractStages, CheckEdgeGivenRefusesAnEdgeFarFromTheStrip) {
   const SyntheticPhoto photo = testing::Render(BorderScene());
   ExtractOptions far;

@@ -8,11 +8,11 @@
 
 namespace textile::cli {
 
-Eigen::Vector2d ParseEdgePx(const std::string& text) {
+Eigen::Vector2d ParsePixelPoint(const std::string& text, const std::string& flag) {
   std::stringstream in(text);
   std::string a, b, rest;
   if (!std::getline(in, a, ',') || !std::getline(in, b, ',') || std::getline(in, rest)) {
-    throw InputError("--edge-px: expected X,Y in pixels, got '" + text + "'");
+    throw InputError(flag + ": expected X,Y in pixels, got '" + text + "'");
   }
   Eigen::Vector2d p;
   for (int k = 0; k < 2; ++k) {
@@ -20,7 +20,7 @@ Eigen::Vector2d ParseEdgePx(const std::string& text) {
     char* end = nullptr;
     p[k] = std::strtod(s.c_str(), &end);
     if (s.empty() || *end != '\0' || !std::isfinite(p[k])) {
-      throw InputError("--edge-px: '" + s + "' is not a number (expected X,Y in pixels)");
+      throw InputError(flag + ": '" + s + "' is not a number (expected X,Y in pixels)");
     }
   }
   return p;
@@ -42,7 +42,8 @@ PhotoInputOptions PhotoFlags::Options() const {
   e.rig = rig_type == "platform" ? RigKind::kPlatform
           : rig_type == "clamp"  ? RigKind::kClamp
                                  : RigKind::kAuto;
-  if (!edge.empty()) e.edge_px = ParseEdgePx(edge);
+  if (!edge.empty()) e.edge_px = ParsePixelPoint(edge, "--edge-px");
+  if (!tip.empty()) e.tip_px = ParsePixelPoint(tip, "--tip-px");
   if (level_option && level_option->count() > 0) e.level_deg = level_deg;
   e.step_mm = step_mm;
   e.accept_guesses = accept_guesses;
@@ -53,6 +54,7 @@ PhotoInputOptions PhotoFlags::Options() const {
   if (!e.Check(&why)) {
     const std::string flag = why.rfind("step", 0) == 0    ? "--step-mm"
                              : why.rfind("level", 0) == 0 ? "--level-deg"
+                             : why.rfind("tip", 0) == 0   ? "--tip-px"
                                                           : "--edge-px";
     throw InputError(flag + ": " + why.substr(why.find(' ') + 1));
   }
@@ -77,6 +79,9 @@ void AddPhotoFlags(CLI::App* sub, PhotoFlags* f) {
       "--level-deg", f->level_deg,
       "Horizontal = image rows turned by this angle [deg], counter-clockwise as seen (default: "
       "the platform's top face, else the rows)");
+  sub->add_option("--tip-px", f->tip,
+                  "Tip override X,Y [px]: the free end, as the overlay shows it (one photo only; "
+                  "a tip fading into the background)");
   sub->add_option("--trace", f->trace,
                   "Line to trace: mid (silhouette mid-line, default), upper or lower boundary "
                   "(oblique views: the lit near edge)")

@@ -22,7 +22,7 @@ namespace textile::cli {
 
 // The shared photo flags, as CLI11 binds them (raw strings; Options() validates them).
 struct PhotoFlags {
-  std::string rig_file, edge, trace = "mid", rig_type = "auto";
+  std::string rig_file, edge, tip, trace = "mid", rig_type = "auto";
   double mm_per_px = 0.0, level_deg = 0.0, step_mm = 0.5;
   bool progress = false, accept_guesses = false, no_shape_check = false;
   CLI::Option *rig_option = nullptr, *scale_option = nullptr, *level_option = nullptr;
@@ -31,12 +31,13 @@ struct PhotoFlags {
   PhotoInputOptions Options() const;
 };
 
-// Adds --rig, --mm-per-px, --trace, --rig-type, --edge-px, --level-deg, --step-mm,
+// Adds --rig, --mm-per-px, --trace, --rig-type, --edge-px, --tip-px, --level-deg, --step-mm,
 // --accept-guesses, --no-shape-check and --progress to a subcommand, bound to *flags (which must outlive the parse).
 void AddPhotoFlags(CLI::App* sub, PhotoFlags* flags);
 
-// "X,Y" in pixels (--edge-px); throws InputError.
-Eigen::Vector2d ParseEdgePx(const std::string& text);
+// "X,Y" in pixels (--edge-px, --tip-px: `flag` names it in the message); throws InputError.
+Eigen::Vector2d ParsePixelPoint(const std::string& text, const std::string& flag = "--edge-px");
+inline Eigen::Vector2d ParseEdgePx(const std::string& text) { return ParsePixelPoint(text); }
 
 }  // namespace textile::cli
 

@@ -1166,6 +1166,10 @@ bool ExtractOptions::Check(std::string* why) const {
     *why = "edge_px must be two finite numbers";
     return false;
   }
+  if (tip_px && !(std::isfinite(tip_px->x()) && std::isfinite(tip_px->y()))) {
+    *why = "tip_px must be two finite numbers";
+    return false;
+  }
   if (detect_side_px < 200 || detect_side_px > 8000) {
     *why = "detect_side_px must lie in [200, 8000]";
     return false;
@@ -1222,6 +1226,12 @@ void CheckExtractInputs(const cv::Mat& gray, const Rig& rig, const ExtractOption
                            options.edge_px->y() >= -0.5 && options.edge_px->y() <= H - 0.5)) {
     throw InputError("--edge-px " + Fmt(options.edge_px->x(), 1) + "," +
                      Fmt(options.edge_px->y(), 1) + " lies outside " + source + " (" +
+                     std::to_string(W) + "x" + std::to_string(H) + " px)");
+  }
+  if (options.tip_px && !(options.tip_px->x() >= -0.5 && options.tip_px->x() <= W - 0.5 &&
+                          options.tip_px->y() >= -0.5 && options.tip_px->y() <= H - 0.5)) {
+    throw InputError("--tip-px " + Fmt(options.tip_px->x(), 1) + "," +
+                     Fmt(options.tip_px->y(), 1) + " lies outside " + source + " (" +
                      std::to_string(W) + "x" + std::to_string(H) + " px)");
   }
   rig.CheckForImage(W, H, source);
@@ -1623,6 +1633,7 @@ StageFailure FindTipEnd(ExtractState* s) {
   const int k = std::min<int>(static_cast<int>(trace.size()) - 1,
                               std::max(10, static_cast<int>(2.0 * s->w_end)));
   const Vec2 tangent = (trace.back() - trace[trace.size() - 1 - k]).normalized();
+  if (s->options.tip_px) return TakeGivenTip(s, tangent);
   const Vec2 normal = s->direction * Vec2(tangent.y(), -tangent.x());
   const Vec2 centre = set.p[end_i] + mids.back() * set.n[end_i];
   TipStatus status;
@@ -1689,6 +1700,31 @@ double SagittaUpTo(const std::vector<Vec2>& line, double along) {
 }
 
 }  // namespace
+
+StageFailure TakeGivenTip(ExtractState* s, const Vec2& tangent) {
+  std::vector<Vec2>& trace = s->trace;
+  const Vec2 tip = *s->options.tip_px;
+  const Vec2 end = trace.back();
+  const double ahead = (tip - end).dot(tangent);
+  double arc = 0.0;
+  const double miss = ahead > 0.0 ? std::abs((tip - end).dot(Vec2(tangent.y(), -tangent.x())))
+                                  : DistanceToPolyline(tip, trace, &arc);
+  const double allowed = 2.0 * std::max(s->w_end, 2.0);
+  if (miss > allowed)
+    throw InputError("--tip-px " + Fmt(tip.x(), 1) + "," + Fmt(tip.y(), 1) + " lies " +
+                     Fmt(miss, 0) + " px off the strip's traced line (at most " +
+                     Fmt(allowed, 0) + " px; the line ends at " + Fmt(end.x(), 0) + "," +
+                     Fmt(end.y(), 0) + " px: see the overlay)");
+  if (ahead <= 0.0) {
+    // Cut the line at the point: drop what lies beyond its arc length.
+    std::vector<double> run(trace.size(), 0.0);
+    for (size_t i = 1; i < trace.size(); ++i) run[i] = run[i - 1] + (trace[i] - trace[i - 1]).norm();
+    while (trace.size() > 2 && run[trace.size() - 1] >= arc) trace.pop_back();
+  }
+  trace.push_back(tip);
+  s->summary.tip_px = tip;
+  return std::nullopt;
+}
 
 void CheckEdgeGiven(const ExtractState& s, std::vector<Note>* warnings) {
   if (!s.options.edge_px) return;

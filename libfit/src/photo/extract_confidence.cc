@@ -8,6 +8,7 @@
 
 #include "extract_internal.h"
 #include "textile/photo/extract.h"
+#include "textile/sim/core/number_text.h"
 
 namespace textile::extract_internal {
 namespace {
@@ -24,7 +25,7 @@ double SectionsMeasured(const ExtractState& s) {
 }
 
 // The guesses of a report, each with what settles it.
-std::vector<std::string> Guesses(const ExtractionConfidence& c) {
+std::vector<std::string> Guesses(const ExtractionConfidence& c, const Eigen::Vector2d& tip_px) {
   std::vector<std::string> guesses;
   if (c.held_end == "guessed")
     guesses.push_back(
@@ -33,7 +34,9 @@ std::vector<std::string> Guesses(const ExtractionConfidence& c) {
   if (c.tip == "inferred")
     guesses.push_back(
         "the tip was inferred (the strip's contrast does not fall off at its end: the last "
-        "measured section was taken; check the overlay's tip)");
+        "measured section was taken, at " +
+        NumberText(tip_px.x(), 5) + "," + NumberText(tip_px.y(), 5) +
+        " px; check the overlay, and --tip-px X,Y at the tip's end settles it)");
   if (c.shape && !c.shape->plausible)
     guesses.push_back(c.shape->message + " (--edge-px or --rig-type settles a wrong held end)");
   return guesses;
@@ -45,10 +48,12 @@ ExtractionConfidence AssessConfidence(const ExtractState& s) {
   ExtractionConfidence c;
   c.held_end = HeldEnd(s);
   c.held_end_how = s.summary.rig_detail;
-  c.tip = HasNote(s.summary.warnings, "tip_end_unclear") ? "inferred" : "found";
+  c.tip = s.options.tip_px ? "given"
+          : HasNote(s.summary.warnings, "tip_end_unclear") ? "inferred"
+                                                            : "found";
   c.sections_measured = SectionsMeasured(s);
   if (s.options.check_shape) c.shape = CheckCantileverShape(s.summary.profile);
-  c.guesses = Guesses(c);
+  c.guesses = Guesses(c, s.summary.tip_px);
   return c;
 }
 

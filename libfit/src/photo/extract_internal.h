@@ -255,6 +255,11 @@ void TraceMeasuredLine(ExtractState* s);
 // tip_end_unclear when it does not). Fails when the tip is cut off by, or too near, the border.
 StageFailure FindTipEnd(ExtractState* s);
 
+// With tip_px (FindTipEnd calls it): the line cut where it passes the given tip, or continued
+// straight to it along `tangent` (the line's direction at its end). Throws InputError when the
+// tip lies more than two strip widths off the line or its continuation.
+StageFailure TakeGivenTip(ExtractState* s, const Vec2& tangent);
+
 // With --edge-px: throws InputError if the edge lies far from the strip; warns
 // (edge_px_along_strip) if it lies well along a strip that already bends there.
 void CheckEdgeGiven(const ExtractState& s, std::vector<Note>* warnings);

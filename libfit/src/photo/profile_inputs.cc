@@ -40,6 +40,12 @@ bool HasImageExtension(const std::string& path) {
 
 bool IsPhotoPath(const std::string& path) { return HasImageMagic(path) || HasImageExtension(path); }
 
+void CheckTipForPhotos(const ExtractOptions& options, size_t photos) {
+  if (options.tip_px && photos > 1)
+    throw InputError("--tip-px names one photo's tip: give one photo with it (each photo's tip "
+                     "lies elsewhere)");
+}
+
 Rig RigFromOptions(const PhotoInputOptions& options, const std::string& what) {
   if (options.rig_path && options.mm_per_px) {
     throw InputError(what + ": give exactly one of --rig RIG.json and --mm-per-px S (both given)");
@@ -68,6 +74,8 @@ std::vector<LoadedProfile> LoadProfileInputs(const std::vector<std::string>& pat
           ": give each profile once (twice, its points would weigh double in the fit)");
     }
   }
+  CheckTipForPhotos(options.extract,
+                    static_cast<size_t>(std::count_if(paths.begin(), paths.end(), IsPhotoPath)));
   std::optional<Rig> rig;  // read once, at the first photo
   std::vector<LoadedProfile> loaded;
   for (const auto& path : paths) {

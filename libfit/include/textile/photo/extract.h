@@ -67,6 +67,12 @@ struct ExtractOptions {
   // Manual origin [px, full resolution]: the edge (platform) or where the strip leaves the
   // clamp. The profile then starts where the traced line crosses the vertical through it.
   std::optional<Eigen::Vector2d> edge_px;
+  // Manual tip [px, full resolution]: where the free end is, as the overlay shows the photo. It
+  // replaces the search for the end face (a thin tip fading into the background is inferred,
+  // and refused, without it): the traced line is cut where it passes the point, or continued
+  // straight to it. It must lie within two strip widths of the line or its continuation
+  // (else InputError). One photo's tip: a caller loading several photos refuses it.
+  std::optional<Eigen::Vector2d> tip_px;
   // Horizontal = image rows turned by this angle [deg], counter-clockwise as seen in the image
   // (a camera rolled clockwise by 1° needs +1). Default: rows (clamp), or the platform's top.
   std::optional<double> level_deg;
@@ -97,8 +103,8 @@ struct ExtractionConfidence {
   // "guessed" (nothing holds it in view: its higher end was taken).
   std::string held_end;
   std::string held_end_how;  // for people: the rig's detail ("edge at the platform's ...")
-  // "found" (the strip's contrast falls off at its end) or "inferred" (it does not: the last
-  // measured cross-section was taken as the tip).
+  // "found" (the strip's contrast falls off at its end), "given" (tip_px) or "inferred" (it
+  // does not fall off: the last measured cross-section was taken as the tip).
   std::string tip;
   // Cross-sections from the origin to the tip whose traced line was measured, 0..1.
   double sections_measured = 0.0;

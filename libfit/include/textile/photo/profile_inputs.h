@@ -49,6 +49,10 @@ struct LoadedProfile {
 // True if the file looks like a photo (magic bytes, or an image extension when unreadable).
 bool IsPhotoPath(const std::string& path);
 
+// A tip position (ExtractOptions::tip_px) belongs to one photo: InputError naming --tip-px when
+// it comes with more than one.
+void CheckTipForPhotos(const ExtractOptions& options, size_t photos);
+
 // The rig the options name; throws InputError when neither or both are given ("<what>: give
 // exactly one of --rig RIG.json and --mm-per-px S ..."), or when the rig file is not one.
 Rig RigFromOptions(const PhotoInputOptions& options, const std::string& what);

@@ -68,6 +68,11 @@ void Run(const BatchArgs& a) {
         std::cout << "failed: " << s.row->fabric << "/" << s.row->specimen << " (line "
                   << s.row->line << "): " << s.error << "\n";
     if (r.summary_written)
+      for (const nlohmann::json& f : r.summary["fabrics"])
+        if (f["material_note"].is_string())
+          std::cout << "note: fabric " << f["fabric"].get<std::string>()
+                    << " has no material: " << f["material_note"].get<std::string>() << "\n";
+    if (r.summary_written)
       std::cout << "wrote " << a.out << "/summary.csv, summary.json and a material per fabric\n";
     else
       std::cout << "shard " << a.shard << ": no summary; run the whole manifest with --resume "
@@ -90,7 +95,7 @@ void RegisterBatch(CLI::App& app) {
       "textile batch samples/series/manifest.csv -o series-out --jobs 2");
   sub->add_option("MANIFEST", a->manifest,
                   "CSV, one specimen a row: fabric, specimen, direction, side, inputs, gsm[, "
-                  "rig, mm_per_px, width_mm, notes]")
+                  "rig, mm_per_px, width_mm, notes, validate]")
       ->required();
   sub->add_option("-o,--out", a->out, "Output folder (made when missing)")->required();
   sub->add_option("--jobs", a->jobs, "Specimens fitted at once (default 1)");

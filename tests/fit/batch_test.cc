@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -127,7 +128,21 @@ TEST(BatchManifest, EachMistakeNamesItsLineAndColumn) {
                        "f,s,warp,face,a.csv,200,maybe\n")
                 .find("column validate: 'maybe'"),
             std::string::npos);
+  EXPECT_NE(ParseError(kHeader + "f,material.json,warp,face,a.csv,200\n").find("a file batch writes"),
+            std::string::npos);
+  EXPECT_NE(ParseError(kHeader + "summary.csv,s,warp,face,a.csv,200\n").find("a file batch writes"),
+            std::string::npos);
   EXPECT_EQ(ParseError(kHeader + "f,s,warp,face,a.csv,200\n"), "");
+}
+
+TEST(BatchManifest, SpreadsheetHabitsAreRead) {
+  // Blank lines before the header, rows of empty cells, values in capitals, CRLF line ends.
+  const Manifest m = ParseManifest("\r\n" + kHeader + ",,,,,\r\nf,s,Warp,FACE,a.csv,200\r\n\n",
+                                   "series.csv", "");
+  ASSERT_EQ(m.rows.size(), 1u);
+  EXPECT_EQ(m.rows[0].direction, StripDirection::kWarp);
+  EXPECT_EQ(m.rows[0].side, FabricSide::kFace);
+  EXPECT_EQ(m.rows[0].inputs[0], "a.csv");
 }
 
 TEST(BatchManifest, ReadingChecksThatEveryInputExists) {
@@ -140,6 +155,26 @@ TEST(BatchManifest, ReadingChecksThatEveryInputExists) {
     EXPECT_NE(std::string(e.what()).find("line 2, column inputs: gone.csv does not exist"),
               std::string::npos)
         << e.what();
+  }
+}
+
+TEST(BatchManifest, ReadingChecksThatAPhotoHasARigOrScaleAndInputsAreFiles) {
+  const fs::path dir = Scratch("photo_without_rig");
+  const std::string photo = std::string(TEXTILE_SOURCE_DIR) + "/samples/photos/pabst-fig8_L040mm.jpg";
+  std::ofstream(dir / "m.csv") << kHeader << "f,s,warp,face," << photo << ",200\n";
+  try {
+    ReadManifest((dir / "m.csv").string());
+    FAIL() << "a photo without a rig was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 2, column rig"), std::string::npos) << e.what();
+  }
+  fs::create_directories(dir / "folder");
+  std::ofstream(dir / "f.csv") << kHeader << "f,s,warp,face,folder,200\n";
+  try {
+    ReadManifest((dir / "f.csv").string());
+    FAIL() << "a folder was taken as an input";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a folder"), std::string::npos) << e.what();
   }
 }
 
@@ -197,6 +232,8 @@ TEST(Batch, AFailingSpecimenIsListedAndTheOthersAreSummarised) {
   EXPECT_NEAR(fabric["overall_rigidity_uNm"].get<double>(), std::sqrt(g_warp * g_weft), 1e-12);
   EXPECT_TRUE(r.summary["fabrics"][1]["overall_rigidity_uNm"].is_null());
   EXPECT_EQ(r.summary["specimens"][4]["status"], "failed");
+  EXPECT_EQ(r.summary["fabrics"][1]["material_note"], "no specimen of it was fitted");
+  EXPECT_TRUE(r.summary["fabrics"][0]["material_note"].is_null());
 
   // The fabric's material: warp and weft means, readable as any material file.
   const Material fig8 = ReadMaterial((dir / "out/fig8/material.json").string());
@@ -208,6 +245,12 @@ TEST(Batch, AFailingSpecimenIsListedAndTheOthersAreSummarised) {
   const std::string csv = ReadAll(dir / "out/summary.csv");
   EXPECT_EQ(csv.rfind("fabric,direction,n,n_failed,b1_mean_gfcm,b1_sd_gfcm,b1_cv,b1_n,", 0), 0u);
   EXPECT_NE(csv.find("\nbad,bias,0,1,"), std::string::npos) << csv;
+  // No column name twice (a spreadsheet or pandas would rename or drop one).
+  std::vector<std::string> columns;
+  std::stringstream header(csv.substr(0, csv.find('\n')));
+  for (std::string c; std::getline(header, c, ',');) columns.push_back(c);
+  std::sort(columns.begin(), columns.end());
+  EXPECT_EQ(std::adjacent_find(columns.begin(), columns.end()), columns.end());
 }
 
 TEST(Batch, FreshResumedAndMergedShardsAreTheSameBytes) {
@@ -257,6 +300,32 @@ TEST(Batch, AChangedInputIsFittedAgainOnResume) {
   EXPECT_EQ(RunBatch(heavier, o).specimens[0].status, SpecimenStatus::kFitted);
 }
 
+TEST(Batch, ARerunLeavesNoStaleOverlayAndAShardRemovesTheOldSummary) {
+  const fs::path dir = Scratch("stale");
+  const std::string photos = std::string(TEXTILE_SOURCE_DIR) + "/samples/photos/";
+  const std::string header = "fabric,specimen,direction,side,inputs,gsm,rig\n";
+  const Manifest by_photo = ParseManifest(
+      header + "f,a," + "warp,face," + photos + "pabst-fig8_L060mm.jpg,200," + photos +
+          "pabst-fig8.rig-truth.json\n",
+      "m.csv", "");
+  BatchOptions o;
+  o.out_dir = (dir / "out").string();
+  ASSERT_EQ(RunBatch(by_photo, o).failed, 0);
+  ASSERT_TRUE(fs::exists(dir / "out/f/a/pabst-fig8_L060mm.overlay.png"));
+  // The same specimen now from a profile: the photo's overlay goes with the photo.
+  const Manifest by_profile =
+      ParseManifest(header + "f,a,warp,face," + Fig8("60") + ",200,\n", "m.csv", "");
+  ASSERT_EQ(RunBatch(by_profile, o).failed, 0);
+  EXPECT_FALSE(fs::exists(dir / "out/f/a/pabst-fig8_L060mm.overlay.png"));
+  ASSERT_TRUE(fs::exists(dir / "out/summary.json"));
+  // A shard's run: the whole run's summary and fabric material no longer describe the folder.
+  o.shard = ParseShard("1/2");
+  RunBatch(by_profile, o);
+  EXPECT_FALSE(fs::exists(dir / "out/summary.json"));
+  EXPECT_FALSE(fs::exists(dir / "out/summary.csv"));
+  EXPECT_FALSE(fs::exists(dir / "out/f/material.json"));
+}
+
 TEST(Batch, OptionsAndAnUnusableFolderAreRefusedBeforeAnySpecimen) {
   const fs::path dir = Scratch("options");
   const Manifest m = SmallSeries(dir);
@@ -286,7 +355,9 @@ TEST(BatchSummary, AFabricWithOneDirectionIsIsotropicAndSaysSo) {
   EXPECT_NE(notes.find("only the weft direction"), std::string::npos) << notes;
   EXPECT_NE(notes.find("bias"), std::string::npos) << notes;
   EXPECT_NE(notes.find("200 .. 220"), std::string::npos) << notes;
-  EXPECT_FALSE(FabricMaterial("other", outcomes).has_value());
+  std::string why;
+  EXPECT_FALSE(FabricMaterial("other", outcomes, &why).has_value());
+  EXPECT_EQ(why, "no specimen of it was fitted");
 }
 
 TEST(BatchSummary, AConstantItsFitDidNotDetermineStaysOutOfTheMean) {

@@ -283,7 +283,8 @@ TEST(ExtractStages, AGivenTipCutsTheLineOrContinuesItAndAFarOneIsRefused) {
   EXPECT_FALSE(HasNote(cut.state.summary.warnings, "tip_end_unclear"));
 
   // A tip beyond the end, on the line's continuation: the line is continued to it.
-  const Eigen::Vector2d end = line.back(), along = (line.back() - line[line.size() - 10]).normalized();
+  const Eigen::Vector2d& end = line.back();
+  const Eigen::Vector2d along = (end - line[line.size() - 10]).normalized();
   ExtractOptions ahead;
   ahead.tip_px = end + 15.0 * along;
   StagedRun longer(photo.gray, ahead);

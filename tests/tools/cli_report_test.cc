@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -55,6 +56,17 @@ std::string Browser() {
   return "";
 }
 
+// Renders `page` in `browser` headless: the DOM after load into dom, the console into log; the
+// browser's exit code.
+int Render(const std::string& browser, const fs::path& page, const fs::path& dom,
+           const fs::path& log) {
+  const std::string cmd = "timeout 120 '" + browser +
+                          "' --no-sandbox --disable-gpu --enable-logging=stderr --v=0 "
+                          "--virtual-time-budget=5000 --dump-dom 'file://" + page.string() +
+                          "' > '" + dom.string() + "' 2> '" + log.string() + "'";
+  return std::system(cmd.c_str());
+}
+
 // The shipped series batched and reported into a scratch folder of the test's own (ctest runs
 // tests in parallel processes).
 fs::path BatchAndReport(const std::string& name) {
@@ -101,18 +113,30 @@ TEST(CliReport, HeadlessChromiumRendersItWithoutAConsoleMessage) {
   if (browser.empty()) GTEST_SKIP() << "no headless Chromium (Debian: chromium-headless-shell)";
   const fs::path dir = BatchAndReport("cli_report_browser");
   const fs::path dom = dir / "dom.html", log = dir / "browser.log";
-  const std::string cmd = "timeout 120 '" + browser +
-                          "' --no-sandbox --disable-gpu --enable-logging=stderr --v=0 "
-                          "--virtual-time-budget=5000 --dump-dom 'file://" +
-                          (dir / "report.html").string() + "' > '" + dom.string() + "' 2> '" +
-                          log.string() + "'";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << ReadAll(log);
+  ASSERT_EQ(Render(browser, dir / "report.html", dom, log), 0) << ReadAll(log);
   const std::string rendered = ReadAll(dom);
   EXPECT_NE(rendered.find("data-selfcheck=\"ok\""), std::string::npos)
       << "a thumbnail or chart failed: " << ReadAll(log);
   EXPECT_EQ(ReadAll(log).find(":CONSOLE"), std::string::npos) << ReadAll(log);
   // The rendered page carries the same numbers as the file.
   EXPECT_EQ(NumberCells(rendered), NumberCells(ReadAll(dir / "report.html")));
+}
+
+TEST(CliReport, HeadlessChromiumCatchesABrokenThumbnail) {
+  // The check above could pass by never looking: a page with one thumbnail broken must fail it.
+  const std::string browser = Browser();
+  if (browser.empty()) GTEST_SKIP() << "no headless Chromium (Debian: chromium-headless-shell)";
+  const fs::path dir = BatchAndReport("cli_report_tampered");
+  std::string html = ReadAll(dir / "report.html");
+  const std::string jpeg = "data:image/jpeg;base64,";
+  const size_t at = html.find(jpeg);
+  ASSERT_NE(at, std::string::npos);
+  html.replace(at + jpeg.size(), 8, "AAAAAAAA");
+  std::ofstream(dir / "tampered.html") << html;
+  const fs::path dom = dir / "dom.html", log = dir / "browser.log";
+  ASSERT_EQ(Render(browser, dir / "tampered.html", dom, log), 0) << ReadAll(log);
+  EXPECT_NE(ReadAll(dom).find("data-selfcheck=\"failed\""), std::string::npos);
+  EXPECT_NE(ReadAll(log).find("thumbnail did not decode"), std::string::npos) << ReadAll(log);
 }
 
 TEST(CliReportRefusals, AFolderWithoutABatchSummaryIsRefused) {

@@ -7,6 +7,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "run_cli.h"
@@ -45,6 +46,28 @@ TEST(Workflow, SnakemakeRunsOneJobASpecimenThenTheSummaryAndReport) {
   EXPECT_TRUE(fs::exists(d / "out/report.html"));
   // Every specimen was its own job: the summary job resumed them all.
   EXPECT_TRUE(fs::exists(d / "out/interlining/photo-1/specimen.json"));
+}
+
+TEST(Workflow, SnakemakeRefitsAChangedInputAndReadsHeadersAsTextileDoes) {
+  if (!fs::exists("/usr/bin/snakemake")) GTEST_SKIP() << "no snakemake (Debian: snakemake)";
+  const fs::path d = Scratch("workflow_snakemake_changed");
+  const fs::path profiles = fs::path(kSource) / "samples/profiles";
+  fs::copy_file(profiles / "pabst-fig8_L060mm.profile.csv", d / "a.csv");
+  fs::copy_file(profiles / "pabst-fig8_L080mm.profile.csv", d / "b.csv");
+  // Header names in capitals, as a spreadsheet may write them: textile takes them, so must the
+  // workflow.
+  std::ofstream(d / "m.csv") << "Fabric,Specimen,Direction,Side,Inputs,GSM\n"
+                             << "f,a,warp,face,a.csv,200\nf,b,weft,face,b.csv,200\n";
+  const std::string cmd = "snakemake -s '" + kSource + "/workflow/Snakefile' --cores 1 -q " +
+                          "--directory '" + d.string() + "' --config manifest='" +
+                          (d / "m.csv").string() + "' out='" + (d / "out").string() +
+                          "' textile='" + TEXTILE_EXE + "'";
+  ASSERT_EQ(Shell(cmd, d / "log"), 0) << ReadAll(d / "log");
+  const std::string before = ReadAll(d / "out/summary.json");
+  fs::copy_file(profiles / "pabst-fig8_L040mm.profile.csv", d / "a.csv",
+                fs::copy_options::overwrite_existing);
+  ASSERT_EQ(Shell(cmd, d / "log2"), 0) << ReadAll(d / "log2");
+  EXPECT_NE(ReadAll(d / "out/summary.json"), before) << "the changed profile was not refitted";
 }
 
 TEST(Workflow, GnuParallelRecipeLogsItsJobsAndResumes) {

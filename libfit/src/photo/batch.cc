@@ -111,12 +111,27 @@ std::optional<Material> ReadCompleteSpecimen(const fs::path& dir, const std::str
   }
 }
 
+// An earlier run's overlays (a photo since replaced by a profile) and temporary files left by
+// a killed run: none may outlive the run that writes the folder anew.
+void RemoveStaleFiles(const fs::path& dir) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return;
+  std::vector<fs::path> stale;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.ends_with(".overlay.png") || name.find(".partial-") != std::string::npos)
+      stale.push_back(e.path());
+  }
+  for (const fs::path& p : stale) fs::remove(p, ec);
+}
+
 // The folder of one specimen: material.json (when fitted), then specimen.json. A failed
 // specimen's stale material is removed, so that its folder never shows an old fit.
 void WriteSpecimen(const std::string& out_dir, const SpecimenOutcome& o) {
   const fs::path dir = SpecimenDir(out_dir, *o.row);
   std::error_code ec;
   fs::remove(dir / kSpecimenRecord, ec);
+  RemoveStaleFiles(dir);
   if (o.material) {
     WriteAtomically(dir / kSpecimenMaterial, MaterialToJson(*o.material).dump(2) + "\n");
   } else {
@@ -147,7 +162,14 @@ SpecimenOutcome ResumeOrFit(const ManifestRow& row, const BatchOptions& options)
   try {
     hash = SpecimenInputHash(row);
   } catch (const InputError& e) {
-    return Failed(row, e.what(), 2);
+    // The folder must not keep an earlier fit of inputs that can no longer be read.
+    SpecimenOutcome failed = Failed(row, e.what(), 2);
+    try {
+      WriteSpecimen(options.out_dir, failed);
+    } catch (const InputError&) {
+      // the folder cannot be written either: the outcome says why the specimen failed
+    }
+    return failed;
   }
   const fs::path dir = SpecimenDir(options.out_dir, row);
   if (options.resume) {
@@ -199,6 +221,16 @@ void RunParallel(const std::vector<size_t>& todo, int jobs,
   for (int t = 1; t < n; ++t) threads.emplace_back(worker);
   worker();
   for (std::thread& t : threads) t.join();
+}
+
+// A shard's run: an earlier whole run's summary and fabric materials no longer describe the
+// folder, and the report must not take them (it refuses a folder without summary.json).
+void RemoveSummary(const std::string& out_dir, const Manifest& manifest) {
+  std::error_code ec;
+  fs::remove(fs::path(out_dir) / "summary.json", ec);
+  fs::remove(fs::path(out_dir) / "summary.csv", ec);
+  for (const ManifestRow& row : manifest.rows)
+    fs::remove(fs::path(out_dir) / row.fabric / "material.json", ec);
 }
 
 void WriteSummary(const std::string& out_dir, BatchResult* r) {
@@ -281,6 +313,9 @@ SpecimenOutcome FitSpecimen(const ManifestRow& row) {
       p["photo"] = row.inputs[i];
       photos.push_back(p);
       o.overlays.push_back(OverlayPng(loaded[i], row.inputs[i]));
+      for (size_t k = 0; k + 1 < o.overlays.size(); ++k)
+        if (o.overlays[k].first == o.overlays.back().first)  // L40.jpg and L40.png, a/ and b/
+          o.overlays.back().first = std::to_string(i + 1) + "-" + o.overlays.back().first;
     }
     FitMaterialOptions fit;
     fit.areal_density = units::GsmToSi(row.gsm);
@@ -325,7 +360,11 @@ BatchResult RunBatch(const Manifest& manifest, const BatchOptions& options) {
     if (options.on_progress) options.on_progress({done, todo.size(), &r.specimens[i]});
   });
   for (const SpecimenOutcome& o : r.specimens) r.failed += o.status == SpecimenStatus::kFailed;
-  if (options.shard.count == 1) WriteSummary(options.out_dir, &r);
+  if (options.shard.count == 1) {
+    WriteSummary(options.out_dir, &r);
+  } else {
+    RemoveSummary(options.out_dir, manifest);
+  }
   return r;
 }
 

@@ -13,6 +13,7 @@
 
 #include "csv_text.h"
 #include "textile/photo/batch.h"
+#include "textile/photo/profile_inputs.h"
 #include "textile/sim/core/error.h"
 #include "textile/sim/core/number_text.h"
 
@@ -37,6 +38,12 @@ const char* SideName(FabricSide s) { return s == FabricSide::kFace ? "face" : "b
 namespace {
 
 namespace fs = std::filesystem;
+
+std::string Lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
 
 // Where a cell sits, for messages: "series.csv line 4, column gsm".
 struct CellPlace {
@@ -85,7 +92,8 @@ std::vector<std::string> SplitCsvRecord(const std::string& line, const std::stri
 
 // The header's columns -> their index. Unknown, duplicate and missing columns are refused.
 std::map<std::string, size_t> ColumnIndex(const std::vector<std::string>& header,
-                                          const std::string& source) {
+                                          const std::string& source, int line) {
+  const std::string where = source + " line " + std::to_string(line);
   std::map<std::string, size_t> index;
   for (size_t i = 0; i < header.size(); ++i) {
     std::string name = header[i];
@@ -95,22 +103,24 @@ std::map<std::string, size_t> ColumnIndex(const std::vector<std::string>& header
       return std::find(list.begin(), list.end(), name) != list.end();
     };
     if (header.size() == 1 && name.find(';') != std::string::npos)
-      throw InputError(source + " line 1: one column '" + header[i] +
+      throw InputError(where + ": one column '" + header[i] +
                        "': the manifest is comma-separated (save it as CSV with ',')");
     if (!known(kManifestRequiredColumns) && !known(kManifestOptionalColumns))
-      throw InputError(source + " line 1: unknown column '" + header[i] +
+      throw InputError(where + ": unknown column '" + header[i] +
                        "' (columns: fabric, specimen, direction, side, inputs, gsm, rig, "
                        "mm_per_px, width_mm, notes, validate)");
     if (!index.emplace(name, i).second)
-      throw InputError(source + " line 1: column '" + name + "' is given twice");
+      throw InputError(where + ": column '" + name + "' is given twice");
   }
   for (const std::string& c : kManifestRequiredColumns)
-    if (!index.contains(c)) throw InputError(source + " line 1: missing column '" + c + "'");
+    if (!index.contains(c)) throw InputError(where + ": missing column '" + c + "'");
   return index;
 }
 
-// A name that can be a folder: [A-Za-z0-9._+-], not empty, not starting with '.'.
-std::string PathSafeName(const std::string& cell, const CellPlace& at) {
+// A name that can be a folder: [A-Za-z0-9._+-], not empty, not starting with '.', and none of
+// `reserved` (the files batch writes beside the folder).
+std::string PathSafeName(const std::string& cell, const CellPlace& at,
+                         const std::vector<std::string>& reserved) {
   if (cell.empty()) Fail(at, "empty");
   const bool safe = std::all_of(cell.begin(), cell.end(), [](unsigned char c) {
     return std::isalnum(c) || c == '.' || c == '_' || c == '-' || c == '+';
@@ -118,6 +128,8 @@ std::string PathSafeName(const std::string& cell, const CellPlace& at) {
   if (!safe || cell.front() == '.')
     Fail(at, "'" + cell + "' cannot name a folder (use letters, digits, '.', '_', '-', '+'; "
                           "not starting with '.')");
+  if (std::find(reserved.begin(), reserved.end(), cell) != reserved.end())
+    Fail(at, "'" + cell + "' is the name of a file batch writes there; choose another");
   return cell;
 }
 
@@ -194,10 +206,10 @@ ManifestRow ParseRow(const std::vector<std::string>& cells,
                     scale = "mm_per_px", width = "width_mm";
   ManifestRow r;
   r.line = line;
-  r.fabric = PathSafeName(cell(fabric), at(fabric));
-  r.specimen = PathSafeName(cell(specimen), at(specimen));
-  r.direction = DirectionCell(cell(direction), at(direction));
-  r.side = SideCell(cell(side), at(side));
+  r.fabric = PathSafeName(cell(fabric), at(fabric), {"summary.json", "summary.csv", "report.html"});
+  r.specimen = PathSafeName(cell(specimen), at(specimen), {"material.json"});
+  r.direction = DirectionCell(Lower(cell(direction)), at(direction));
+  r.side = SideCell(Lower(cell(side)), at(side));
   r.inputs = InputsCell(cell(inputs), at(inputs));
   for (const std::string& in : r.inputs) r.paths.push_back(Resolve(in, base_dir));
   r.gsm = PositiveInRange(cell(gsm), at(gsm), "g/m²", 1.0, 1e4);
@@ -208,7 +220,7 @@ ManifestRow ParseRow(const std::vector<std::string>& cells,
     Fail(at(scale), "give a rig or a scale, not both (the rig already maps pixels to mm)");
   if (!cell(width).empty()) r.width_mm = PositiveInRange(cell(width), at(width), "mm", 1.0, 1000.0);
   r.notes = cell("notes");
-  r.validate = ValidateCell(cell("validate"), at("validate"));
+  r.validate = ValidateCell(Lower(cell("validate")), at("validate"));
   return r;
 }
 
@@ -235,11 +247,12 @@ Manifest ParseManifest(const std::string& raw, const std::string& source,
     const std::string where = source + " line " + std::to_string(number);
     const std::vector<std::string> cells = SplitCsvRecord(line, where);
     if (index.empty()) {
-      if (number != 1) throw InputError(where + ": the header must be the first line");
-      index = ColumnIndex(cells, source);
+      index = ColumnIndex(cells, source, number);
       columns = cells.size();
       continue;
     }
+    if (std::all_of(cells.begin(), cells.end(), [](const std::string& c) { return c.empty(); }))
+      continue;  // a spreadsheet's empty row, all commas
     if (cells.size() != columns)
       throw InputError(where + ": " + std::to_string(cells.size()) + " cells for " +
                        std::to_string(columns) + " columns");
@@ -261,11 +274,18 @@ Manifest ReadManifest(const std::string& path) {
   text << in.rdbuf();
   Manifest m = ParseManifest(text.str(), path, fs::path(path).parent_path().string());
   for (const ManifestRow& r : m.rows) {
+    const std::string at = path + " line " + std::to_string(r.line) + ", column ";
     for (size_t i = 0; i < r.paths.size(); ++i) {
       std::error_code ec;
+      if (fs::is_directory(r.paths[i], ec))
+        throw InputError(at + "inputs: " + r.inputs[i] + " is a folder, not a photo or profile");
       if (!fs::is_regular_file(r.paths[i], ec))
-        throw InputError(path + " line " + std::to_string(r.line) + ", column inputs: " +
-                         r.inputs[i] + " does not exist (inputs are relative to the manifest)");
+        throw InputError(at + "inputs: " + r.inputs[i] +
+                         " does not exist (inputs are relative to the manifest)");
+      if (r.rig.empty() && !r.mm_per_px && IsPhotoPath(r.paths[i]))
+        throw InputError(at + "rig: " + r.inputs[i] +
+                         " is a photo: give its rig file (column rig) or its scale (column "
+                         "mm_per_px)");
     }
     std::error_code ec;
     if (!r.rig_path.empty() && !fs::is_regular_file(r.rig_path, ec))

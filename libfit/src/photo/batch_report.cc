@@ -83,6 +83,57 @@ std::string PercentCell(const json& v, const std::string& key) {
          NumberText(100.0 * v.get<double>(), 3) + " %</td>";
 }
 
+// The shape the page reads (batch.h, SummaryJson), checked before any of it is read: a field
+// missing or of another type throws (std::runtime_error, made an InputError by ReadSummary).
+void CheckSummaryShape(const json& s) {
+  const auto need = [](const json& o, const char* key, bool (json::*is)() const, bool null_ok,
+                       const std::string& where) {
+    if (!o.is_object() || !o.contains(key) || !((o[key].*is)() || (null_ok && o[key].is_null())))
+      throw std::runtime_error(where + ": '" + key + "' missing or of the wrong type");
+  };
+  const auto name = [](const json& o, const char* key, const std::string& where) {
+    const std::string v = o[key].get<std::string>();
+    if (v.empty() || v.front() == '.' || v.find('/') != std::string::npos ||
+        v.find('\\') != std::string::npos)
+      throw std::runtime_error(where + ": '" + key + "' is no folder name");
+  };
+  for (const char* k : {"directions", "fabrics", "specimens"})
+    need(s, k, &json::is_array, false, "summary");
+  for (const json& d : s["directions"]) {
+    for (const char* k : {"fabric", "direction"}) need(d, k, &json::is_string, false, "direction");
+    for (const char* k : {"n", "n_failed"}) need(d, k, &json::is_number, false, "direction");
+    for (const char* q : {"b1_gfcm", "b2_gfcm", "c1_gfcm2", "bending_length_mm",
+                          "flexural_rigidity_uNm", "flexural_rigidity_mgcm"}) {
+      need(d, q, &json::is_object, false, "direction");
+      need(d[q], "n", &json::is_number, false, q);
+      for (const char* k : {"mean", "sd", "cv"}) need(d[q], k, &json::is_number, true, q);
+    }
+  }
+  for (const json& f : s["fabrics"]) {
+    need(f, "fabric", &json::is_string, false, "fabric");
+    name(f, "fabric", "fabric");
+    for (const char* k : {"overall_rigidity_uNm", "overall_rigidity_mgcm"})
+      need(f, k, &json::is_number, true, "fabric");
+  }
+  for (const json& sp : s["specimens"]) {
+    for (const char* k : {"fabric", "specimen", "direction", "side", "status"})
+      need(sp, k, &json::is_string, false, "specimen");
+    name(sp, "fabric", "specimen");
+    name(sp, "specimen", "specimen");
+    for (const char* k : {"b1_gfcm", "b2_gfcm", "c1_gfcm2", "bending_length_mm",
+                          "flexural_rigidity_uNm", "rms_mm"})
+      need(sp, k, &json::is_number, true, "specimen");
+    need(sp, "error", &json::is_string, true, "specimen");
+    need(sp, "validation", &json::is_object, true, "specimen");
+    if (sp["validation"].is_object()) {
+      for (const char* k : {"goodness_of_fit", "held_out"})
+        need(sp["validation"], k, &json::is_string, false, "validation");
+      need(sp["validation"], "pass", &json::is_boolean, false, "validation");
+      need(sp["validation"], "reason", &json::is_string, true, "validation");
+    }
+  }
+}
+
 json ReadSummary(const std::string& dir) {
   const fs::path p = fs::path(dir) / "summary.json";
   std::error_code ec;
@@ -90,10 +141,9 @@ json ReadSummary(const std::string& dir) {
     throw InputError(dir + ": no summary.json (run textile batch into it first)");
   try {
     json s = json::parse(ReadText(p));
-    for (const char* k : {"directions", "fabrics", "specimens"})
-      if (!s.contains(k) || !s[k].is_array()) throw InputError(std::string("no '") + k + "' list");
+    CheckSummaryShape(s);
     return s;
-  } catch (const std::exception& e) {
+  } catch (const std::exception& e) {  // JSON syntax, a missing field, a wrong type
     throw InputError(p.string() + ": not a batch summary (" + e.what() + ")");
   }
 }
@@ -166,6 +216,7 @@ std::string StatisticsSection(const json& s) {
 struct Curve {
   std::string direction;
   BendingLaw law;
+  bool determined = true;  // its fit determined every constant (else drawn dashed)
 };
 
 const char* DirectionColour(const std::string& d) {
@@ -191,8 +242,10 @@ double KappaRange(const std::string& dir, const json& s, const std::string& fabr
 std::string CurvesSvg(const std::string& fabric, const std::vector<Curve>& curves, double kmax) {
   constexpr int kW = 560, kH = 340, kL = 60, kR = 20, kT = 20, kB = 45, kSamples = 60;
   std::map<std::string, std::vector<std::vector<double>>> by;  // direction -> curves' M
+  std::map<std::string, std::vector<bool>> determined;          // direction -> each curve's
   double mmax = 0.0;
   for (const Curve& c : curves) {
+    determined[c.direction].push_back(c.determined);
     std::vector<double> m;
     for (int i = 0; i <= kSamples; ++i) {
       const double k = kmax * i / kSamples;
@@ -240,8 +293,10 @@ std::string CurvesSvg(const std::string& fabric, const std::vector<Curve>& curve
         svg << X(kmax * i / kSamples) << "," << Y(mean[i] - sd[i]) << " ";
       svg << "\"/>\n";
     }
-    for (const auto& m : ms) {
+    for (size_t c = 0; c < ms.size(); ++c) {
+      const std::vector<double>& m = ms[c];
       svg << "<polyline fill=\"none\" stroke=\"" << colour << "\" stroke-width=\"0.8\" "
+          << (determined[direction][c] ? "" : "stroke-dasharray=\"4 3\" ")
           << "stroke-opacity=\"0.6\" points=\"";
       for (int i = 0; i <= kSamples; ++i) svg << X(kmax * i / kSamples) << "," << Y(m[i]) << " ";
       svg << "\"/>\n";
@@ -257,15 +312,19 @@ std::string CurvesSvg(const std::string& fabric, const std::vector<Curve>& curve
 
 std::string CurvesSection(const std::string& dir, const json& s) {
   std::ostringstream h;
-  h << "<h2>Moment-curvature curves</h2>\n<p>Thin lines: each fitted specimen's M(κ) over the "
-       "curvatures its data reached; thick: their mean; band: ± 1 sample sd.</p>\n";
+  h << "<h2>Moment-curvature curves</h2>\n<p>Thin lines: each fitted specimen's M(κ), dashed "
+       "where its fit left a constant undetermined (such a constant stays out of the statistics "
+       "above); thick: their mean; band: ± 1 sample sd of M. Up to the largest curvature any "
+       "specimen's data of the fabric reached.</p>\n";
   for (const json& f : s["fabrics"]) {
     const std::string fabric = f["fabric"];
     std::vector<Curve> curves;
     for (const json& sp : s["specimens"]) {
       if (sp["fabric"] != fabric || sp["status"] != "fitted" || sp["b1_gfcm"].is_null()) continue;
-      curves.push_back({sp["direction"], BendingLaw::FromKes(sp["b1_gfcm"], sp["b2_gfcm"],
-                                                             sp["c1_gfcm2"])});
+      const bool determined = !sp.contains("unobserved") || sp["unobserved"].empty();
+      curves.push_back({sp["direction"],
+                        BendingLaw::FromKes(sp["b1_gfcm"], sp["b2_gfcm"], sp["c1_gfcm2"]),
+                        determined});
     }
     h << "<h3>" << Escape(fabric) << "</h3>\n";
     if (curves.empty()) {

@@ -27,6 +27,9 @@ struct Quantity {
   const char* unit;  // "gfcm"
   std::optional<double> (*value)(const Material&);
   bool law_constant = false;
+  // The same quantity in another unit as the one before: its CV and n are that one's, and the
+  // CSV does not repeat them (two columns of one name).
+  bool another_unit = false;
 };
 
 std::optional<double> FitNumber(const Material& m, const char* key) {
@@ -54,7 +57,7 @@ const std::vector<Quantity>& Quantities() {
       {"flexural_rigidity", "uNm",
        [](const Material& m) { return FitNumber(m, "flexural_rigidity_uNm"); }},
       {"flexural_rigidity", "mgcm",
-       [](const Material& m) { return FitNumber(m, "flexural_rigidity_mgcm"); }}};
+       [](const Material& m) { return FitNumber(m, "flexural_rigidity_mgcm"); }, false, true}};
   return q;
 }
 
@@ -147,6 +150,10 @@ json SpecimenJson(const SpecimenOutcome& o) {
   for (const Quantity& q : Quantities())
     j[Key(q)] = o.material ? OrNull(q.value(*o.material)) : json();
   j["rms_mm"] = o.material ? OrNull(FitNumber(*o.material, "rms_mm")) : json();
+  json unobserved = json::array();
+  for (const char* c : {"b1", "b2", "c1"})
+    if (o.material && !Observed(*o.material, c)) unobserved.push_back(c);
+  j["unobserved"] = unobserved;
   j["validation"] = o.validation;
   return j;
 }
@@ -205,7 +212,8 @@ SeriesStats Stats(const std::vector<double>& values) {
 }
 
 std::optional<Material> FabricMaterial(const std::string& fabric,
-                                       const std::vector<SpecimenOutcome>& specimens) {
+                                       const std::vector<SpecimenOutcome>& specimens,
+                                       std::string* why) {
   std::map<StripDirection, std::vector<const SpecimenOutcome*>> by;
   double gsm = 0.0, gsm_min = 1e300, gsm_max = 0.0;
   size_t n = 0;
@@ -218,7 +226,10 @@ std::optional<Material> FabricMaterial(const std::string& fabric,
       ++n;
     }
   }
-  if (n == 0) return std::nullopt;
+  if (n == 0) {
+    if (why) *why = "no specimen of it was fitted";
+    return std::nullopt;
+  }
   const bool warp = !by[StripDirection::kWarp].empty(), weft = !by[StripDirection::kWeft].empty();
   const StripDirection main = warp   ? StripDirection::kWarp
                               : weft ? StripDirection::kWeft
@@ -249,7 +260,12 @@ std::optional<Material> FabricMaterial(const std::string& fabric,
   }
   m.fit = {{"method", "batch mean"}, {"directions", directions}};
   if (!notes.empty()) m.extra["notes"] = notes;
-  if (std::string why; !m.Check(&why)) return std::nullopt;
+  if (std::string problem; !m.Check(&problem)) {
+    if (why)
+      *why = "the direction means make no valid law (" + problem +
+             "): the specimens disagree too much to average; see each specimen's fit";
+    return std::nullopt;
+  }
   return m;
 }
 
@@ -261,8 +277,10 @@ json SummaryJson(const std::vector<SpecimenOutcome>& specimens) {
       for (const SpecimenOutcome& o : specimens) listed |= o.row->fabric == fabric && o.row->direction == d;
       if (listed) directions.push_back(DirectionJson(specimens, fabric, d));
     }
-    const std::optional<Material> m = FabricMaterial(fabric, specimens);
+    std::string why;
+    const std::optional<Material> m = FabricMaterial(fabric, specimens, &why);
     fabrics.push_back({{"fabric", fabric},
+                       {"material_note", m ? json() : json(why)},
                        {"overall_rigidity_uNm",
                         OverallRigidity(directions, fabric, "flexural_rigidity_uNm")},
                        {"overall_rigidity_mgcm",
@@ -277,16 +295,16 @@ std::string SummaryCsv(const json& summary) {
   std::ostringstream out;
   out << "fabric,direction,n,n_failed";
   for (const Quantity& q : Quantities())
-    out << ',' << q.name << "_mean_" << q.unit << ',' << q.name << "_sd_" << q.unit << ','
-        << q.name << "_cv" << (q.law_constant ? std::string(",") + q.name + "_n" : "");
+    out << ',' << q.name << "_mean_" << q.unit << ',' << q.name << "_sd_" << q.unit
+        << (q.another_unit ? "" : std::string(",") + q.name + "_cv," + q.name + "_n");
   out << ",overall_rigidity_uNm,overall_rigidity_mgcm\n";
   for (const json& d : summary["directions"]) {
     out << CsvCell(d["fabric"]) << ',' << CsvCell(d["direction"]) << ',' << CsvCell(d["n"])
         << ',' << CsvCell(d["n_failed"]);
     for (const Quantity& q : Quantities()) {
       const json& s = d[Key(q)];
-      out << ',' << CsvCell(s["mean"]) << ',' << CsvCell(s["sd"]) << ',' << CsvCell(s["cv"]);
-      if (q.law_constant) out << ',' << CsvCell(s["n"]);
+      out << ',' << CsvCell(s["mean"]) << ',' << CsvCell(s["sd"]);
+      if (!q.another_unit) out << ',' << CsvCell(s["cv"]) << ',' << CsvCell(s["n"]);
     }
     for (const json& f : summary["fabrics"]) {
       if (f["fabric"] != d["fabric"]) continue;

@@ -154,17 +154,19 @@ struct SeriesStats {
 SeriesStats Stats(const std::vector<double>& values);
 
 // summary.json: {"directions": [{fabric, direction, n, n_failed, b1_gfcm: {n, n_unobserved, mean,
-// sd, cv}, ...}], "fabrics": [{fabric, overall_rigidity_uNm, overall_rigidity_mgcm, material}],
-// "specimens": [{fabric, specimen, direction, side, line, status, error, b1_gfcm ..., rms_mm,
-// validation}]}, fabrics in manifest order, directions warp, weft, bias.
+// sd, cv}, ...}], "fabrics": [{fabric, material_note, overall_rigidity_uNm, overall_rigidity_mgcm,
+// material}], "specimens": [{fabric, specimen, direction, side, line, status, error, b1_gfcm ...,
+// rms_mm, unobserved, validation}]}, fabrics in manifest order, directions warp, weft, bias.
 nlohmann::json SummaryJson(const std::vector<SpecimenOutcome>& specimens);
 // summary.csv from SummaryJson: one row a fabric and direction.
 std::string SummaryCsv(const nlohmann::json& summary);
 // The material of one fabric from its direction means: the warp law (or the only one measured),
 // the weft law when both were measured; a bias mean is reported, not simulated (a note says so).
-// None when no specimen of the fabric was fitted.
+// None, with the reason in *why (if non-null), when no specimen of the fabric was fitted or the
+// means make no law a material file takes.
 std::optional<Material> FabricMaterial(const std::string& fabric,
-                                       const std::vector<SpecimenOutcome>& specimens);
+                                       const std::vector<SpecimenOutcome>& specimens,
+                                       std::string* why = nullptr);
 
 }  // namespace textile
 

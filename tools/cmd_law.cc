@@ -132,9 +132,11 @@ void Plot(const Material& m, const std::string& material_path, double kappa_max,
                   .log_x = log_kappa};
   chart::Panel bk{.title = "Bending stiffness", .x_label = "κ [1/cm]", .y_label = "B = dM/dκ [gf·cm]",
                   .log_x = log_kappa, .log_y = log_kappa};
+  const bool directions = m.bending_weft || m.bending_bias;
   std::vector<std::pair<std::string, BendingLaw>> laws = {
-      {m.bending_weft ? "warp" : "law", m.EffectiveLaw()}};
+      {directions ? "warp" : "law", m.EffectiveLaw()}};
   if (m.bending_weft) laws.emplace_back("weft", m.EffectiveWeftLaw());
+  if (m.bending_bias) laws.emplace_back("bias (measured)", *m.EffectiveBiasLaw());
   constexpr int kSamples = 400;
   for (const auto& [label, law] : laws) {
     chart::Series sm{.label = label}, sb{.label = label};
@@ -186,7 +188,9 @@ void Plot(const Material& m, const std::string& material_path, double kappa_max,
   // its data reached; measured pairs as markers.
   std::string no_band;
   if (!measured.empty() || m.fit.is_object()) {
-    if (const auto cov = m.bending_weft ? std::nullopt : FitCovariance(m, material_path, &no_band)) {
+    if (const auto cov = m.bending_weft || m.bending_bias
+                             ? std::nullopt
+                             : FitCovariance(m, material_path, &no_band)) {
       const BendingLaw law = m.EffectiveLaw();
       const double reach = std::min(kappa_max, FitCurvatureReach(m).value_or(kappa_max));
       chart::Series lo{.label = "±1σ of the fit", .dashed = true}, hi{.dashed = true};
@@ -277,6 +281,7 @@ void Run(const LawArgs& a) {
                         {"beta", m.beta},
                         {"law", LawJson(law, kappas)}};
     if (m.bending_weft) j["law_weft"] = LawJson(m.EffectiveWeftLaw(), kappas);
+    if (m.bending_bias) j["law_bias"] = LawJson(*m.EffectiveBiasLaw(), kappas);
     if (!a.plot.empty()) j["plot"] = a.plot;
     PrintJson(j);
     return;
@@ -284,8 +289,10 @@ void Run(const LawArgs& a) {
   std::cout << "material: " << (m.name.empty() ? a.material : m.name) << "  [" << a.material
             << "]\nareal density: " << Num(units::SiToGsm(m.areal_density)) << " g/m²"
             << (m.beta != 1.0 ? ", beta = " + Num(m.beta) + " (applied below)" : "") << "\n";
-  PrintLawText(m.bending_weft ? "warp law" : "law", law, kappas);
+  PrintLawText(m.bending_weft || m.bending_bias ? "warp law" : "law", law, kappas);
   if (m.bending_weft) PrintLawText("weft law", m.EffectiveWeftLaw(), kappas);
+  if (m.bending_bias) PrintLawText("bias law (measured; simulations blend warp and weft)",
+                                   *m.EffectiveBiasLaw(), kappas);
   if (!a.plot.empty()) std::cout << "plot: " << a.plot << "\n";
 }
 

@@ -230,6 +230,37 @@ std::vector<std::vector<std::string>> CsvRows(const std::string& text) {
 }
 
 // The fitted sample: its CSV carries the fit's σ, and its bending length is the fit report's.
+TEST(MaterialExport, AMeasuredBiasLawIsWhatEveryFormatWritesForTheBias) {
+  Material m = Anisotropic();
+  m.bending_bias = BendingLaw::FromKes(0.2, 0.15, -0.01);
+  const BendingLaw bias = *m.EffectiveBiasLaw();  // β = 1.5 applied
+
+  const nlohmann::json arcsim = nlohmann::json::parse(ExportMaterial(m, ExportFormat::kArcsim, {}).text);
+  for (size_t j = 1; j < kArcsimBendingAlpha.size(); ++j) {
+    const double kappa = kArcsimCurvaturePerAlpha * kArcsimBendingAlpha[j];
+    EXPECT_NEAR(arcsim["bending"][1][j].get<double>(), 4.0 * bias.Moment(kappa) / kappa,
+                1e-12 * bias.b1());
+  }
+  const QuadraticBending q = PcbBending(bias);
+  EXPECT_DOUBLE_EQ(arcsim["pcb_bending_bias"][0].get<double>(), q.k1);
+  EXPECT_DOUBLE_EQ(arcsim["pcb_bending_bias"][1].get<double>(), q.k2);
+
+  const ExportedMaterial csv = ExportMaterial(m, ExportFormat::kCsv, {});
+  std::istringstream rows(csv.text);
+  std::string header, warp, weft, bias_row;
+  std::getline(rows, header);
+  std::getline(rows, warp);
+  std::getline(rows, weft);
+  std::getline(rows, bias_row);
+  EXPECT_EQ(bias_row.rfind("bias,45,pabst,0.3,0.225,-0.015,", 0), 0u) << bias_row;
+  for (const Note& n : csv.notes) EXPECT_NE(n.code, "bias_blend") << "the bias is measured";
+
+  ExportOptions o;
+  o.thickness_mm = 0.5;
+  const nlohmann::json u3m = nlohmann::json::parse(ExportMaterial(m, ExportFormat::kU3m, o).text);
+  EXPECT_NEAR(u3m["custom"]["textile"]["bending_bias"]["b1"].get<double>(), 0.3, 1e-12);
+}
+
 TEST(MaterialExport, CsvHasOneRowADirectionWithTheLabsNumbers) {
   const Material fitted = ReadMaterial(kSamples + "expected/pabst-fig8.fitted.json");
   const ExportedMaterial e = ExportMaterial(fitted, ExportFormat::kCsv, {});

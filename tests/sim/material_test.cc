@@ -102,6 +102,34 @@ TEST(Material, JsonRoundTrip) {
   EXPECT_EQ(b.extra, a.extra);
 }
 
+TEST(Material, AMeasuredBiasLawIsReadCheckedWrittenAndNamedAsNotSimulated) {
+  const std::string text = R"({"areal_density_gsm": 200,
+    "bending": {"units": "kes", "b1": 0.1, "b2": 0.0892, "c1": -0.0092},
+    "bending_weft": {"units": "kes", "b1": 0.06, "b2": 0.05, "c1": -0.004},
+    "bending_bias": {"units": "kes", "b1": 0.05, "b2": 0.04, "c1": -0.003},
+    "beta": 2})";
+  const Material m = ParseMaterialJson(text, "bias.json");
+  ASSERT_TRUE(m.bending_bias.has_value());
+  EXPECT_NEAR(m.bending_bias->b1_kes(), 0.05, 1e-12);
+  EXPECT_NEAR(m.EffectiveBiasLaw()->b1_kes(), 0.1, 1e-12);  // β applied
+  const Material back = ParseMaterialJson(MaterialToJson(m).dump(), "round trip");
+  ASSERT_TRUE(back.bending_bias.has_value());
+  EXPECT_NEAR(back.bending_bias->c1_kes(), -0.003, 1e-12);
+  // The drape blends warp and weft: its 45° b1 (0.08 x 2) against the measured 0.05 x 2.
+  const std::optional<Note> note = BiasNotSimulatedNote(m);
+  ASSERT_TRUE(note.has_value());
+  EXPECT_EQ(note->code, "bias_not_simulated");
+  EXPECT_NE(note->text.find("45° b1 is 0.16 gf·cm against the measured 0.1"), std::string::npos)
+      << note->text;
+  EXPECT_FALSE(BiasNotSimulatedNote(LawOnlyMaterial(m.bending, 0.2)).has_value());
+  // A bias law a file would refuse is named by its field.
+  Material bad = m;
+  bad.bending_bias = BendingLaw::FromKes(2e5, 100, -1e7);
+  std::string why;
+  EXPECT_FALSE(bad.Check(&why));
+  EXPECT_EQ(why.rfind("bending_bias", 0), 0u) << why;
+}
+
 TEST(Material, SplineLawsReadInKesAndSiAndSurviveTheRoundTrip) {
   const Material kes = ParseMaterialJson(
       R"({"areal_density_gsm": 300, "bending": {"law": "spline", "units": "kes",
@@ -281,6 +309,8 @@ TEST(MaterialCheck, RefusesWhatTheParserRefusesInItsWords) {
        [](Material& m) { m.bending = BendingLaw::FromKes(0.1, 0.2, 1e6); });
   with("weft law beyond the range",
        [](Material& m) { m.bending_weft = BendingLaw::FromKes(2e5, 100, -1e7); });
+  with("bias law beyond the range",
+       [](Material& m) { m.bending_bias = BendingLaw::FromKes(2e5, 100, -1e7); });
   with("spline secant below the range", [](Material& m) {
     m.bending = BendingLaw::FromSplineKes({0.0, 1.0, 2.0}, {0.0, 1e-7, 2e-7}, {});
   });
@@ -601,7 +631,7 @@ TEST(MaterialMembrane, CodeBuiltMembranesAreWrittenAndChecked) {
                 1e-12 * m.orthotropic->weft.Force(e) + 1e-12);
   }
   // Check refuses in the parser's words, without the file name.
-  const auto refused = [](Material bad, const std::string& expected) {
+  const auto refused = [](const Material& bad, const std::string& expected) {
     std::string why;
     EXPECT_FALSE(bad.Check(&why)) << expected;
     EXPECT_EQ(why.find(expected), 0u) << why;

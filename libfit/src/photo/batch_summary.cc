@@ -239,16 +239,18 @@ std::optional<Material> FabricMaterial(const std::string& fabric,
                                units::GsmToSi(gsm / static_cast<double>(n)));
   m.name = fabric;
   if (warp && weft) m.bending_weft = MeanLaw(by[StripDirection::kWeft], StripDirection::kWeft, &notes);
+  if (!by[StripDirection::kBias].empty() && main != StripDirection::kBias)
+    m.bending_bias = MeanLaw(by[StripDirection::kBias], StripDirection::kBias, &notes);
   if (gsm_max > 1.01 * gsm_min)
     notes.push_back("the specimens' gsm range " + NumberText(gsm_min) + " .. " +
                     NumberText(gsm_max) + " g/m²: the material takes their mean");
   if (!(warp && weft))
     notes.push_back(std::string("only the ") + DirectionName(main) +
                     " direction was fitted: the material is isotropic with its law");
-  if (!by[StripDirection::kBias].empty() && main != StripDirection::kBias)
+  if (m.bending_bias)
     notes.push_back(
-        "the bias mean is in summary.json; simulations blend warp and weft by angle "
-        "(docs/methods/materials.md, \"Warp, weft and bias\") and do not take a bias law");
+        "bending_bias is the bias mean: exports carry it; simulations blend warp and weft by "
+        "angle (docs/methods/materials.md, \"Warp, weft and bias\") and do not take it");
   json directions = json::object();
   for (StripDirection d : kDirections) {
     if (by[d].empty()) continue;

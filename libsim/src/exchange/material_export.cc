@@ -42,6 +42,10 @@ std::vector<Direction> Directions(const Material& m) {
   const BendingLaw warp = m.EffectiveLaw(), weft = m.EffectiveWeftLaw();
   std::vector<Direction> d = {{"warp", 0.0, warp, LawKind(warp)},
                               {"weft", 90.0, weft, LawKind(weft)}};
+  if (const std::optional<BendingLaw> measured = m.EffectiveBiasLaw()) {
+    d.push_back({"bias", 45.0, *measured, LawKind(*measured)});
+    return d;
+  }
   const BendingLaw bias = BiasLaw(m);
   d.push_back({"bias", 45.0, bias, m.bending_weft ? "blend" : LawKind(warp)});
   return d;
@@ -57,12 +61,15 @@ nlohmann::json ArcsimBendingTable(const Material& m) {
       BlendedLaw(m.EffectiveLaw(), m.EffectiveWeftLaw(), 0.5 * std::numbers::pi),  // curvature ∥ weft
       BlendedLaw(m.EffectiveLaw(), m.EffectiveWeftLaw(), 0.25 * std::numbers::pi),
       BlendedLaw(m.EffectiveLaw(), m.EffectiveWeftLaw(), 0.0)};  // curvature ∥ warp
+  const std::optional<BendingLaw> bias = m.EffectiveBiasLaw();  // measured: the 45° row's
   nlohmann::json table = nlohmann::json::array();
-  for (const BlendedLaw& law : by_edge) {
+  for (int r = 0; r < 3; ++r) {
     nlohmann::json row = nlohmann::json::array();
-    for (double alpha : kArcsimBendingAlpha)
-      row.push_back(kArcsimStiffnessPerSecant *
-                    SecantStiffness(law, kArcsimCurvaturePerAlpha * alpha));
+    for (double alpha : kArcsimBendingAlpha) {
+      const double kappa = kArcsimCurvaturePerAlpha * alpha;
+      row.push_back(kArcsimStiffnessPerSecant * (r == 1 && bias ? SecantStiffness(*bias, kappa)
+                                                                : SecantStiffness(by_edge[r], kappa)));
+    }
     table.push_back(row);
   }
   return table;
@@ -134,8 +141,9 @@ void AddStretching(const Material& m, const ExportOptions& o, nlohmann::json* ou
 void AddPcbNotes(const Material& m, const std::vector<Direction>& dirs, std::vector<Note>* notes) {
   for (const Direction& d : dirs) {
     if (std::string(d.kind) == "blend") continue;  // the mean of the other two keys
-    const std::string key = m.bending_weft ? std::string("pcb_bending_") + d.name
-                                           : std::string("pcb_bending_warp, _weft and _bias");
+    const bool one_law = !m.bending_weft && !m.bending_bias;
+    const std::string key = !one_law ? std::string("pcb_bending_") + d.name
+                                     : std::string("pcb_bending_warp, _weft and _bias");
     const QuadraticBending q = PcbBending(d.law);
     if (d.law.is_spline()) {
       notes->push_back({"pcb_bending_fitted",
@@ -153,7 +161,7 @@ void AddPcbNotes(const Material& m, const std::vector<Direction>& dirs, std::vec
                             " /cm; past it the law is linear and the fork's moment " +
                             (d.law.c1() < 0.0 ? "falls below it" : "rises above it")});
     }
-    if (!m.bending_weft) return;
+    if (one_law) return;
   }
 }
 
@@ -163,12 +171,14 @@ ExportedMaterial ExportArcsim(const Material& m, const ExportOptions& o) {
   j["density"] = m.areal_density;
   j["bending"] = ArcsimBendingTable(m);
   const std::vector<Direction> dirs = Directions(m);
-  // The fork's bias row is the 45° blend: for two quadratics, their mean.
+  // The fork's bias key: the measured bias law's quadratic, else the 45° blend's (for two
+  // quadratics, their mean).
   const QuadraticBending warp = PcbBending(dirs[0].law), weft = PcbBending(dirs[1].law);
   j["pcb_bending_warp"] = PcbJson(warp);
   j["pcb_bending_weft"] = PcbJson(weft);
   j["pcb_bending_bias"] =
-      nlohmann::json::array({0.5 * (warp.k1 + weft.k1), 0.5 * (warp.k2 + weft.k2)});
+      m.bending_bias ? PcbJson(PcbBending(dirs[2].law))
+                     : nlohmann::json::array({0.5 * (warp.k1 + weft.k1), 0.5 * (warp.k2 + weft.k2)});
   AddStretching(m, o, &j, &e.notes);
   AddPcbNotes(m, dirs, &e.notes);
   e.notes.push_back({"arcsim_curvature_samples",
@@ -187,7 +197,7 @@ nlohmann::json OrNull(const nlohmann::json& fit, const char* key, double scale) 
 
 // The law's 1-σ in KES units (β applied) from the fit report, null where unknown.
 nlohmann::json BendingSigma(const Material& m) {
-  if (!m.fit.is_object() || m.bending_weft) return nullptr;
+  if (!m.fit.is_object() || m.bending_weft || m.bending_bias) return nullptr;
   return {{"units", "kes"},
           {"b1", OrNull(m.fit, "b1_sd", m.beta)},
           {"b2", OrNull(m.fit, "b2_sd", m.beta)},
@@ -203,6 +213,7 @@ nlohmann::json U3mCustom(const Material& m, const ExportOptions& o) {
                       {"areal_density_gsm", units::SiToGsm(m.areal_density)},
                       {"material", file}};
   if (m.bending_weft) t["bending_weft"] = LawToJson(m.EffectiveWeftLaw());
+  if (m.bending_bias) t["bending_bias"] = LawToJson(*m.EffectiveBiasLaw());
   if (!o.producer.empty()) t["producer"] = o.producer;
   return t;
 }
@@ -273,7 +284,7 @@ ExportedMaterial ExportCsv(const Material& m) {
   for (const Direction& d : Directions(m)) {
     const bool pabst = std::string(d.kind) == "pabst";
     // Only a material with one law has the fit's σ, and then every direction shares it.
-    const bool has_sigma = !m.bending_weft && sigma.is_object();
+    const bool has_sigma = sigma.is_object();
     out << d.name << ',' << Cell(d.angle_deg) << ',' << d.kind << ',' << Cell(d.law.b1_kes())
         << ',' << (pabst ? Cell(d.law.b2_kes()) : "") << ',' << (pabst ? Cell(d.law.c1_kes()) : "")
         << ',' << (has_sigma ? SigmaCell(sigma, "b1") : "") << ','
@@ -287,9 +298,10 @@ ExportedMaterial ExportCsv(const Material& m) {
     } else {
       out << ",,";
       // One note for a material with one law: its three directions are the same strip.
-      if (m.bending_weft || d.angle_deg == 0.0)
+      const bool one_law = !m.bending_weft && !m.bending_bias;
+      if (!one_law || d.angle_deg == 0.0)
         e.notes.push_back({"no_bending_length",
-                           std::string(m.bending_weft ? d.name : "warp, weft and bias") +
+                           std::string(!one_law ? d.name : "warp, weft and bias") +
                                ": no bending length: " + crossing.message});
     }
     out << ',' << Cell(units::SiToGsm(m.areal_density)) << ',';
@@ -306,7 +318,7 @@ ExportedMaterial ExportCsv(const Material& m) {
     e.notes.push_back({"membrane_not_measured",
                        "tensile and shear moduli left empty: the material does not give " +
                            JoinText(MissingMembraneFields(m), ", ")});
-  if (m.bending_weft)
+  if (m.bending_weft && !m.bending_bias)
     e.notes.push_back({"bias_blend",
                        "bias: the 45 degree blend of the warp and weft laws, M = (M_warp + "
                        "M_weft) / 2; b2 and c1 are empty (not a Pabst law)"});

@@ -526,14 +526,15 @@ Material ParseMaterialJson(const std::string& text, const std::string& source) {
   const JsonFields f(source);
   const json root = ParseJsonText(text, source);
   f.RequireObject(root);
-  f.CheckKeys(root, "", {"name", "areal_density_gsm", "bending", "bending_weft", "beta", "stretch",
-                         "friction", "fit", "notes", "assumptions", "source"});
+  f.CheckKeys(root, "", {"name", "areal_density_gsm", "bending", "bending_weft", "bending_bias",
+                         "beta", "stretch", "friction", "fit", "notes", "assumptions", "source"});
   Material m;
   if (root.contains("name")) m.name = f.String(root["name"], "name");
   m.areal_density = ReadArealDensity(f, root);
   f.Require(root, "bending", "required: {\"units\", \"b1\", \"b2\", \"c1\"}");
   m.bending = Law(f, root, "bending");
   if (root.contains("bending_weft")) m.bending_weft = Law(f, root, "bending_weft");
+  if (root.contains("bending_bias")) m.bending_bias = Law(f, root, "bending_bias");
   if (root.contains("beta")) {
     m.beta = f.Number(root["beta"], "beta");
     Refuse(f, "beta", BetaProblem(m.beta, JsonFields::Brief(root["beta"])));
@@ -693,6 +694,18 @@ std::vector<Note> MaterialDefaultNotes(const Material& m) {
   return notes;
 }
 
+std::optional<Note> BiasNotSimulatedNote(const Material& m) {
+  if (!m.bending_bias) return std::nullopt;
+  const double blend = 0.5 * (m.EffectiveLaw().b1() + m.EffectiveWeftLaw().b1());
+  const double measured = m.EffectiveBiasLaw()->b1();
+  return Note{"bias_not_simulated",
+              "bending_bias is not simulated: bending at angle φ to the warp blends the warp and "
+              "weft laws by cos²φ, whose 45° b1 is " +
+                  NumberText(units::SiStiffnessToKes(blend), 4) + " gf·cm against the measured " +
+                  NumberText(units::SiStiffnessToKes(measured), 4) +
+                  " (docs/methods/materials.md, \"Warp, weft and bias\")"};
+}
+
 bool Material::Check(std::string* why) const {
   std::string w;
   const auto field = [&w](const char* name, const std::string& problem) {
@@ -707,6 +720,7 @@ bool Material::Check(std::string* why) const {
     field("areal_density_gsm", ArealDensityProblem(gsm, Written(gsm)));
   if (w.empty()) w = LawProblem(bending, "bending");
   if (w.empty() && bending_weft) w = LawProblem(*bending_weft, "bending_weft");
+  if (w.empty() && bending_bias) w = LawProblem(*bending_bias, "bending_bias");
   if (number("beta", beta)) field("beta", BetaProblem(beta, Written(beta)));
   if (w.empty()) w = StretchProblem(*this);
   if (number("friction", friction)) field("friction", FrictionProblem(friction, Written(friction)));
@@ -748,6 +762,7 @@ nlohmann::json MaterialToJson(const Material& m) {
   j["areal_density_gsm"] = units::SiToGsm(m.areal_density);
   j["bending"] = LawToJson(m.bending);
   if (m.bending_weft) j["bending_weft"] = LawToJson(*m.bending_weft);
+  if (m.bending_bias) j["bending_bias"] = LawToJson(*m.bending_bias);
   j["beta"] = m.beta;
   if (json st = StretchJson(m); !st.empty()) j["stretch"] = std::move(st);
   j["friction"] = m.friction;

@@ -852,6 +852,7 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
   result.notes = drape_internal::DrapeNotes(o, result, rim_capped);
   // A membrane the file did not give is a guess the DC depends on: the run says which parts.
   for (Note& n : MaterialDefaultNotes(material)) result.notes.push_back(std::move(n));
+  if (std::optional<Note> bias = BiasNotSimulatedNote(material)) result.notes.push_back(*bias);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

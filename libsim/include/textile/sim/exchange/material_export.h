@@ -11,8 +11,9 @@
 //
 // Directions follow the material: pattern x (ARCSim's material u axis) is the warp. The warp
 // law is the bending of a warp strip, curvature along the warp, so a hinge whose edge runs along
-// the weft bends with it (docs/methods/materials.md, "Warp, weft and bias"). Every format gets
-// the laws with β applied: what the simulators use.
+// the weft bends with it (docs/methods/materials.md, "Warp, weft and bias"). The bias is the
+// material's measured bias law where it has one (bending_bias), else the 45° blend of warp and
+// weft. Every format gets the laws with β applied: what the simulators use.
 
 #include <array>
 #include <optional>

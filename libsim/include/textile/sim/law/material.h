@@ -57,6 +57,10 @@ struct Material {
   double areal_density = 0.0;                // ρ [kg/m²]
   BendingLaw bending = BendingLaw::FromKes(0.1, 0.1, 0.0);  // warp law (or the only law)
   std::optional<BendingLaw> bending_weft;    // weft law, when anisotropic
+  // A measured bias law (a strip cut at 45°), when the lab measured one: exports and reports
+  // carry it (ARCSim's 45° row, the fork's pcb_bending_bias, CLO and Browzwear's bias). The
+  // simulations blend warp and weft by angle and do not take it (BiasNotSimulatedNote).
+  std::optional<BendingLaw> bending_bias;
   double beta = 1.0;                         // linear bending stiffness factor β (section 3.4)
   // The membrane (docs/methods/materials.md, "Membrane"). Isotropic (stabilised StVK of
   // docs/spec/physics.md) with stretch_stiffness and poisson when the file gives only
@@ -108,11 +112,20 @@ struct Material {
   BendingLaw EffectiveLaw() const { return bending.Scaled(beta); }
   // The weft law with β applied, or the warp law when the material is isotropic.
   BendingLaw EffectiveWeftLaw() const { return (bending_weft ? *bending_weft : bending).Scaled(beta); }
+  // The measured bias law with β applied; none when the file gives none.
+  std::optional<BendingLaw> EffectiveBiasLaw() const {
+    return bending_bias ? std::optional<BendingLaw>(bending_bias->Scaled(beta)) : std::nullopt;
+  }
 };
 
 // One note a default the material's membrane uses (code "membrane_default"), naming the field,
 // the value and docs/methods/materials.md; none when the file gave every membrane field.
 std::vector<Note> MaterialDefaultNotes(const Material& material);
+
+// The note a simulation that blends warp and weft by angle gives for a material with a measured
+// bias law it does not take (code "bias_not_simulated"), naming the blend's 45° stiffness and the
+// measured one; none without bending_bias.
+std::optional<Note> BiasNotSimulatedNote(const Material& material);
 
 // A material of a law and an areal density [kg/m²] alone, as a file with only
 // `areal_density_gsm` and `bending` reads: its membrane the documented defaults, each listed in

@@ -291,8 +291,7 @@ void Run(const LawArgs& a) {
             << (m.beta != 1.0 ? ", beta = " + Num(m.beta) + " (applied below)" : "") << "\n";
   PrintLawText(m.bending_weft || m.bending_bias ? "warp law" : "law", law, kappas);
   if (m.bending_weft) PrintLawText("weft law", m.EffectiveWeftLaw(), kappas);
-  if (m.bending_bias) PrintLawText("bias law (measured; simulations blend warp and weft)",
-                                   *m.EffectiveBiasLaw(), kappas);
+  if (m.bending_bias) PrintLawText("bias law (measured)", *m.EffectiveBiasLaw(), kappas);
   if (!a.plot.empty()) std::cout << "plot: " << a.plot << "\n";
 }
 

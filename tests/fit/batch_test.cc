@@ -353,7 +353,7 @@ TEST(BatchSummary, AFabricWithOneDirectionIsIsotropicAndSaysSo) {
   EXPECT_NEAR(mat->bending.b1_kes(), outcomes[0].material->bending.b1_kes(), 1e-12);
   const std::string notes = mat->extra["notes"].dump();
   EXPECT_NE(notes.find("only the weft direction"), std::string::npos) << notes;
-  // The bias specimen's law is carried as the measured bias, with a note that it is not simulated.
+  // The bias specimen's law is carried as the measured bias, with a note saying so.
   ASSERT_TRUE(mat->bending_bias.has_value());
   EXPECT_NEAR(mat->bending_bias->b1_kes(), outcomes[1].material->bending.b1_kes(), 1e-12);
   EXPECT_NE(notes.find("bending_bias is the bias mean"), std::string::npos) << notes;

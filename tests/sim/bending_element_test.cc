@@ -59,6 +59,33 @@ Eigen::MatrixXd DenseHessian(const BendingElements& b, const Vertices& x, bool p
 
 std::string Name(BendingModel m) { return BendingModelName(m); }
 
+// Central differences of the energy (kFdStep below).
+Vertices FdGradient(const BendingElements& b, const Vertices& x, double step) {
+  Vertices fd(x.rows(), 3);
+  for (int i = 0; i < x.rows(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      Vertices xp = x, xm = x;
+      xp(i, c) += step;
+      xm(i, c) -= step;
+      fd(i, c) = (b.Energy(xp) - b.Energy(xm)) / (2 * step);
+    }
+  return fd;
+}
+
+// Central differences of the gradient, column j of dof j = 3 vertex + coordinate.
+Eigen::MatrixXd FdHessian(const BendingElements& b, const Vertices& x, double step) {
+  const int n = 3 * static_cast<int>(x.rows());
+  Eigen::MatrixXd fd(n, n);
+  for (int j = 0; j < n; ++j) {
+    Vertices xp = x, xm = x;
+    xp(j / 3, j % 3) += step;
+    xm(j / 3, j % 3) -= step;
+    const Vertices d = (Gradient(b, xp) - Gradient(b, xm)) / (2 * step);
+    fd.col(j) = Eigen::Map<const Eigen::VectorXd>(d.data(), n);
+  }
+  return fd;
+}
+
 TEST(HingeBendAngle, IsSignedAndPositiveWhenFoldingTowardsTheNormals) {
   // Edge along y, wings at x = ∓1 rising by δ: the flat pattern's normals point to +z, the
   // wings fold up towards them.
@@ -86,14 +113,7 @@ TEST(BendingElements, GradientMatchesFiniteDifferencesForEveryModel) {
       const BendingElements b(rest, BuildHinges(rest), law, std::nullopt, {.model = model});
       const Vertices x = Perturbed(rest.vertices, 0.002, &rng);
       const Vertices g = Gradient(b, x);
-      Vertices fd(x.rows(), 3);
-      for (int i = 0; i < x.rows(); ++i)
-        for (int c = 0; c < 3; ++c) {
-          Vertices xp = x, xm = x;
-          xp(i, c) += kFdStep;
-          xm(i, c) -= kFdStep;
-          fd(i, c) = (b.Energy(xp) - b.Energy(xm)) / (2 * kFdStep);
-        }
+      const Vertices fd = FdGradient(b, x, kFdStep);
       EXPECT_LT((g - fd).cwiseAbs().maxCoeff(), kFdRelTolerance * g.cwiseAbs().maxCoeff())
           << Name(model);
       // EnergyGradient is the fused version of the same.
@@ -112,15 +132,7 @@ TEST(BendingElements, HessianMatchesFiniteDifferencesOfTheGradientForEveryModel)
       const BendingElements b(rest, BuildHinges(rest), law, std::nullopt, {.model = model});
       const Vertices x = Perturbed(rest.vertices, 0.002, &rng);
       const Eigen::MatrixXd h = DenseHessian(b, x, false);
-      const int n = 3 * static_cast<int>(x.rows());
-      Eigen::MatrixXd fd(n, n);
-      for (int j = 0; j < n; ++j) {
-        Vertices xp = x, xm = x;
-        xp(j / 3, j % 3) += kFdStep;
-        xm(j / 3, j % 3) -= kFdStep;
-        const Vertices d = (Gradient(b, xp) - Gradient(b, xm)) / (2 * kFdStep);
-        fd.col(j) = Eigen::Map<const Eigen::VectorXd>(d.data(), n);
-      }
+      const Eigen::MatrixXd fd = FdHessian(b, x, kFdStep);
       EXPECT_LT((h - fd).cwiseAbs().maxCoeff(), kFdRelTolerance * h.cwiseAbs().maxCoeff())
           << Name(model);
       EXPECT_LT((h - h.transpose()).cwiseAbs().maxCoeff(), 1e-12 * h.cwiseAbs().maxCoeff())
@@ -371,6 +383,53 @@ TEST(BendingElements, WarpWeftBlendFollowsTheBendingDirectionAcrossTheRestEdge) 
   }
 }
 
+// With a measured bias law each hinge blends the three laws by its edge's direction, in the SIMD
+// kernel, the spline path and the Hessian alike.
+TEST(BendingElements, ABiasLawIsBlendedPerHingeByDirection) {
+  std::mt19937 rng(61);
+  const TriangleMesh rest = SmallPattern(&rng);
+  const auto hinges = BuildHinges(rest);
+  const BendingLaw warp = Fig8(), weft = Interlining();
+  const BendingLaw bias = BendingLaw::FromKes(0.02, 0.015, -0.001);
+  const BendingElements b(rest, hinges, DirectionLaws{warp, weft, bias},
+                          {.model = BendingModel::kPabst});
+  const Vertices x = Perturbed(rest.vertices, 0.003, &rng);
+  double sum = 0.0;
+  int pure_bias = 0;
+  for (int h = 0; h < b.num_hinges(); ++h) {
+    const Eigen::Vector3d e = rest.vertices.row(hinges[h].v[3]) - rest.vertices.row(hinges[h].v[2]);
+    const BlendedLaw blended(warp, weft, bias, std::atan2(e.y(), e.x()) + 0.5 * M_PI);
+    const double expected = b.area_weight(h) * blended.Energy(b.HingeCurvature(x, h));
+    EXPECT_NEAR(b.HingeEnergy(x, h), expected, 1e-14 * expected) << "hinge " << h;
+    EXPECT_NEAR(b.bias_weight(h), blended.weights().bias, 1e-12);
+    pure_bias += b.bias_weight(h) == 1.0;
+    sum += expected;
+  }
+  EXPECT_GT(pure_bias, 0);  // the pattern has diagonal edges
+  EXPECT_NEAR(b.Energy(x), sum, 1e-12 * sum);
+  const Vertices g = Gradient(b, x);
+  EXPECT_LT((g - FdGradient(b, x, kFdStep)).cwiseAbs().maxCoeff(),
+            kFdRelTolerance * g.cwiseAbs().maxCoeff());
+  const Eigen::MatrixXd hessian = DenseHessian(b, x, false);
+  EXPECT_LT((hessian - FdHessian(b, x, kFdStep)).cwiseAbs().maxCoeff(),
+            kFdRelTolerance * hessian.cwiseAbs().maxCoeff());
+  // The fixed-pattern Hessian (the solvers' path) agrees with the triplets.
+  Eigen::SparseMatrix<double> fixed = b.HessianPattern(false);
+  b.SetHessian(x, HessianProjection::kNone, b.HessianSlots(fixed, false), &fixed);
+  EXPECT_LT((Eigen::MatrixXd(fixed) - hessian).cwiseAbs().maxCoeff(),
+            1e-12 * hessian.cwiseAbs().maxCoeff());
+  // The spline path (a spline bias law) gives the same hinge energies.
+  std::vector<double> kappa = {0.0}, moment = {0.0};
+  for (int i = 1; i <= 2000; ++i) {
+    kappa.push_back(0.5 * i);
+    moment.push_back(bias.Moment(0.5 * i));
+  }
+  const BendingElements spline(rest, hinges,
+                               DirectionLaws{warp, weft, BendingLaw::FromSpline(kappa, moment)},
+                               {.model = BendingModel::kPabst});
+  EXPECT_NEAR(spline.Energy(x), b.Energy(x), 1e-3 * b.Energy(x));
+}
+
 TEST(BendingElements, StiffnessMultiplierScalesEachHinge) {
   std::mt19937 rng(53);
   const TriangleMesh rest = SmallPattern(&rng);
@@ -510,14 +569,7 @@ TEST(BendingElements, GradientMatchesFiniteDifferencesForWarpWeftAndCurvedRest) 
     const BendingElements b(rest, BuildHinges(rest), Fig8(), Interlining(), {.model = model});
     const Vertices x = Perturbed(rest.vertices, 0.003, &rng);
     const Vertices g = Gradient(b, x);
-    Vertices fd(x.rows(), 3);
-    for (int i = 0; i < x.rows(); ++i)
-      for (int c = 0; c < 3; ++c) {
-        Vertices xp = x, xm = x;
-        xp(i, c) += kFdStep;
-        xm(i, c) -= kFdStep;
-        fd(i, c) = (b.Energy(xp) - b.Energy(xm)) / (2 * kFdStep);
-      }
+    const Vertices fd = FdGradient(b, x, kFdStep);
     EXPECT_LT((g - fd).cwiseAbs().maxCoeff(), kFdRelTolerance * g.cwiseAbs().maxCoeff())
         << Name(model);
     // The per-hinge views (scalar code) sum to the kernel's energy.

@@ -199,6 +199,73 @@ TEST(BlendedLaw, WarpAndWeftAtAngles) {
   }
 }
 
+// The three-direction weights: none negative, sum 1, pure at 0°, 45° and 90°.
+TEST(BlendedLaw, DirectionWeightsAreAConvexCombinationPureAtTheMeasuredAngles) {
+  for (int i = 0; i <= 90; ++i) {
+    const double phi = i * M_PI / 180.0, c2 = std::cos(phi) * std::cos(phi);
+    for (bool with_bias : {false, true}) {
+      const LawWeights w = DirectionWeights(c2, with_bias);
+      EXPECT_GE(w.warp, 0.0) << i;
+      EXPECT_GE(w.weft, 0.0) << i;
+      EXPECT_GE(w.bias, 0.0) << i;
+      EXPECT_NEAR(w.warp + w.weft + w.bias, 1.0, 1e-15) << i;
+      if (!with_bias) EXPECT_EQ(w.bias, 0.0);
+    }
+  }
+  const auto at = [](double phi) {
+    return DirectionWeights(std::cos(phi) * std::cos(phi), true);
+  };
+  EXPECT_EQ(at(0.0).warp, 1.0);
+  EXPECT_EQ(at(M_PI / 4).bias, 1.0);  // exactly, though cos²(π/4) rounds above ½
+  EXPECT_EQ(at(M_PI / 2).weft, 1.0);
+  // Each side takes its own measured axis only.
+  EXPECT_EQ(at(M_PI / 8).weft, 0.0);
+  EXPECT_EQ(at(3 * M_PI / 8).warp, 0.0);
+  EXPECT_NEAR(at(M_PI / 8).warp, std::cos(M_PI / 4), 1e-15);
+  // Out-of-range input (round-off of a caller's cos²) is clamped, not extrapolated.
+  EXPECT_EQ(DirectionWeights(1.0 + 1e-16, true).warp, 1.0);
+  EXPECT_EQ(DirectionWeights(-1e-16, false).weft, 1.0);
+}
+
+// A bias law equal to the mean of warp and weft gives the two-law cos²φ blend back.
+TEST(BlendedLaw, ABiasLawThatIsTheMeanGivesTheTwoLawBlend) {
+  const auto warp = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+  const auto weft = BendingLaw::FromKes(0.08, 0.07, -0.006);
+  std::vector<double> kappa = {0.0}, moment = {0.0};
+  for (int i = 1; i <= 400; ++i) {
+    kappa.push_back(0.5 * i);
+    moment.push_back(0.5 * (warp.Moment(0.5 * i) + weft.Moment(0.5 * i)));
+  }
+  const BendingLaw mean = BendingLaw::FromSpline(kappa, moment);
+  for (double phi : {0.1, 0.5, M_PI / 4, 1.0, 1.4}) {
+    const BlendedLaw two(warp, weft, phi), three(warp, weft, mean, phi);
+    for (double k : {-40.0, 3.0, 17.5, 150.0}) {
+      EXPECT_NEAR(three.Moment(k), two.Moment(k), 1e-9 * std::abs(two.Moment(k)))
+          << phi << " " << k;
+    }
+  }
+}
+
+// A bias much softer than warp and weft: the blend stays monotone and invertible.
+TEST(BlendedLaw, ASoftBiasLawBlendsMonotoneAndInverts) {
+  const auto warp = BendingLaw::FromKes(0.4, 0.3, -0.01);
+  const auto weft = BendingLaw::FromKes(0.2, 0.15, -0.01);
+  const auto bias = BendingLaw::FromKes(0.02, 0.01, -0.001);
+  for (double phi : {0.2, M_PI / 4, 1.2}) {
+    const BlendedLaw law(warp, weft, bias, phi);
+    double previous = 0.0;
+    for (int i = 1; i <= 200; ++i) {
+      const double k = 0.5 * i, m = law.Moment(k);
+      EXPECT_GT(m, previous) << phi << " " << k;
+      EXPECT_GT(law.Stiffness(k), 0.0);
+      EXPECT_NEAR(law.Curvature(m), k, 1e-12 * k);
+      previous = m;
+    }
+  }
+  const BlendedLaw mid(warp, weft, bias, M_PI / 4);
+  EXPECT_DOUBLE_EQ(mid.Energy(20.0), bias.Energy(20.0));
+}
+
 // ---- Spline laws ----
 
 // A spline through n + 1 evenly spaced knots of a law on [0, kappa_max] [1/m].

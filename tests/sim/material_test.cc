@@ -102,7 +102,7 @@ TEST(Material, JsonRoundTrip) {
   EXPECT_EQ(b.extra, a.extra);
 }
 
-TEST(Material, AMeasuredBiasLawIsReadCheckedWrittenAndNamedAsNotSimulated) {
+TEST(Material, AMeasuredBiasLawIsReadCheckedWrittenAndBlendedAt45Degrees) {
   const std::string text = R"({"areal_density_gsm": 200,
     "bending": {"units": "kes", "b1": 0.1, "b2": 0.0892, "c1": -0.0092},
     "bending_weft": {"units": "kes", "b1": 0.06, "b2": 0.05, "c1": -0.004},
@@ -115,13 +115,11 @@ TEST(Material, AMeasuredBiasLawIsReadCheckedWrittenAndNamedAsNotSimulated) {
   const Material back = ParseMaterialJson(MaterialToJson(m).dump(), "round trip");
   ASSERT_TRUE(back.bending_bias.has_value());
   EXPECT_NEAR(back.bending_bias->c1_kes(), -0.003, 1e-12);
-  // The drape blends warp and weft: its 45° b1 (0.08 x 2) against the measured 0.05 x 2.
-  const std::optional<Note> note = BiasNotSimulatedNote(m);
-  ASSERT_TRUE(note.has_value());
-  EXPECT_EQ(note->code, "bias_not_simulated");
-  EXPECT_NE(note->text.find("45° b1 is 0.16 gf·cm against the measured 0.1"), std::string::npos)
-      << note->text;
-  EXPECT_FALSE(BiasNotSimulatedNote(LawOnlyMaterial(m.bending, 0.2)).has_value());
+  // Bending at 45° is the measured bias (β applied), not the mean of warp and weft (0.08 x 2).
+  const double k = 30.0;  // [1/m]
+  EXPECT_DOUBLE_EQ(m.EffectiveLawAt(0.25 * M_PI).Moment(k), m.EffectiveBiasLaw()->Moment(k));
+  EXPECT_DOUBLE_EQ(m.EffectiveLawAt(0.0).Moment(k), m.EffectiveLaw().Moment(k));
+  EXPECT_DOUBLE_EQ(m.EffectiveLawAt(0.5 * M_PI).Moment(k), m.EffectiveWeftLaw().Moment(k));
   // A bias law a file would refuse is named by its field.
   Material bad = m;
   bad.bending_bias = BendingLaw::FromKes(2e5, 100, -1e7);

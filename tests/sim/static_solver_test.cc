@@ -1005,5 +1005,38 @@ TEST(Support, DistancesAndNormalsAreConsistent) {
   EXPECT_THROW(Support::Plane({0, 0, 0}, {0, 0, 0}), InputError);
 }
 
+// A measured bias law reaches the hinges (scaled like the other laws); the curvature-tensor
+// elements, which take warp and weft only, refuse such a material by name.
+TEST(ClothProblem, ABiasLawGoesToTheHingesAndTheTensorElementsRefuseIt) {
+  const TriangleMesh mesh = CrissCrossGridMesh(0.2, 0.12, 10, 6);
+  Material m = Cotton();
+  m.bending_bias = m.bending.Scaled(0.25);
+  ClothOptions options;
+  options.bending_scale = 2.0;
+  const ClothProblem problem(mesh, m, {}, options);
+  const BendingElements* hinges = problem.hinge_bending();
+  ASSERT_NE(hinges, nullptr);
+  Vertices x = mesh.vertices;
+  for (int i = 0; i < x.rows(); ++i) x(i, 2) = 0.3 * x(i, 0) * x(i, 0) + 0.2 * x(i, 0) * x(i, 1);
+  const BendingLaw bias = m.EffectiveBiasLaw()->Scaled(2.0);
+  int pure_bias = 0;
+  for (int h = 0; h < hinges->num_hinges(); ++h) {
+    if (hinges->bias_weight(h) != 1.0) continue;
+    ++pure_bias;
+    const double expected = hinges->area_weight(h) * bias.Energy(hinges->HingeCurvature(x, h));
+    EXPECT_NEAR(hinges->HingeEnergy(x, h), expected, 1e-12 * expected) << "hinge " << h;
+  }
+  EXPECT_GT(pure_bias, 0);  // the criss-cross diagonals
+  options.discretization = BendingDiscretization::kTensor;
+  try {
+    ClothProblem tensor(mesh, m, {}, options);
+    FAIL() << "the tensor elements took a bias law";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bending_bias"), std::string::npos) << e.what();
+  }
+  m.bending_bias.reset();
+  EXPECT_NO_THROW(ClothProblem(mesh, m, {}, options));
+}
+
 }  // namespace
 }  // namespace textile

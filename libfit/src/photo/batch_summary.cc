@@ -235,22 +235,27 @@ std::optional<Material> FabricMaterial(const std::string& fabric,
                               : weft ? StripDirection::kWeft
                                      : StripDirection::kBias;
   json notes = json::array();
-  Material m = LawOnlyMaterial(MeanLaw(by[main], main, &notes),
-                               units::GsmToSi(gsm / static_cast<double>(n)));
+  std::map<StripDirection, BendingLaw> mean;  // one a measured direction, its notes once
+  for (StripDirection d : kDirections)
+    if (!by[d].empty()) mean.emplace(d, MeanLaw(by[d], d, &notes));
+  Material m = LawOnlyMaterial(mean.at(main), units::GsmToSi(gsm / static_cast<double>(n)));
   m.name = fabric;
-  if (warp && weft) m.bending_weft = MeanLaw(by[StripDirection::kWeft], StripDirection::kWeft, &notes);
-  if (!by[StripDirection::kBias].empty() && main != StripDirection::kBias)
-    m.bending_bias = MeanLaw(by[StripDirection::kBias], StripDirection::kBias, &notes);
+  if (warp && weft) m.bending_weft = mean.at(StripDirection::kWeft);
+  if (mean.contains(StripDirection::kBias) && main != StripDirection::kBias)
+    m.bending_bias = mean.at(StripDirection::kBias);
   if (gsm_max > 1.01 * gsm_min)
     notes.push_back("the specimens' gsm range " + NumberText(gsm_min) + " .. " +
                     NumberText(gsm_max) + " g/m²: the material takes their mean");
-  if (!(warp && weft))
-    notes.push_back(std::string("only the ") + DirectionName(main) +
-                    " direction was fitted: the material is isotropic with its law");
+  if (main == StripDirection::kBias)
+    notes.push_back("only the bias direction was fitted: the material takes its law for every "
+                    "direction");
+  else if (!(warp && weft))
+    notes.push_back(std::string("of warp and weft only the ") + DirectionName(main) +
+                    " direction was fitted: the material takes its law for both");
   if (m.bending_bias)
     notes.push_back(
-        "bending_bias is the bias mean: exports carry it; simulations blend warp and weft by "
-        "angle (docs/methods/materials.md, \"Warp, weft and bias\") and do not take it");
+        "bending_bias is the bias mean: the drape blends it with warp and weft by angle "
+        "(docs/methods/materials.md, \"Warp, weft and bias\") and the exports carry it");
   json directions = json::object();
   for (StripDirection d : kDirections) {
     if (by[d].empty()) continue;
@@ -258,7 +263,7 @@ std::optional<Material> FabricMaterial(const std::string& fabric,
     for (const SpecimenOutcome* o : by[d]) names.push_back(o->row->specimen);
     directions[DirectionName(d)] = {{"n", by[d].size()},
                                     {"specimens", names},
-                                    {"law_kes", LawToJson(MeanLaw(by[d], d, nullptr), false)}};
+                                    {"law_kes", LawToJson(mean.at(d), false)}};
   }
   m.fit = {{"method", "batch mean"}, {"directions", directions}};
   if (!notes.empty()) m.extra["notes"] = notes;

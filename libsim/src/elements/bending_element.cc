@@ -113,9 +113,12 @@ struct LawCoefficients {
 struct DihedralLanesIn {
   bool pabst;        // else Bridson
   bool anisotropic;  // blend warp and weft with warp_weight
+  bool bias;         // and the bias law with bias_weight
   const LawCoefficients* warp;
   const LawCoefficients* weft;
-  const double *rest_angle, *inv_height, *weight, *warp_weight, *sin_half, *cos_half;
+  const LawCoefficients* bias_law;
+  const double *rest_angle, *inv_height, *weight, *warp_weight, *bias_weight, *sin_half,
+      *cos_half;
 };
 
 // Outputs: energy[l] (when asked), dE/dθ times ∂θ/∂x as grad[3 i + c][l] (when asked),
@@ -129,7 +132,25 @@ struct DihedralLanesOut {
 
 // One block of dihedral hinges: bend angle, law, gradient (docs/methods/bending.md). kHessian: grad is
 // ∂θ/∂x unscaled and d_energy, d2_energy are filled.
-enum class LaneModel { kPabst, kPabstWarpWeft, kBridson };
+enum class LaneModel { kPabst, kPabstWarpWeft, kPabstWarpWeftBias, kBridson };
+
+// The law's value f(law) for lane l: the warp law's, or the blend of the direction laws with the
+// lane's weights (the weft's is 1 - warp - bias).
+template <LaneModel kModel, class F>
+TEXTILE_ALWAYS_INLINE double LaneLaw(const DihedralLanesIn& in, const LawCoefficients& warp,
+                                     const LawCoefficients& weft, const LawCoefficients& bias,
+                                     int l, F&& f) {
+  const double a = f(warp);
+  if constexpr (kModel == LaneModel::kPabstWarpWeft) {
+    const double ww = in.warp_weight[l];
+    return ww * a + (1.0 - ww) * f(weft);
+  } else if constexpr (kModel == LaneModel::kPabstWarpWeftBias) {
+    const double ww = in.warp_weight[l], wb = in.bias_weight[l];
+    return ww * a + wb * f(bias) + (1.0 - ww - wb) * f(weft);
+  } else {
+    return a;
+  }
+}
 
 // Where the kernel reads coordinate c of corner i of lane l: gathered lanes (LanePositions) or
 // straight from the positions through the corners' offsets (GatherPositions).
@@ -149,7 +170,7 @@ template <LaneModel kModel, bool kEnergy, bool kGradient, bool kHessian, class P
 TEXTILE_ALWAYS_INLINE void DihedralLanesImpl(const DihedralLanesIn& in, const Positions& pos,
                                              DihedralLanesOut* out) {
   // Local copies: loads in the arms of a conditional through a pointer would not if-convert.
-  const LawCoefficients warp = *in.warp, weft = *in.weft;
+  const LawCoefficients warp = *in.warp, weft = *in.weft, bias = *in.bias_law;
 #pragma omp simd
   for (int l = 0; l < kLanes; ++l) {
     const double x2x = PositionAt(pos, 2, 0, l), x2y = PositionAt(pos, 2, 1, l),
@@ -170,26 +191,25 @@ TEXTILE_ALWAYS_INLINE void DihedralLanesImpl(const DihedralLanesIn& in, const Po
     if constexpr (kModel != LaneModel::kBridson) {
       const double kappa = (Atan2(sin_term, cos_term) - in.rest_angle[l]) * in.inv_height[l];
       const double w = in.weight[l], ih = in.inv_height[l];
-      double m = warp.Moment(kappa);
-      if constexpr (kModel == LaneModel::kPabstWarpWeft) {
-        const double ww = in.warp_weight[l];
-        m = ww * m + (1.0 - ww) * weft.Moment(kappa);
-      }
+      const double m = LaneLaw<kModel>(in, warp, weft, bias, l,
+                                       [kappa](const LawCoefficients& c) __attribute__((always_inline)) {
+                                         return c.Moment(kappa);
+                                       });
       d_energy = w * m * ih;
       if constexpr (kHessian) {
-        double b = warp.Stiffness(kappa);
-        if constexpr (kModel == LaneModel::kPabstWarpWeft) {
-          const double ww = in.warp_weight[l];
-          b = ww * b + (1.0 - ww) * weft.Stiffness(kappa);
-        }
+        const double b = LaneLaw<kModel>(
+            in, warp, weft, bias, l,
+            [kappa](const LawCoefficients& c) __attribute__((always_inline)) {
+              return c.Stiffness(kappa);
+            });
         d2_energy = w * b * ih * ih;
       }
       if constexpr (kEnergy) {
-        double psi = warp.Energy(kappa);
-        if constexpr (kModel == LaneModel::kPabstWarpWeft) {
-          const double ww = in.warp_weight[l];
-          psi = ww * psi + (1.0 - ww) * weft.Energy(kappa);
-        }
+        const double psi = LaneLaw<kModel>(
+            in, warp, weft, bias, l,
+            [kappa](const LawCoefficients& c) __attribute__((always_inline)) {
+              return c.Energy(kappa);
+            });
         energy = w * psi;
       }
     } else {
@@ -249,6 +269,8 @@ TEXTILE_SIMD_CLONES void HessianInputLanes(const DihedralLanesIn& in, const Lane
                                            DihedralLanesOut* out) {
   if (!in.pabst) {
     DihedralLanesImpl<LaneModel::kBridson, false, false, true>(in, pos, out);
+  } else if (in.bias) {
+    DihedralLanesImpl<LaneModel::kPabstWarpWeftBias, false, false, true>(in, pos, out);
   } else if (in.anisotropic) {
     DihedralLanesImpl<LaneModel::kPabstWarpWeft, false, false, true>(in, pos, out);
   } else {
@@ -320,9 +342,10 @@ TEXTILE_ALWAYS_INLINE double DihedralBlocksImpl(const DihedralBlocksIn& in, long
                               {in.corner[0] + b, in.corner[1] + b, in.corner[2] + b,
                                in.corner[3] + b}};
     const DihedralLanesIn& r = in.rest;
-    const DihedralLanesIn lanes{r.pabst,          r.anisotropic,       r.warp,
-                                r.weft,           r.rest_angle + b,    r.inv_height + b,
-                                r.weight + b,     r.warp_weight + b,   r.sin_half + b,
+    const DihedralLanesIn lanes{r.pabst,           r.anisotropic,     r.bias,
+                                r.warp,            r.weft,            r.bias_law,
+                                r.rest_angle + b,  r.inv_height + b,  r.weight + b,
+                                r.warp_weight + b, r.bias_weight + b, r.sin_half + b,
                                 r.cos_half + b};
     DihedralLanesImpl<kModel, kEnergy, kGradient, false>(lanes, pos, &out);
     if constexpr (kEnergy)
@@ -372,6 +395,10 @@ TEXTILE_SIMD_CLONES double DihedralBlocks(const DihedralBlocksIn& in, long begin
                                           bool energy, double* grad, double* hinge_grad) {
   if (!in.rest.pabst) {
     return DihedralBlocksModel<LaneModel::kBridson>(in, begin, end, energy, grad, hinge_grad);
+  }
+  if (in.rest.bias) {
+    return DihedralBlocksModel<LaneModel::kPabstWarpWeftBias>(in, begin, end, energy, grad,
+                                                              hinge_grad);
   }
   if (in.rest.anisotropic) {
     return DihedralBlocksModel<LaneModel::kPabstWarpWeft>(in, begin, end, energy, grad,
@@ -634,24 +661,35 @@ bool BendingOptions::Check(std::string* why) const {
 BendingElements::BendingElements(const TriangleMesh& rest, const std::vector<Hinge>& hinges,
                                  const Material& material, const BendingOptions& options,
                                  const std::vector<double>& stiffness_multiplier)
-    : BendingElements(rest, hinges, material.EffectiveLaw(),
-                      material.bending_weft ? std::optional<BendingLaw>(material.EffectiveWeftLaw())
-                                            : std::nullopt,
+    : BendingElements(rest, hinges,
+                      DirectionLaws{material.EffectiveLaw(),
+                                    material.bending_weft
+                                        ? std::optional<BendingLaw>(material.EffectiveWeftLaw())
+                                        : std::nullopt,
+                                    material.EffectiveBiasLaw()},
                       options, stiffness_multiplier) {}
 
 BendingElements::BendingElements(const TriangleMesh& rest, const std::vector<Hinge>& hinges,
                                  const BendingLaw& warp, const std::optional<BendingLaw>& weft,
                                  const BendingOptions& options,
                                  const std::vector<double>& stiffness_multiplier)
+    : BendingElements(rest, hinges, DirectionLaws{warp, weft, std::nullopt}, options,
+                      stiffness_multiplier) {}
+
+BendingElements::BendingElements(const TriangleMesh& rest, const std::vector<Hinge>& hinges,
+                                 const DirectionLaws& laws, const BendingOptions& options,
+                                 const std::vector<double>& stiffness_multiplier)
     : options_(options),
-      warp_(warp),
-      weft_(weft ? *weft : warp),
-      anisotropic_(weft.has_value()),
+      warp_(laws.warp),
+      weft_(laws.weft ? *laws.weft : laws.warp),
+      bias_(laws.bias ? *laws.bias : laws.warp),
+      anisotropic_(laws.weft.has_value() || laws.bias.has_value()),
+      has_bias_(laws.bias.has_value()),
       num_vertices_(rest.num_vertices()),
       hinges_(hinges) {
   if (std::string why; !options.Check(&why)) throw InputError(why);
-  hinge_by_hinge_ =
-      options_.model == BendingModel::kPabst && (warp_.is_spline() || weft_.is_spline());
+  hinge_by_hinge_ = options_.model == BendingModel::kPabst &&
+                    (warp_.is_spline() || weft_.is_spline() || bias_.is_spline());
   const int nh = static_cast<int>(hinges.size());
   if (!stiffness_multiplier.empty() && static_cast<int>(stiffness_multiplier.size()) != nh) {
     throw InputError("bending: stiffness multiplier has " +
@@ -708,10 +746,14 @@ BendingElements::BendingElements(const TriangleMesh& rest, const std::vector<Hin
     // edge, so an edge along the weft (y) bends a warp strip, with the warp law.
     // In the pattern plane: a curved rest edge's z does not count towards either yarn.
     const double in_plane = e.x() * e.x() + e.y() * e.y();
-    r.warp_weight = !anisotropic_ ? 1.0 : in_plane > 0.0 ? e.y() * e.y() / in_plane : 0.5;
+    const LawWeights lw =
+        !anisotropic_ ? LawWeights{}
+                      : DirectionWeights(in_plane > 0.0 ? e.y() * e.y() / in_plane : 0.5, has_bias_);
+    r.warp_weight = lw.warp;
+    r.bias_weight = lw.bias;
     edge_length_[h] = l;
     const double area_weight = l * height;  // A_h = |ē| h̄e = Ā0 + Ā1
-    const double b1 = r.warp_weight * warp_.b1() + (1.0 - r.warp_weight) * weft_.b1();
+    const double b1 = lw.warp * warp_.b1() + lw.weft * weft_.b1() + lw.bias * bias_.b1();
     const double s = multiplier_[h];
     switch (options_.model) {
       case BendingModel::kPabst:
@@ -756,6 +798,7 @@ BendingElements::BendingElements(const TriangleMesh& rest, const std::vector<Hin
     d.inv_height.assign(padded, 1.0);
     d.weight.assign(padded, 0.0);
     d.warp_weight.assign(padded, 1.0);
+    d.bias_weight.assign(padded, 0.0);
     d.sin_half.assign(padded, 0.0);
     d.cos_half.assign(padded, 1.0);
     for (int i = 0; i < 4; ++i) d.corner[i].assign(padded, nh > 0 ? 3 * rest_[0].v[i] : 0);
@@ -764,6 +807,7 @@ BendingElements::BendingElements(const TriangleMesh& rest, const std::vector<Hin
       d.inv_height[h] = rest_[h].inv_height;
       d.weight[h] = rest_[h].weight;
       d.warp_weight[h] = rest_[h].warp_weight;
+      d.bias_weight[h] = rest_[h].bias_weight;
       for (int i = 0; i < 4; ++i) d.corner[i][h] = 3 * rest_[h].v[i];
       if (options_.model == BendingModel::kBridson) {
         d.sin_half[h] = half_angle_[2 * h];
@@ -789,17 +833,24 @@ int BendingElements::NumThreads() const {
   return std::clamp(n, 1, kMaxThreads);
 }
 
+// The hinge's law value f(law): the warp law's, or the blend of the direction laws (the same
+// arithmetic as LaneLaw).
+template <class F>
+double BendingElements::HingeLaw(const HingeRest& r, F&& f) const {
+  const double a = f(warp_);
+  if (!anisotropic_) return a;
+  const double ww = r.warp_weight, wb = r.bias_weight;
+  if (!has_bias_) return ww * a + (1.0 - ww) * f(weft_);
+  return ww * a + wb * f(bias_) + (1.0 - ww - wb) * f(weft_);
+}
 double BendingElements::LawEnergy(const HingeRest& r, double kappa) const {
-  if (!anisotropic_) return warp_.Energy(kappa);
-  return r.warp_weight * warp_.Energy(kappa) + (1.0 - r.warp_weight) * weft_.Energy(kappa);
+  return HingeLaw(r, [kappa](const BendingLaw& law) { return law.Energy(kappa); });
 }
 double BendingElements::LawMoment(const HingeRest& r, double kappa) const {
-  if (!anisotropic_) return warp_.Moment(kappa);
-  return r.warp_weight * warp_.Moment(kappa) + (1.0 - r.warp_weight) * weft_.Moment(kappa);
+  return HingeLaw(r, [kappa](const BendingLaw& law) { return law.Moment(kappa); });
 }
 double BendingElements::LawStiffness(const HingeRest& r, double kappa) const {
-  if (!anisotropic_) return warp_.Stiffness(kappa);
-  return r.warp_weight * warp_.Stiffness(kappa) + (1.0 - r.warp_weight) * weft_.Stiffness(kappa);
+  return HingeLaw(r, [kappa](const BendingLaw& law) { return law.Stiffness(kappa); });
 }
 
 // Energy of hinge h and, for the dihedral models, dE/dθ and d²E/dθ² (null pointers skip them).
@@ -875,7 +926,7 @@ double BendingElements::Evaluate(const Vertices& x, double* grad) const {
   const BendingModel model = options_.model;
 
   const bool linear = model == BendingModel::kVolino || model == BendingModel::kIsometric;
-  const LawCoefficients warp(warp_), weft(weft_);
+  const LawCoefficients warp(warp_), weft(weft_), bias(bias_);
 
   auto linear_run = [&](long begin, long end, int thread) {
     double energy = 0.0;
@@ -903,12 +954,15 @@ double BendingElements::Evaluate(const Vertices& x, double* grad) const {
   auto dihedral_run = [&](long begin, long end, int thread) {
     const DihedralLanesIn rest{model == BendingModel::kPabst,
                                anisotropic_,
+                               has_bias_,
                                &warp,
                                &weft,
+                               &bias,
                                dihedral_.rest_angle.data(),
                                dihedral_.inv_height.data(),
                                dihedral_.weight.data(),
                                dihedral_.warp_weight.data(),
+                               dihedral_.bias_weight.data(),
                                dihedral_.sin_half.data(),
                                dihedral_.cos_half.data()};
     const DihedralBlocksIn in{rest,
@@ -1108,15 +1162,18 @@ void BendingElements::HessianBlocks(const Vertices& x, HessianProjection project
       pos.p[3 * i + 2][l] = p[2];
     }
   }
-  const LawCoefficients warp(warp_), weft(weft_);
+  const LawCoefficients warp(warp_), weft(weft_), bias(bias_);
   const DihedralLanesIn in{options_.model == BendingModel::kPabst,
                            anisotropic_,
+                           has_bias_,
                            &warp,
                            &weft,
+                           &bias,
                            dihedral_.rest_angle.data() + first,
                            dihedral_.inv_height.data() + first,
                            dihedral_.weight.data() + first,
                            dihedral_.warp_weight.data() + first,
+                           dihedral_.bias_weight.data() + first,
                            dihedral_.sin_half.data() + first,
                            dihedral_.cos_half.data() + first};
   DihedralLanesOut out;

@@ -57,19 +57,16 @@ std::vector<Direction> Directions(const Material& m) {
 // u axis (dde.cpp: the angle of the edge's du). An edge along u (the warp) is bent by a
 // curvature along the weft: row 0 is the weft law, row 2 the warp law.
 nlohmann::json ArcsimBendingTable(const Material& m) {
-  const BlendedLaw by_edge[3] = {
-      BlendedLaw(m.EffectiveLaw(), m.EffectiveWeftLaw(), 0.5 * std::numbers::pi),  // curvature ∥ weft
-      BlendedLaw(m.EffectiveLaw(), m.EffectiveWeftLaw(), 0.25 * std::numbers::pi),
-      BlendedLaw(m.EffectiveLaw(), m.EffectiveWeftLaw(), 0.0)};  // curvature ∥ warp
-  const std::optional<BendingLaw> bias = m.EffectiveBiasLaw();  // measured: the 45° row's
+  // The 45° row is the measured bias law where the material has one (the blend's weights).
+  const BlendedLaw by_edge[3] = {m.EffectiveLawAt(0.5 * std::numbers::pi),  // curvature ∥ weft
+                                 m.EffectiveLawAt(0.25 * std::numbers::pi),
+                                 m.EffectiveLawAt(0.0)};  // curvature ∥ warp
   nlohmann::json table = nlohmann::json::array();
-  for (int r = 0; r < 3; ++r) {
+  for (const BlendedLaw& law : by_edge) {
     nlohmann::json row = nlohmann::json::array();
-    for (double alpha : kArcsimBendingAlpha) {
-      const double kappa = kArcsimCurvaturePerAlpha * alpha;
-      row.push_back(kArcsimStiffnessPerSecant * (r == 1 && bias ? SecantStiffness(*bias, kappa)
-                                                                : SecantStiffness(by_edge[r], kappa)));
-    }
+    for (double alpha : kArcsimBendingAlpha)
+      row.push_back(kArcsimStiffnessPerSecant *
+                    SecantStiffness(law, kArcsimCurvaturePerAlpha * alpha));
     table.push_back(row);
   }
   return table;

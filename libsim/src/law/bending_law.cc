@@ -394,29 +394,64 @@ double BendingLaw::b1_kes() const { return units::SiStiffnessToKes(b1_); }
 double BendingLaw::b2_kes() const { return units::SiStiffnessToKes(b2_); }
 double BendingLaw::c1_kes() const { return units::SiQuadraticToKes(c1_); }
 
-BlendedLaw::BlendedLaw(const BendingLaw& warp, const BendingLaw& weft, double phi)
-    : warp_(warp), weft_(weft) {
-  const double c = std::cos(phi);
-  w_warp_ = c * c;
-  w_weft_ = 1.0 - w_warp_;
+LawWeights DirectionWeights(double cos_sq_phi, bool with_bias) {
+  const double c2 = std::clamp(cos_sq_phi, 0.0, 1.0);
+  if (!with_bias) return {c2, 1.0 - c2, 0.0};
+  double c = 2.0 * c2 - 1.0;  // cos 2φ
+  if (std::abs(c) < 1e-12) c = 0.0;  // φ = 45° up to round-off (cos²(π/4) = 0.5000000000000001)
+  if (c >= 0.0) return {c, 0.0, 1.0 - c};
+  return {0.0, -c, 1.0 + c};
 }
 
+BlendedLaw::BlendedLaw(const BendingLaw& warp, const BendingLaw& weft, double phi)
+    : BlendedLaw(warp, weft, std::nullopt, phi) {}
+
+BlendedLaw::BlendedLaw(const BendingLaw& warp, const BendingLaw& weft,
+                       const std::optional<BendingLaw>& bias, double phi)
+    : warp_(warp), weft_(weft), bias_(bias ? *bias : warp) {
+  const double c = std::cos(phi);
+  w_ = DirectionWeights(c * c, bias.has_value());
+}
+
+namespace {
+
+// w_warp f(warp) + w_weft f(weft) + w_bias f(bias), skipping the laws of weight 0.
+template <class F>
+double Blend(const LawWeights& w, const BendingLaw& warp, const BendingLaw& weft,
+             const BendingLaw& bias, F&& f) {
+  double sum = 0.0;
+  if (w.warp != 0.0) sum += w.warp * f(warp);
+  if (w.weft != 0.0) sum += w.weft * f(weft);
+  if (w.bias != 0.0) sum += w.bias * f(bias);
+  return sum;
+}
+
+}  // namespace
+
 double BlendedLaw::Moment(double kappa) const {
-  return w_warp_ * warp_.Moment(kappa) + w_weft_ * weft_.Moment(kappa);
+  return Blend(w_, warp_, weft_, bias_, [&](const BendingLaw& l) { return l.Moment(kappa); });
 }
 
 double BlendedLaw::Stiffness(double kappa) const {
-  return w_warp_ * warp_.Stiffness(kappa) + w_weft_ * weft_.Stiffness(kappa);
+  return Blend(w_, warp_, weft_, bias_, [&](const BendingLaw& l) { return l.Stiffness(kappa); });
 }
 
 double BlendedLaw::Energy(double kappa) const {
-  return w_warp_ * warp_.Energy(kappa) + w_weft_ * weft_.Energy(kappa);
+  return Blend(w_, warp_, weft_, bias_, [&](const BendingLaw& l) { return l.Energy(kappa); });
 }
 
 double BlendedLaw::Curvature(double moment) const {
-  // M is strictly increasing; each pure law's inverse brackets the blend's.
-  double lo = warp_.Curvature(moment), hi = weft_.Curvature(moment);
-  if (lo > hi) std::swap(lo, hi);
+  // M is strictly increasing; the inverses of the laws it blends bracket the blend's.
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  const auto bracket = [&](double weight, const BendingLaw& law) {
+    if (weight == 0.0) return;
+    const double k = law.Curvature(moment);
+    lo = std::min(lo, k);
+    hi = std::max(hi, k);
+  };
+  bracket(w_.warp, warp_);
+  bracket(w_.weft, weft_);
+  bracket(w_.bias, bias_);
   double k = 0.5 * (lo + hi);
   for (int it = 0; it < 100 && hi > lo; ++it) {
     const double f = Moment(k) - moment;

@@ -694,18 +694,6 @@ std::vector<Note> MaterialDefaultNotes(const Material& m) {
   return notes;
 }
 
-std::optional<Note> BiasNotSimulatedNote(const Material& m) {
-  if (!m.bending_bias) return std::nullopt;
-  const double blend = 0.5 * (m.EffectiveLaw().b1() + m.EffectiveWeftLaw().b1());
-  const double measured = m.EffectiveBiasLaw()->b1();
-  return Note{"bias_not_simulated",
-              "bending_bias is not simulated: bending at angle φ to the warp blends the warp and "
-              "weft laws by cos²φ, whose 45° b1 is " +
-                  NumberText(units::SiStiffnessToKes(blend), 4) + " gf·cm against the measured " +
-                  NumberText(units::SiStiffnessToKes(measured), 4) +
-                  " (docs/methods/materials.md, \"Warp, weft and bias\")"};
-}
-
 bool Material::Check(std::string* why) const {
   std::string w;
   const auto field = [&w](const char* name, const std::string& problem) {

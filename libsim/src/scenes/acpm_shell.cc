@@ -74,13 +74,22 @@ Clock::time_point DeadlineAfter(double seconds) {
                             std::chrono::duration<double>(std::min(seconds, 1e7)));
 }
 
+// The material as the push bends it: along the warp, so a measured bias law takes no part
+// (the curvature-tensor elements, the default, take none; the hinges would bend their diagonals
+// with it, an artefact of the grid, not of the strip).
+Material WarpStrip(const Material& material) {
+  Material m = material;
+  m.bending_bias.reset();
+  return m;
+}
+
 // One push: the sample at a given overhang, its grid and its solver state.
 class PushedSample {
  public:
   PushedSample(const Material& material, const AcpmOptions& options, const AcpmSeam& seam,
                const ShellAcpmSettings& settings, double reference_overhang,
                Clock::time_point deadline)
-      : material_(material),
+      : material_(WarpStrip(material)),
         options_(options),
         seam_(seam),
         settings_(settings),
@@ -248,7 +257,7 @@ class PushedSample {
   }
 
  private:
-  const Material& material_;
+  const Material material_;
   const AcpmOptions& options_;
   AcpmSeam seam_;
   ShellAcpmSettings settings_;

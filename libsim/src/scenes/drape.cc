@@ -582,7 +582,9 @@ double RimTurnDownLength(const Material& material, const DrapeOptions& o) {
   if (!(overhang > 0.0) || !Finite(overhang))
     throw InputError("rim turn-down length: the specimen must be larger than the support");
   const BendingLaw warp = material.EffectiveLaw(), weft = material.EffectiveWeftLaw();
-  const double b = std::min(warp.MinStiffness(), weft.MinStiffness());  // the softest B
+  double b = std::min(warp.MinStiffness(), weft.MinStiffness());  // the softest B
+  if (const std::optional<BendingLaw> bias = material.EffectiveBiasLaw())
+    b = std::min(b, bias->MinStiffness());
   const double g = ClothOptions{}.gravity.norm();  // [m/s²]
   return std::sqrt(b / (material.areal_density * g * overhang));
 }
@@ -852,7 +854,6 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
   result.notes = drape_internal::DrapeNotes(o, result, rim_capped);
   // A membrane the file did not give is a guess the DC depends on: the run says which parts.
   for (Note& n : MaterialDefaultNotes(material)) result.notes.push_back(std::move(n));
-  if (std::optional<Note> bias = BiasNotSimulatedNote(material)) result.notes.push_back(*bias);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

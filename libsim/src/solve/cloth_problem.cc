@@ -86,9 +86,19 @@ ClothProblem::ClothProblem(const TriangleMesh& rest, const Material& material,
   const std::optional<BendingLaw> weft = WeftLaw(material, options_.bending_scale);
   const std::vector<double> multipliers = Multipliers(rest_, hinges_, seams);
   if (options_.discretization == BendingDiscretization::kTensor) {
+    // docs/methods/materials.md, "Warp, weft and bias": the twist term a bias law fixes can
+    // make the tensor energy non-convex, so these elements take warp and weft only.
+    if (material.bending_bias) {
+      throw InputError(
+          "bending_bias: the curvature-tensor bending takes warp and weft laws only; use the "
+          "hinge discretisation for a material with a measured bias law");
+    }
     tensor_.emplace(rest_, hinges_, warp, weft, multipliers);
   } else {
-    bending_.emplace(rest_, hinges_, warp, weft, options_.bending, multipliers);
+    std::optional<BendingLaw> bias = material.EffectiveBiasLaw();
+    if (bias) bias = bias->Scaled(options_.bending_scale);
+    bending_.emplace(rest_, hinges_, DirectionLaws{warp, weft, bias}, options_.bending,
+                     multipliers);
   }
   BuildPattern();
 }

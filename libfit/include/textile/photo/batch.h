@@ -161,8 +161,8 @@ nlohmann::json SummaryJson(const std::vector<SpecimenOutcome>& specimens);
 // summary.csv from SummaryJson: one row a fabric and direction.
 std::string SummaryCsv(const nlohmann::json& summary);
 // The material of one fabric from its direction means: the warp law (or the only one measured),
-// the weft law when both were measured, and the bias mean as bending_bias (exports carry it,
-// simulations do not take it: a note says so).
+// the weft law when both were measured, and the bias mean as bending_bias (the drape blends
+// it in by angle, exports carry it; a note says so).
 // None, with the reason in *why (if non-null), when no specimen of the fabric was fitted or the
 // means make no law a material file takes.
 std::optional<Material> FabricMaterial(const std::string& fabric,

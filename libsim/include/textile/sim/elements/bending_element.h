@@ -132,7 +132,13 @@ class BendingElements {
                   const BendingLaw& warp, const std::optional<BendingLaw>& weft,
                   const BendingOptions& options = {},
                   const std::vector<double>& stiffness_multiplier = {});
-  // The material's effective (β-scaled) warp and weft laws.
+  // The same with a measured bias law (a strip cut at 45°; nullopt: none): a hinge then blends
+  // the laws with DirectionWeights (bending_law.h), linear in cos 2ψ between the two measured
+  // directions its bending lies between.
+  BendingElements(const TriangleMesh& rest, const std::vector<Hinge>& hinges,
+                  const DirectionLaws& laws, const BendingOptions& options = {},
+                  const std::vector<double>& stiffness_multiplier = {});
+  // The material's effective (β-scaled) warp, weft and bias laws.
   BendingElements(const TriangleMesh& rest, const std::vector<Hinge>& hinges,
                   const Material& material, const BendingOptions& options = {},
                   const std::vector<double>& stiffness_multiplier = {});
@@ -192,20 +198,22 @@ class BendingElements {
   double rest_edge_length(int h) const { return edge_length_[h]; }                   // |ē| [m]
   double area_weight(int h) const { return edge_length_[h] / rest_[h].inv_height; }  // A_h [m²]
   double stiffness_multiplier(int h) const { return multiplier_[h]; }                // S
-  double warp_weight(int h) const { return rest_[h].warp_weight; }                   // cos²ψ
+  double warp_weight(int h) const { return rest_[h].warp_weight; }  // w_warp (cos²ψ without bias)
+  double bias_weight(int h) const { return rest_[h].bias_weight; }  // w_bias (0 without bias)
   // Bend angle θ [rad], hinge curvature κ = (θ - θ̄)/h̄e [1/m] and energy [J] of hinge h.
   double BendAngle(const Vertices& x, int h) const;
   double HingeCurvature(const Vertices& x, int h) const;
   double HingeEnergy(const Vertices& x, int h) const;
 
  private:
-  // Hot per-hinge rest data, one contiguous array (48 bytes a hinge).
+  // Hot per-hinge rest data, one contiguous array (56 bytes a hinge).
   struct HingeRest {
     std::array<int, 4> v;
     double rest_angle;   // θ̄ [rad]
     double inv_height;   // 1/h̄e [1/m]
     double weight;       // Pabst: S A_h [m²]; Bridson: S k_h [J]; linear: S k_h [N/m]
-    double warp_weight;  // cos²ψ of BlendedLaw
+    double warp_weight;  // DirectionWeights(cos²ψ).warp; the weft's is 1 - warp - bias
+    double bias_weight;  // DirectionWeights(cos²ψ).bias
   };
   // Linear models: R = Σ alpha[i] x_v[i], rest value R̄.
   struct LinearRest {
@@ -215,7 +223,8 @@ class BendingElements {
 
   // Dihedral models, structure of arrays padded to a multiple of the SIMD block (hot loop).
   struct DihedralRest {
-    std::vector<double> rest_angle, inv_height, weight, warp_weight, sin_half, cos_half;
+    std::vector<double> rest_angle, inv_height, weight, warp_weight, bias_weight, sin_half,
+        cos_half;
     std::array<std::vector<int>, 4> corner;  // 3 v[i]: offset of corner i's position in x
   };
 
@@ -238,14 +247,17 @@ class BendingElements {
   double HingeTerms(const Vertices& x, int h, double* d_energy, double* d2_energy) const;
   double DihedralTerms(double cos_term, double sin_term, int h, double* d_energy, double* d2_energy,
                        bool want_energy) const;
+  template <class F>
+  double HingeLaw(const HingeRest& r, F&& f) const;
   double LawEnergy(const HingeRest& r, double kappa) const;
   double LawMoment(const HingeRest& r, double kappa) const;
   double LawStiffness(const HingeRest& r, double kappa) const;
   int NumThreads() const;
 
   BendingOptions options_;
-  BendingLaw warp_, weft_;
-  bool anisotropic_ = false;
+  BendingLaw warp_, weft_, bias_;  // bias_ is warp_ when the fabric has no bias law
+  bool anisotropic_ = false;        // a weft or a bias law: the hinges blend by direction
+  bool has_bias_ = false;
   // The Pabst model with a spline law: hinge by hinge through BendingLaw (the SIMD kernels
   // inline the three-constant law).
   bool hinge_by_hinge_ = false;

@@ -34,6 +34,7 @@
 #include <array>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -147,24 +148,49 @@ class BendingLaw {
   std::shared_ptr<const Spline> spline_;  // null for a Pabst law; immutable, so shared by copies
 };
 
-// Warp/weft anisotropy (docs/spec/physics.md): bending whose direction (the curvature's, across
-// a hinge's edge) makes angle φ with the warp follows M(κ) = cos²φ M_warp(κ) + sin²φ M_weft(κ):
-// the warp law is the bending of a strip cut along the warp, as a lab measures it. The blend of two laws is again
-// odd, C1 and strictly increasing; its inverse is found by safeguarded Newton.
+// The weights of the warp, weft and bias laws for bending in a direction (the curvature's,
+// across a hinge's edge) at angle φ to the warp (docs/methods/materials.md, "Warp, weft and
+// bias"); none negative, their sum 1. cos_sq_phi = cos²φ in [0, 1].
+// - Without a bias law: cos²φ, sin²φ, 0 (docs/spec/physics.md), so the bias is the mean of the
+//   warp and weft laws.
+// - With one, linear in cos 2φ between the two measured directions φ lies between:
+//   cos 2φ ≥ 0 (φ ≤ 45°): warp cos 2φ, bias 1 - cos 2φ; else weft |cos 2φ|, bias 1 - |cos 2φ|.
+//   A bias law equal to the mean of warp and weft gives the cos²φ blend back exactly.
+struct LawWeights {
+  double warp = 1.0, weft = 0.0, bias = 0.0;
+};
+LawWeights DirectionWeights(double cos_sq_phi, bool with_bias);
+
+// The laws of the directions a lab measures: the warp (the only one of an isotropic fabric), and
+// where measured the weft and the bias (a strip cut at 45°).
+struct DirectionLaws {
+  BendingLaw warp;
+  std::optional<BendingLaw> weft, bias;
+};
+
+// Warp/weft(/bias) anisotropy: bending whose direction makes angle φ with the warp follows
+// M(κ) = w_warp M_warp(κ) + w_weft M_weft(κ) + w_bias M_bias(κ), the weights of
+// DirectionWeights: the warp law is the bending of a strip cut along the warp, as a lab measures
+// it, the bias law that of a strip cut at 45°. A blend of laws is again odd, C1 and strictly
+// increasing; its inverse is found by safeguarded Newton.
 class BlendedLaw {
  public:
   // phi: angle between the bending direction (the curvature's: across a hinge's edge) and the
   // warp [rad]; 0 is a strip cut along the warp, π/2 one cut along the weft.
   BlendedLaw(const BendingLaw& warp, const BendingLaw& weft, double phi);
+  // The same with a measured bias law (none: the two-law blend above).
+  BlendedLaw(const BendingLaw& warp, const BendingLaw& weft, const std::optional<BendingLaw>& bias,
+             double phi);
   double Moment(double kappa) const;      // [N]
   double Stiffness(double kappa) const;   // [N·m]
   double Energy(double kappa) const;      // [J/m²]
   double Curvature(double moment) const;  // [1/m], to 1e-14 relative
-  double warp_weight() const { return w_warp_; }
+  double warp_weight() const { return w_.warp; }
+  const LawWeights& weights() const { return w_; }
 
  private:
-  BendingLaw warp_, weft_;
-  double w_warp_, w_weft_;
+  BendingLaw warp_, weft_, bias_;
+  LawWeights w_;
 };
 
 }  // namespace textile

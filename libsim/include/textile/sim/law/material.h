@@ -57,9 +57,9 @@ struct Material {
   double areal_density = 0.0;                // ρ [kg/m²]
   BendingLaw bending = BendingLaw::FromKes(0.1, 0.1, 0.0);  // warp law (or the only law)
   std::optional<BendingLaw> bending_weft;    // weft law, when anisotropic
-  // A measured bias law (a strip cut at 45°), when the lab measured one: exports and reports
-  // carry it (ARCSim's 45° row, the fork's pcb_bending_bias, CLO and Browzwear's bias). The
-  // simulations blend warp and weft by angle and do not take it (BiasNotSimulatedNote).
+  // A measured bias law (a strip cut at 45°), when the lab measured one. The hinge bending
+  // blends it with warp and weft by angle (DirectionWeights in bending_law.h); exports and
+  // reports carry it (ARCSim's 45° row, the fork's pcb_bending_bias, CLO and Browzwear's bias).
   std::optional<BendingLaw> bending_bias;
   double beta = 1.0;                         // linear bending stiffness factor β (section 3.4)
   // The membrane (docs/methods/materials.md, "Membrane"). Isotropic (stabilised StVK of
@@ -116,16 +116,15 @@ struct Material {
   std::optional<BendingLaw> EffectiveBiasLaw() const {
     return bending_bias ? std::optional<BendingLaw>(bending_bias->Scaled(beta)) : std::nullopt;
   }
+  // The effective laws blended for bending at angle phi [rad] to the warp (DirectionWeights).
+  BlendedLaw EffectiveLawAt(double phi) const {
+    return BlendedLaw(EffectiveLaw(), EffectiveWeftLaw(), EffectiveBiasLaw(), phi);
+  }
 };
 
 // One note a default the material's membrane uses (code "membrane_default"), naming the field,
 // the value and docs/methods/materials.md; none when the file gave every membrane field.
 std::vector<Note> MaterialDefaultNotes(const Material& material);
-
-// The note a simulation that blends warp and weft by angle gives for a material with a measured
-// bias law it does not take (code "bias_not_simulated"), naming the blend's 45° stiffness and the
-// measured one; none without bending_bias.
-std::optional<Note> BiasNotSimulatedNote(const Material& material);
 
 // A material of a law and an areal density [kg/m²] alone, as a file with only
 // `areal_density_gsm` and `bending` reads: its membrane the documented defaults, each listed in

@@ -51,7 +51,9 @@ struct ClothOptions {
   MembraneModel membrane = MembraneModel::kStVK;  // stabilised StVK (Sensitive Couture)
   BendingOptions bending;                         // Pabst's law by default
   // Hinge energies (bending.model) or Pabst's law on a curvature tensor per triangle
-  // (tensor_bending.h: bend and twist separate, the stiffness of a free strip right).
+  // (tensor_bending.h: bend and twist separate, the stiffness of a free strip right). The
+  // tensor takes warp and weft laws only: ClothProblem refuses it for a material with a
+  // measured bias law (bending_bias), which the hinges blend in.
   BendingDiscretization discretization = BendingDiscretization::kHinge;
   Eigen::Vector3d gravity{0.0, 0.0, -9.80665};    // [m/s²]
   ContactOptions contact;                         // used when supports are added

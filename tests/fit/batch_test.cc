@@ -340,7 +340,7 @@ TEST(Batch, OptionsAndAnUnusableFolderAreRefusedBeforeAnySpecimen) {
   EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
-TEST(BatchSummary, AFabricWithOneDirectionIsIsotropicAndSaysSo) {
+TEST(BatchSummary, AFabricWithOneOfWarpAndWeftTakesItsLawForBothAndSaysSo) {
   const fs::path dir = Scratch("one_direction");
   const Manifest m = ParseManifest(kHeader + "f,s,weft,face," + Fig8("60") + ",200\n" +
                                        "f,t,bias,face," + Fig8("80") + ",220\n",

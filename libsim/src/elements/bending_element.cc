@@ -746,9 +746,10 @@ BendingElements::BendingElements(const TriangleMesh& rest, const std::vector<Hin
     // edge, so an edge along the weft (y) bends a warp strip, with the warp law.
     // In the pattern plane: a curved rest edge's z does not count towards either yarn.
     const double in_plane = e.x() * e.x() + e.y() * e.y();
-    const LawWeights lw =
-        !anisotropic_ ? LawWeights{}
-                      : DirectionWeights(in_plane > 0.0 ? e.y() * e.y() / in_plane : 0.5, has_bias_);
+    // An edge with no extent in the plane (a curved rest state) takes the mean of warp and weft.
+    const LawWeights lw = !anisotropic_      ? LawWeights{}
+                          : in_plane > 0.0 ? DirectionWeights(e.y() * e.y() / in_plane, has_bias_)
+                                           : LawWeights{0.5, 0.5, 0.0};
     r.warp_weight = lw.warp;
     r.bias_weight = lw.bias;
     edge_length_[h] = l;

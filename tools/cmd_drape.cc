@@ -56,6 +56,9 @@ struct DrapeArgs {
   std::string compare;
   std::optional<double> dc_tol, node_tol, outline_tol_mm;
   bool strict = false;
+  // --sensitivity, and the parameters it is taken for (comma-separated; empty: all).
+  bool sensitivity = false;
+  std::string sensitivity_params;
 };
 
 SeamProfile LoadSeamProfile(const DrapeArgs& a) {
@@ -148,6 +151,17 @@ DrapeOptions Options(const DrapeArgs& a) {
   }
   if (a.seeds < 1 || a.seeds > 1000) throw InputError("--seeds: must be in 1..1000");
   o.seeds = a.seeds;
+  if (!a.sensitivity_params.empty() && !a.sensitivity)
+    throw InputError("--sensitivity-params: needs --sensitivity");
+  o.sensitivity = a.sensitivity;
+  for (size_t from = 0; !a.sensitivity_params.empty() && from <= a.sensitivity_params.size();) {
+    const size_t comma = std::min(a.sensitivity_params.find(',', from), a.sensitivity_params.size());
+    const std::string name = a.sensitivity_params.substr(from, comma - from);
+    if (name.empty())
+      throw InputError("--sensitivity-params: '" + a.sensitivity_params + "' has an empty name");
+    o.sensitivity_parameters.push_back(name);
+    from = comma + 1;
+  }
   o.first_seed = a.first_seed;
   if (a.resolution_mm) {
     const double h = finite(*a.resolution_mm, "--resolution-mm");
@@ -430,6 +444,21 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
     j["scene"]["seam_profile"] = SeamProfileToJson(o.seam_profile);
     if (o.seams == DrapeSeams::kShifted) j["scene"]["shift_mm"] = units::MToMm(o.seam_shift);
   }
+  if (o.sensitivity) {
+    j["drape_coefficient_sigma"] = NumberOrNull(r.drape_coefficient_sigma);
+    j["drape_coefficient_sigma_note"] = r.sigma_note;
+    j["sensitivity_seconds"] = r.sensitivity_seconds;
+    j["sensitivities"] = nlohmann::json::array();
+    for (const DrapeSensitivity& s : r.sensitivities)
+      j["sensitivities"].push_back({{"parameter", s.parameter},
+                                    {"value", s.value},
+                                    {"unit", s.unit},
+                                    {"defaulted", s.defaulted},
+                                    {"d_dc_d_ln_p", s.d_dc_d_ln_p},
+                                    {"uncertainty_ln", NumberOrNull(s.uncertainty_ln)},
+                                    {"uncertainty_source", s.uncertainty_source},
+                                    {"dc_change", s.dc_change}});
+  }
   j["material"] = MaterialToJson(m);
   // Where the membrane's compression ratio came from: the file, or --compression-ratio over it.
   j["scene"]["compression_ratio"] = m.compression_ratio;
@@ -437,6 +466,20 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
   j["material"]["file"] = a.material;
   j["seconds"] = r.seconds;
   return j;
+}
+
+// The DC's σ and the influence table, largest change first.
+void PrintSensitivities(const DrapeResult& r) {
+  std::cout << "DC sigma: "
+            << (std::isfinite(r.drape_coefficient_sigma) ? Num(r.drape_coefficient_sigma, 2)
+                                                         : std::string("none"))
+            << " (" << r.sigma_note << ")\n"
+            << "influence (dDC/dln p; DC change over the uncertainty):\n";
+  for (const DrapeSensitivity& s : r.sensitivities)
+    std::cout << "  " << s.parameter << " = " << Num(s.value, 4)
+              << (s.unit == "-" ? std::string() : " " + s.unit)
+              << (s.defaulted ? " (default)" : "") << ": " << Num(s.d_dc_d_ln_p, 3) << "; "
+              << Num(s.dc_change, 2) << " over " << s.uncertainty_source << "\n";
 }
 
 // The result as text on stdout (the JSON's figures, rounded for people).
@@ -492,6 +535,7 @@ void PrintText(const DrapeResult& r, const DrapeOptions& o, const Material& m, c
   }
   if (!note.empty()) std::cout << "\nnote: " << note;
   std::cout << "\n";
+  if (o.sensitivity) PrintSensitivities(r);
   if (comparison) PrintComparison(*comparison, a, r.per_seed.size() > 1);
   std::cout << "time: " << Num(r.seconds, 3) << " s\nresult: " << a.out
             << "\noutline: " << outline_path << "\n";
@@ -692,6 +736,13 @@ void RegisterDrape(CLI::App& app) {
                   "rotation [mm] (default: reported, not judged)");
   sub->add_flag("--strict", a->strict,
                 "--compare: a failed verdict is an error (exit 3, nothing written)");
+  sub->add_flag("--sensitivity", a->sensitivity,
+                "Each material parameter's influence on the DC (dDC/dln p, and the DC's change "
+                "over the parameter's uncertainty) and the DC's sigma from the fit's covariance; "
+                "clamped mount only (docs/methods/sensitivity.md)");
+  sub->add_option("--sensitivity-params", a->sensitivity_params,
+                  "--sensitivity: only these parameters, comma-separated as the material file "
+                  "names them (b1,b2,c1,beta,areal_density_gsm,stretch.warp,...)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   sub->callback([a] { Run(*a); });
 }

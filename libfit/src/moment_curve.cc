@@ -8,6 +8,7 @@
 #include "csv_text.h"
 #include "textile/sim/core/error.h"
 #include "textile/sim/core/units.h"
+#include "textile/sim/law/material_parameters.h"
 
 namespace textile {
 namespace {
@@ -111,19 +112,11 @@ std::optional<Eigen::Matrix3d> FitCovariance(const Material& m, const std::strin
       return std::nullopt;
     }
   }
-  const nlohmann::json& c = f["covariance_kes"];
-  const double to_si[3] = {units::KesStiffnessToSi(1.0), units::KesStiffnessToSi(1.0),
-                           units::KesQuadraticToSi(1.0)};
-  Eigen::Matrix3d cov;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      if (!c.is_array() || c.size() != 3 || !c[i].is_array() || c[i].size() != 3 ||
-          !c[i][j].is_number())
-        throw InputError(source + ": fit.covariance_kes must be a 3×3 array of numbers");
-      cov(i, j) = c[i][j].get<double>() * to_si[i] * to_si[j];
-    }
+  try {
+    return MaterialFitCovariance(m);
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
   }
-  return cov;
 }
 
 std::optional<double> FitCurvatureReach(const Material& m) {

@@ -469,6 +469,37 @@ TEST(CliDrape, CompressionRatioOverridesTheMaterialsAndIsReported) {
   EXPECT_GT(s["drape_coefficient"].get<double>(), p["drape_coefficient"].get<double>() + 0.08);
 }
 
+// --sensitivity adds the DC's σ (null without a fit covariance, with the reason) and the
+// influence table, largest change first, to drape.json and the text; the unmeasured membrane
+// default (compression ratio) leads for the Fig. 8 file.
+TEST(CliDrape, SensitivityReportsTheInfluenceTableAndSigma) {
+  const auto dir = Scratch("CliDrape.Sensitivity");
+  const auto r = Textile("drape " + kFig8 + kCoarse + " --sensitivity -o " +
+                         (dir / "s.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("DC sigma: none"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("influence (dDC/dln p"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(ReadAll(dir / "s.json"));
+  EXPECT_TRUE(j["drape_coefficient_sigma"].is_null());
+  EXPECT_NE(j["drape_coefficient_sigma_note"].get<std::string>().find("no fit covariance"),
+            std::string::npos);
+  const auto& table = j["sensitivities"];
+  ASSERT_EQ(table.size(), 8u);  // b1 b2 c1 beta density, stiffness poisson compression_ratio
+  EXPECT_EQ(table[0]["parameter"], "stretch.compression_ratio");
+  EXPECT_TRUE(table[0]["defaulted"].get<bool>());
+  for (size_t k = 1; k < table.size(); ++k)
+    EXPECT_GE(table[k - 1]["dc_change"].get<double>(), table[k]["dc_change"].get<double>());
+  for (const auto& row : table) {
+    if (row["parameter"] == "b1") {
+      EXPECT_GT(row["d_dc_d_ln_p"].get<double>(), 0.0);
+    }
+  }
+  // Without the flag the result has none of it.
+  const auto plain = Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "p.json").string());
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_FALSE(nlohmann::json::parse(ReadAll(dir / "p.json")).contains("sensitivities"));
+}
+
 // --start-modes widens the start perturbation's band of harmonics; the result records it, and a
 // different start on the same fabric is a different first seed's drape (docs/methods/drapemeter.md,
 // "Nodes").

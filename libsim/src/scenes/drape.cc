@@ -372,6 +372,10 @@ bool DrapeOptions::Check(std::string* why) const {
   if (!Finite(node_prominence_relative) || node_prominence_relative < 0.0 ||
       node_prominence_relative >= 1.0)
     return Fail(why, "node_prominence_relative: must be in [0, 1)");
+  if (sensitivity && mount != DrapeMount::kClamped)
+    return Fail(why,
+                "sensitivity: clamped mount only (the resting mount's friction state has no "
+                "derivative here)");
   return true;
 }
 
@@ -674,6 +678,10 @@ struct SeedState {
   DrapeSeedResult seed;
   std::unique_ptr<ClothProblem> fine_problem;  // the split's friction anchors come from it
   std::string failure;                         // why this seed has no DC
+  // With a rim split: the base mesh's equilibrium and the split mesh's problem (sensitivities).
+  Vertices base_positions;
+  std::unique_ptr<ClothProblem> split_problem;
+  std::vector<double> d_dc_d_p;  // with options.sensitivity: ∂DC/∂p per parameter [per SI unit]
 };
 
 // The shadow of x on `mesh` into *shadow, and its DC.
@@ -726,6 +734,7 @@ void SettleSplit(const Material& material, const DrapeOptions& o, const DrapeSce
     Say(o, line.str());
   }
   auto split_problem = MakeProblem(*scene.split, material, scene.seams, o);
+  st->base_positions = seed.positions;
   seed.positions = scene.refined.Prolong(seed.positions);
   // Resting: the friction goes on from where each node landed on the base mesh.
   if (o.mount == DrapeMount::kResting)
@@ -742,6 +751,26 @@ void SettleSplit(const Material& material, const DrapeOptions& o, const DrapeSce
     seed.shadow = DrapeShadow{};
     seed.base_drape_coefficient = kNaN;
   }
+  st->split_problem = std::move(split_problem);
+}
+
+// Stage 5 (sensitivity): ∂DC/∂p of a converged seed, through each equilibrium it was measured
+// on; with a split rim the extrapolation's DC_split + (DC_split - DC_base)/2.
+void SeedSensitivities(const Material& material, const DrapeOptions& o, const DrapeScene& scene,
+                       const DrapeResult& result, const std::vector<std::string>& parameters,
+                       SeedState* st) {
+  if (!o.sensitivity || !st->seed.converged) return;
+  const auto derivatives = [&](ClothProblem* problem, const Vertices& x, const Pattern& p) {
+    return drape_internal::DcDerivatives(problem, x, p.pm.mesh.triangles, material, o, result,
+                                         parameters);
+  };
+  if (!scene.split) {
+    st->d_dc_d_p = derivatives(st->fine_problem.get(), st->seed.positions, scene.fine);
+    return;
+  }
+  const std::vector<double> base = derivatives(st->fine_problem.get(), st->base_positions, scene.fine);
+  st->d_dc_d_p = derivatives(st->split_problem.get(), st->seed.positions, *scene.split);
+  for (size_t k = 0; k < base.size(); ++k) st->d_dc_d_p[k] = 1.5 * st->d_dc_d_p[k] - 0.5 * base[k];
 }
 
 // How deep the deepest node lies inside the resting mount's disk [m].
@@ -835,13 +864,24 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
   if (std::string why; !o.Check(&why)) throw InputError("drape options: " + why);
   DrapeResult result;
   result.rim_turn_down = RimTurnDownLength(material, o);
+  // Sensitivities: the names and the covariance checked before any work (InputError).
+  const std::vector<std::string> parameters = drape_internal::SensitivityParameters(material, o);
   const DrapeScene scene = BuildScene(o, &result);
   Say(o, SceneReport(scene, result));
   std::string failure;  // the first failing seed's
+  std::vector<std::vector<double>> seed_derivatives;
   for (int k = 0; k < o.seeds; ++k) {
     SeedState st = SettleBase(material, o, scene, o.first_seed + static_cast<unsigned>(k), &result);
     SettleSplit(material, o, scene, result, &st);
     MeasureSeed(o, scene, result, &st.seed);
+    const auto sensitivity_start = std::chrono::steady_clock::now();
+    SeedSensitivities(material, o, scene, result, parameters, &st);
+    if (!st.d_dc_d_p.empty()) {
+      result.sensitivity_seconds +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - sensitivity_start).count();
+      result.sensitivity_equilibria += scene.split ? 2 : 1;
+    }
+    if (!st.d_dc_d_p.empty()) seed_derivatives.push_back(std::move(st.d_dc_d_p));
     Say(o, SeedReport(st.seed, scene.split != nullptr));
     if (!st.seed.converged && failure.empty())
       failure = "seed " + std::to_string(st.seed.seed) + ": " + st.failure;
@@ -849,6 +889,8 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
   }
   drape_internal::SummariseSeeds(&result);
   if (!result.converged) result.message = failure;
+  if (o.sensitivity && result.converged)
+    drape_internal::SummariseSensitivities(material, parameters, seed_derivatives, &result);
   bool rim_capped = false;
   if (o.rim_auto) AutoRimElementSize(material, o, o.rim_extrapolation, &rim_capped);
   result.notes = drape_internal::DrapeNotes(o, result, rim_capped);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "textile/sim/scenes/drape.h"
+#include "textile/sim/solve/cloth_problem.h"
 #include "textile/sim/core/note.h"
 
 namespace textile::drape_internal {
@@ -45,6 +46,23 @@ void AddSupportShadow(double support_radius, DrapeShadow* shadow);
 void FloodFromBorder(DrapeShadow* shadow);
 void MeasureOutline(int bins, DrapeShadow* shadow);
 void FillEmptyBins(Eigen::VectorXd* radii);
+
+// Sensitivities (drape_sensitivity.cc). The parameters options.sensitivity asks for (every
+// parameter of the material when none is named; none without sensitivity), each checked, and the
+// material's fit covariance checked: InputError before any work.
+std::vector<std::string> SensitivityParameters(const Material& material,
+                                               const DrapeOptions& options);
+// ∂DC/∂p [per SI unit] of one equilibrium x of `problem` (on `triangles`) for each parameter:
+// the equilibrium's sensitivity (EquilibriumSensitivity) through the traced outline's area.
+std::vector<double> DcDerivatives(ClothProblem* problem, const Vertices& x,
+                                  const Triangles& triangles, const Material& material,
+                                  const DrapeOptions& options, const DrapeResult& result,
+                                  const std::vector<std::string>& parameters);
+// result->sensitivities (means over the seeds' derivatives, with each parameter's uncertainty,
+// largest dc_change first), drape_coefficient_sigma and sigma_note.
+void SummariseSensitivities(const Material& material, const std::vector<std::string>& parameters,
+                            const std::vector<std::vector<double>>& seed_derivatives,
+                            DrapeResult* result);
 
 }  // namespace textile::drape_internal
 

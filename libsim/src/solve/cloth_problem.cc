@@ -71,6 +71,7 @@ ClothProblem::ClothProblem(const TriangleMesh& rest, const Material& material,
                            const std::vector<Seam>& seams, const ClothOptions& options)
     : rest_(Checked(rest)),
       options_(Checked(options)),
+      seams_(seams),
       masses_(LumpedMasses(rest, material.areal_density, seams)),
       membrane_(rest, material, options.membrane),
       hinges_(BuildHinges(rest)),
@@ -82,25 +83,51 @@ ClothProblem::ClothProblem(const TriangleMesh& rest, const Material& material,
   penalty_ = masses_ * (g_scale / options_.contact.sink_under_own_weight);
   tangential_stiffness_ = options_.contact.tangential_ratio * material.MembraneModulus();
   // Only the chosen discretisation is built; both take the hinges and their seam multipliers.
-  const BendingLaw warp = material.EffectiveLaw().Scaled(options_.bending_scale);
-  const std::optional<BendingLaw> weft = WeftLaw(material, options_.bending_scale);
-  const std::vector<double> multipliers = Multipliers(rest_, hinges_, seams);
+  multipliers_ = Multipliers(rest_, hinges_, seams);
   if (options_.discretization == BendingDiscretization::kTensor) {
-    // docs/methods/materials.md, "Warp, weft and bias": the twist term a bias law fixes can
-    // make the tensor energy non-convex, so these elements take warp and weft only.
-    if (material.bending_bias) {
-      throw InputError(
-          "bending_bias: the curvature-tensor bending takes warp and weft laws only; use the "
-          "hinge discretisation for a material with a measured bias law");
-    }
-    tensor_.emplace(rest_, hinges_, warp, weft, multipliers);
+    tensor_.emplace(TensorElements(material));
   } else {
-    std::optional<BendingLaw> bias = material.EffectiveBiasLaw();
-    if (bias) bias = bias->Scaled(options_.bending_scale);
-    bending_.emplace(rest_, hinges_, DirectionLaws{warp, weft, bias}, options_.bending,
-                     multipliers);
+    bending_.emplace(HingeElements(material));
   }
   BuildPattern();
+}
+
+DirectionLaws ClothProblem::BendingLaws(const Material& material) const {
+  std::optional<BendingLaw> bias = material.EffectiveBiasLaw();
+  if (bias) bias = bias->Scaled(options_.bending_scale);
+  return {material.EffectiveLaw().Scaled(options_.bending_scale),
+          WeftLaw(material, options_.bending_scale), bias};
+}
+
+BendingElements ClothProblem::HingeElements(const Material& material) const {
+  return BendingElements(rest_, hinges_, BendingLaws(material), options_.bending, multipliers_);
+}
+
+TensorBending ClothProblem::TensorElements(const Material& material) const {
+  // docs/methods/materials.md, "Warp, weft and bias": the twist term a bias law fixes can
+  // make the tensor energy non-convex, so these elements take warp and weft only.
+  if (material.bending_bias) {
+    throw InputError(
+        "bending_bias: the curvature-tensor bending takes warp and weft laws only; use the "
+        "hinge discretisation for a material with a measured bias law");
+  }
+  const DirectionLaws laws = BendingLaws(material);
+  return TensorBending(rest_, hinges_, laws.warp, laws.weft, multipliers_);
+}
+
+Vertices ClothProblem::MaterialGradient(const Vertices& x, const Material& other,
+                                        int parts) const {
+  Vertices grad = Vertices::Zero(x.rows(), 3);
+  if (parts & kMembranePart) MembraneElements(rest_, other, options_.membrane).AddGradient(x, grad);
+  if ((parts & kBendingPart) && tensor_) TensorElements(other).EnergyGradient(x, grad);
+  if ((parts & kBendingPart) && !tensor_) HingeElements(other).AddGradient(x, grad);
+  if (parts & kGravityPart) {
+    const Eigen::VectorXd masses = LumpedMasses(rest_, other.areal_density, seams_);
+    for (int i = 0; i < num_vertices(); ++i)
+      grad.row(i) -= masses(i) * options_.gravity.transpose();
+  }
+  for (int v : fixed_) grad.row(v).setZero();
+  return grad;
 }
 
 int ClothProblem::num_bending_elements() const {

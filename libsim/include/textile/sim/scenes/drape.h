@@ -43,6 +43,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,7 @@
 #include "textile/sim/mesh/mesh.h"
 #include "textile/sim/core/note.h"
 #include "textile/sim/law/seam.h"
+#include "textile/sim/scenes/drape_sensitivity.h"
 #include "textile/sim/solve/static_solver.h"
 
 namespace textile {
@@ -166,6 +168,12 @@ struct DrapeOptions {
   // Called with one line of progress (meshing, each seed's outcome); may be empty.
   std::function<void(const std::string&)> progress;
 
+  // Sensitivities (drape_sensitivity.h, docs/methods/sensitivity.md): the DC's derivative for
+  // each of sensitivity_parameters (empty: every parameter of the material,
+  // MaterialParameterNames), its influence and the DC's 1-σ. Clamped mount only.
+  bool sensitivity = false;
+  std::vector<std::string> sensitivity_parameters;
+
   // False with "<field>: <problem>" when a field is out of range.
   bool Check(std::string* why) const;
 };
@@ -274,6 +282,16 @@ struct DrapeResult {
   //   skirt_sink         resting: the skirt sank over 0.3 mm into the support
   //   reversed_bracket   rim extrapolation: a seed's split rim gave a lower DC than its base
   std::vector<Note> notes;
+  // With options.sensitivity (and converged): each parameter's influence, the largest
+  // dc_change first; the DC's 1-σ from the fit's covariance of the bending law's b1, b2, c1
+  // (NaN when the material carries none, sigma_note saying so).
+  std::vector<DrapeSensitivity> sensitivities;
+  double drape_coefficient_sigma = std::numeric_limits<double>::quiet_NaN();
+  std::string sigma_note;
+  // Wall time of the sensitivities, all seeds and equilibria: factorisations, the parameters'
+  // differences and back-substitutions, the outlines [s].
+  double sensitivity_seconds = 0.0;
+  int sensitivity_equilibria = 0;  // equilibria differentiated (two a seed with a split rim)
 };
 
 // The largest |seam_shift| [m] a shifted seam may have: one element (element_size) inside the
@@ -286,7 +304,7 @@ std::vector<SeamLine> DrapeSeamLines(const DrapeOptions& options);
 // ℓ = sqrt(B / (ρ g (R − R_s))) [m]: the length over which the overhang turns down at the rim,
 // the boundary layer of a strip of stiffness B [N·m] clamped flat and pulled down by the weight
 // of the hanging overhang (ρ g (R − R_s) [N/m]); B is the smallest initial or ultimate stiffness
-// of the warp and weft laws (β applied). The DC's shortfall scales with the rim's element size
+// of the warp, weft and bias laws (β applied). The DC's shortfall scales with the rim's element size
 // over ℓ (docs/methods/drapemeter.md, "Resolution at the rim"); `--rim-mm auto` meshes the rim with
 // ℓ/3. Throws InputError for a material without a density or a specimen not larger than the
 // support.

@@ -83,6 +83,16 @@ class ClothProblem {
   void SetFixedPositions(const Vertices& positions);
   void AddSupport(const Support& support);
 
+  // ∇E [N] at x of the parts a material gives (membrane, bending, gravity), for `other` in
+  // place of the problem's material on the same pattern, seams and options; zero on fixed
+  // vertices. Contact is left out. For design sensitivities (sensitivity.h): the difference of
+  // two such gradients over a parameter step is ∂R/∂p, with the contact state frozen.
+  // `parts` limits it to those (MaterialPart bits; a part the change does not touch adds nothing
+  // to a difference). Throws InputError as the constructor does for `other`.
+  enum MaterialPart { kMembranePart = 1, kBendingPart = 2, kGravityPart = 4, kAllParts = 7 };
+  Vertices MaterialGradient(const Vertices& x, const Material& other,
+                            int parts = kAllParts) const;
+
   // Total potential energy [J] at x (#V×3 [m]), with the current anchors.
   double Energy(const Vertices& x) const;
   // Fills grad (#V×3, resized) with ∇E [N], zero on fixed vertices; returns E [J].
@@ -184,15 +194,21 @@ class ClothProblem {
   double UpdateLaggedFriction(int i, double depth, const Eigen::Vector3d& normal);
   void BuildPattern();
   void DropFixedFromPattern();
+  // A material's bending laws (β and bending_scale applied) and elements on this pattern.
+  DirectionLaws BendingLaws(const Material& material) const;
+  BendingElements HingeElements(const Material& material) const;
+  TensorBending TensorElements(const Material& material) const;
   // Bending Hessian elements [first, end) of the active discretisation into triplets_.
   int num_bending_elements() const;
   void BendingTriplets(const Vertices& x, HessianProjection projection, int first, int end);
 
   TriangleMesh rest_;
   ClothOptions options_;
+  std::vector<Seam> seams_;
   Eigen::VectorXd masses_;
   MembraneElements membrane_;
   std::vector<Hinge> hinges_;
+  std::vector<double> multipliers_;         // per hinge S(d) of the seams; empty: none
   std::optional<BendingElements> bending_;  // kHinge only
   std::optional<TensorBending> tensor_;     // kTensor only
   std::vector<Support> supports_;

@@ -1,0 +1,60 @@
+#ifndef TEXTILE_SIM_SOLVE_SENSITIVITY_H_
+#define TEXTILE_SIM_SOLVE_SENSITIVITY_H_
+
+// Design sensitivity of a static equilibrium (Umetani et al., Sensitive Couture, section 4):
+// at a converged state x, R(x, p) = ∇E(x; p) = 0 (SC eq. 1 with R the net force), and a
+// parameter change dp moves the equilibrium by the incremental update of SC section 4,
+//
+//   K dx = -(∂R/∂p) dp,   K = ∇ₓR = ∇²E(x), the exact (unprojected) Hessian,
+//
+// one back-substitution per parameter with one Cholesky factorisation of K
+// (docs/methods/sensitivity.md):
+//
+//   textile::EquilibriumSensitivity s(&problem, x, material);   // factorises K once
+//   textile::Vertices dx = s.Displacement("b1");                // ∂x/∂ln b1 [m]
+//
+// ∂R/∂p is a central difference of ClothProblem::MaterialGradient at fixed x over
+// p e^(±1e-4) (the elements are not differentiated by hand; the step's truncation error is
+// ~1e-8 relative). Contact and friction anchors stay as they are: the contact set is frozen.
+
+#include <memory>
+#include <string>
+
+#include "textile/sim/law/material.h"
+#include "textile/sim/solve/cloth_problem.h"
+
+namespace textile {
+
+class EquilibriumSensitivity {
+ public:
+  // Factorises K at x (#V×3 [m], fixed vertices in place). `material` is the one `problem`
+  // was built with. Throws InputError when x is not an equilibrium of the problem (relative
+  // residual above max_residual: a sensitivity there means nothing), ComputeError when K is not
+  // positive definite (a buckling point, where the branch may change; no sensitivity exists).
+  EquilibriumSensitivity(ClothProblem* problem, const Vertices& x, const Material& material,
+                         double max_residual = 1e-4);
+  ~EquilibriumSensitivity();
+  EquilibriumSensitivity(const EquilibriumSensitivity&) = delete;
+  EquilibriumSensitivity& operator=(const EquilibriumSensitivity&) = delete;
+
+  // dx for a change of the net force dR (#V×3 [N]): K dx = -dR; zero on fixed vertices.
+  Vertices Solve(const Vertices& residual_change) const;
+  // ∂R/∂p [N per unit of p, SI] for a material parameter (material_parameters.h), by central
+  // differences; throws InputError for an unknown name or when the stepped material is invalid.
+  Vertices ResidualDerivative(const std::string& parameter) const;
+  // ∂x/∂p [m per unit of p, SI]: -K⁻¹ ∂R/∂p.
+  Vertices DisplacementPerUnit(const std::string& parameter) const;
+  // ∂x/∂ln p = p ∂x/∂p [m] (zero for a parameter that is 0, e.g. c1 of a linear law).
+  Vertices Displacement(const std::string& parameter) const;
+
+ private:
+  struct Factor;
+  ClothProblem* problem_;
+  Vertices x_;
+  Material material_;
+  std::unique_ptr<Factor> factor_;
+};
+
+}  // namespace textile
+
+#endif  // TEXTILE_SIM_SOLVE_SENSITIVITY_H_

@@ -1,0 +1,182 @@
+#include "textile/sim/scenes/drape_sensitivity.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <utility>
+
+#include "drape_stages.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/law/material_parameters.h"
+#include "textile/sim/solve/sensitivity.h"
+
+namespace textile {
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
+
+double Angle(const Eigen::Vector2d& p) {
+  const double a = std::atan2(p.y(), p.x());
+  return a < 0.0 ? a + kTwoPi : a;
+}
+
+// Each edge of the mesh once (i < j).
+std::vector<std::array<int, 2>> UniqueEdges(const Triangles& triangles) {
+  std::vector<std::array<int, 2>> edges;
+  edges.reserve(3 * static_cast<size_t>(triangles.rows()));
+  for (int f = 0; f < triangles.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      int a = triangles(f, k), b = triangles(f, (k + 1) % 3);
+      if (a > b) std::swap(a, b);
+      edges.push_back({a, b});
+    }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  return edges;
+}
+
+Eigen::Vector2d Projected(const Vertices& x, int v) { return {x(v, 0), x(v, 1)}; }
+
+}  // namespace
+
+ShadowOutline TraceShadowOutline(const Vertices& x, const Triangles& triangles, int bins,
+                                 double support_radius) {
+  if (bins < 8) throw InputError("shadow outline: need at least 8 angle bins");
+  if (!x.allFinite()) throw InputError("shadow outline: non-finite vertex positions");
+  if (triangles.rows() == 0 || triangles.minCoeff() < 0 || triangles.maxCoeff() >= x.rows())
+    throw InputError("shadow outline: no triangles, or a vertex id out of range");
+  const double step = kTwoPi / bins;
+  ShadowOutline o;
+  o.radii.assign(bins, support_radius);
+  o.edge.assign(bins, {-1, -1});
+  o.along.assign(bins, 0.0);
+  for (const auto& [i, j] : UniqueEdges(triangles)) {
+    const Eigen::Vector2d p = Projected(x, i), q = Projected(x, j), e = q - p;
+    if (std::max(p.norm(), q.norm()) <= support_radius) continue;  // inside the support's disk
+    // The bins whose rays the edge's angular span (the short way round) holds.
+    double from = Angle(p), span = Angle(q) - from;
+    if (span > std::numbers::pi) span -= kTwoPi;
+    if (span < -std::numbers::pi) span += kTwoPi;
+    if (span < 0.0) from += span, span = -span;
+    const long first = static_cast<long>(std::ceil(from / step - 0.5));
+    const long last = static_cast<long>(std::floor((from + span) / step - 0.5));
+    for (long k = first; k <= last; ++k) {
+      const int b = static_cast<int>(((k % bins) + bins) % bins);
+      const double theta = (b + 0.5) * step;
+      const Eigen::Vector2d u(std::cos(theta), std::sin(theta));
+      const double denominator = Cross(u, e);
+      if (std::abs(denominator) <= 1e-300) continue;  // the edge runs along the ray
+      const double s = Cross(p, u) / denominator, r = Cross(p, e) / denominator;
+      if (s < 0.0 || s > 1.0 || !(r > o.radii[b])) continue;
+      o.radii[b] = r;
+      o.edge[b] = {i, j};
+      o.along[b] = s;
+    }
+  }
+  for (double r : o.radii) o.area += 0.5 * r * r * step;
+  return o;
+}
+
+double OutlineAreaDerivative(const ShadowOutline& outline, const Vertices& x, const Vertices& dx) {
+  const int bins = static_cast<int>(outline.radii.size());
+  const double step = kTwoPi / bins;
+  double d_area = 0.0;
+  for (int b = 0; b < bins; ++b) {
+    const auto [i, j] = outline.edge[b];
+    if (i < 0) continue;  // the support's rim: fixed
+    const double theta = (b + 0.5) * step, s = outline.along[b];
+    const Eigen::Vector2d u(std::cos(theta), std::sin(theta));
+    const Eigen::Vector2d e = Projected(x, j) - Projected(x, i), n(-e.y(), e.x());
+    const double un = u.dot(n);
+    if (std::abs(un) <= 1e-12 * n.norm()) continue;  // grazing: no first-order change
+    const Eigen::Vector2d v = (1.0 - s) * Projected(dx, i) + s * Projected(dx, j);
+    d_area += outline.radii[b] * (v.dot(n) / un) * step;
+  }
+  return d_area;
+}
+
+namespace drape_internal {
+
+// The outline's bins for the sensitivity: fine enough that the polar area is the raster's within
+// its cells whatever options.outline_bins (which is for the node count).
+constexpr int kSensitivityBins = 2048;
+
+std::vector<std::string> SensitivityParameters(const Material& material, const DrapeOptions& o) {
+  if (!o.sensitivity) return {};
+  MaterialFitCovariance(material);  // a malformed covariance is refused now, not after the solve
+  if (o.sensitivity_parameters.empty()) return MaterialParameterNames(material);
+  for (const std::string& name : o.sensitivity_parameters)
+    if (const std::string why = ParameterWithoutEffect(material, name); !why.empty())
+      throw InputError(why);
+  return o.sensitivity_parameters;
+}
+
+std::vector<double> DcDerivatives(ClothProblem* problem, const Vertices& x,
+                                  const Triangles& triangles, const Material& material,
+                                  const DrapeOptions& o, const DrapeResult& result,
+                                  const std::vector<std::string>& parameters) {
+  // The solve stops at o.solver.tolerance; a state 100 times further off is no equilibrium.
+  const EquilibriumSensitivity sensitivity(problem, x, material,
+                                           std::max(100.0 * o.solver.tolerance, 1e-6));
+  const ShadowOutline outline = TraceShadowOutline(x, triangles, kSensitivityBins, o.support_radius);
+  const double scale = result.specimen_area - result.support_area;
+  std::vector<double> d;
+  for (const std::string& p : parameters)
+    d.push_back(OutlineAreaDerivative(outline, x, sensitivity.DisplacementPerUnit(p)) / scale);
+  return d;
+}
+
+void SummariseSensitivities(const Material& material, const std::vector<std::string>& parameters,
+                            const std::vector<std::vector<double>>& seed_derivatives,
+                            DrapeResult* result) {
+  if (seed_derivatives.empty()) return;
+  const std::optional<Eigen::Matrix3d> covariance = MaterialFitCovariance(material);
+  Eigen::Vector3d law_gradient = Eigen::Vector3d::Zero();  // ∂DC/∂{b1, b2, c1}
+  int law_terms = 0;
+  result->sensitivities.clear();
+  for (size_t k = 0; k < parameters.size(); ++k) {
+    DrapeSensitivity s;
+    s.parameter = parameters[k];
+    const MaterialParameterValue v = GetMaterialParameter(material, s.parameter);
+    s.value = v.lab;
+    s.unit = v.unit;
+    s.defaulted = v.defaulted;
+    for (const std::vector<double>& d : seed_derivatives) s.d_dc_d_p += d[k];
+    s.d_dc_d_p /= static_cast<double>(seed_derivatives.size());
+    s.d_dc_d_ln_p = v.si * s.d_dc_d_p;
+    const ParameterUncertainty u = DefaultParameterUncertainty(material, s.parameter, covariance);
+    s.uncertainty_ln = u.ln;
+    s.uncertainty_source = u.source;
+    s.dc_change = std::abs(s.d_dc_d_p) * u.si;
+    for (int i = 0; i < 3; ++i)
+      if (s.parameter == std::array<const char*, 3>{"b1", "b2", "c1"}[i]) {
+        law_gradient(i) = s.d_dc_d_p;
+        ++law_terms;
+      }
+    result->sensitivities.push_back(std::move(s));
+  }
+  std::stable_sort(result->sensitivities.begin(), result->sensitivities.end(),
+                   [](const DrapeSensitivity& a, const DrapeSensitivity& b) {
+                     return a.dc_change > b.dc_change;
+                   });
+  result->drape_coefficient_sigma = std::numeric_limits<double>::quiet_NaN();
+  if (!covariance) {
+    result->sigma_note =
+        "no σ: the material carries no fit covariance (fit.covariance_kes); the table gives each "
+        "input's change over its stated or default uncertainty";
+  } else if (law_terms < 3) {
+    result->sigma_note = "no σ: b1, b2 and c1 must all be among the sensitivity's parameters";
+  } else {
+    result->drape_coefficient_sigma = std::sqrt(std::max(0.0, law_gradient.dot(*covariance * law_gradient)));
+    result->sigma_note =
+        "σ from the fit's covariance of b1, b2, c1 only; the membrane's and the density's "
+        "uncertainties are the table's";
+  }
+}
+
+}  // namespace drape_internal
+}  // namespace textile

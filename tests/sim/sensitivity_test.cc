@@ -1,0 +1,128 @@
+#include "textile/sim/solve/sensitivity.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "textile/sim/core/error.h"
+#include "textile/sim/law/material_parameters.h"
+#include "textile/sim/mesh/mesh.h"
+#include "textile/sim/solve/static_solver.h"
+
+namespace textile {
+namespace {
+
+// The Fig. 8 fabric on an isotropic membrane, and a parsed file with the orthotropic defaults.
+Material Fig8() {
+  Material m;
+  m.areal_density = 0.2;
+  m.bending = BendingLaw::FromKes(0.1, 0.0892, -0.0092);
+  return m;
+}
+
+// An 80 × 40 mm strip clamped flat along its first 6.7 mm (two columns of vertices: a single
+// pinned row would let it hang straight down, unbent), under its weight: the bending length
+// (17 mm) is well inside it, so every law constant, the density and the membrane move it.
+struct HangingStrip {
+  TriangleMesh mesh = CrissCrossGridMesh(0.08, 0.04, 12, 6);
+  std::vector<int> held;
+  HangingStrip() {
+    for (int v = 0; v < mesh.num_vertices(); ++v)
+      if (mesh.vertices(v, 0) < 0.08 / 12 + 1e-12) held.push_back(v);
+  }
+  std::unique_ptr<ClothProblem> Problem(const Material& m) const {
+    auto p = std::make_unique<ClothProblem>(mesh, m, std::vector<Seam>{}, ClothOptions{});
+    Vertices fixed(static_cast<long>(held.size()), 3);
+    for (size_t k = 0; k < held.size(); ++k) fixed.row(static_cast<long>(k)) = mesh.vertices.row(held[k]);
+    p->FixVertices(held, fixed);
+    return p;
+  }
+  // The equilibrium from `start`, solved tight (the differences below need it).
+  Vertices Solve(const Material& m, const Vertices& start) const {
+    auto p = Problem(m);
+    Vertices x = start;
+    SolveOptions o;
+    o.tolerance = 1e-11;
+    o.max_iterations = 400;
+    const SolveSummary s = SolveStatic(p.get(), &x, o);
+    EXPECT_TRUE(s.converged) << s.message;
+    return x;
+  }
+};
+
+// ∂x/∂ln p by one back-substitution against central differences of full solves (started from
+// the equilibrium, so they stay on its branch): within 2 % for every parameter that moves it.
+TEST(EquilibriumSensitivity, MatchesDifferencesOfFullSolvesForEachParameter) {
+  const HangingStrip strip;
+  const Material m = Fig8();
+  Vertices start = strip.mesh.vertices;
+  for (int v = 0; v < start.rows(); ++v) start(v, 2) = -0.3 * start(v, 0);  // tilted down
+  const Vertices x = strip.Solve(m, start);
+  auto problem = strip.Problem(m);
+  const EquilibriumSensitivity sensitivity(problem.get(), x, m);
+  constexpr double kStep = 1e-3;  // relative
+  for (const std::string name :
+       {"b1", "b2", "c1", "beta", "areal_density_gsm", "stretch.stiffness_N_per_m"}) {
+    const double p = GetMaterialParameter(m, name).si;
+    const Vertices up = strip.Solve(WithMaterialParameter(m, name, p * std::exp(kStep)), x);
+    const Vertices down = strip.Solve(WithMaterialParameter(m, name, p * std::exp(-kStep)), x);
+    const Vertices expected = (up - down) / (2.0 * kStep);
+    const Vertices got = sensitivity.Displacement(name);
+    ASSERT_GT(expected.norm(), 1e-9) << name << " does not move the strip";
+    EXPECT_LT((got - expected).norm(), 0.02 * expected.norm())
+        << name << ": |dx| " << got.norm() << " against " << expected.norm();
+    for (int v : strip.held) EXPECT_EQ(got.row(v).norm(), 0.0);
+  }
+  // β scales the law, M_β = β M: its sensitivity is the sum of the three constants'.
+  const Vertices sum = sensitivity.Displacement("b1") + sensitivity.Displacement("b2") +
+                       sensitivity.Displacement("c1");
+  EXPECT_LT((sensitivity.Displacement("beta") - sum).norm(), 1e-6 * sum.norm());
+}
+
+TEST(EquilibriumSensitivity, RefusesAStateThatIsNoEquilibriumAndUnknownParameters) {
+  const HangingStrip strip;
+  const Material m = Fig8();
+  auto problem = strip.Problem(m);
+  Vertices bent = strip.mesh.vertices;
+  for (int v = 0; v < bent.rows(); ++v) bent(v, 2) = -0.3 * bent(v, 0);
+  try {
+    EquilibriumSensitivity s(problem.get(), bent, m);
+    FAIL() << "took a state far from equilibrium";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not an equilibrium"), std::string::npos) << e.what();
+  }
+  const Vertices x = strip.Solve(m, bent);
+  const EquilibriumSensitivity s(problem.get(), x, m);
+  try {
+    s.Displacement("b3");
+    FAIL() << "took an unknown parameter";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'b3' is not a parameter"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("areal_density_gsm"), std::string::npos);
+  }
+}
+
+// A strip compressed between its held ends past Euler's load is an equilibrium (flat, by
+// symmetry) but no minimum: its stiffness has negative out-of-plane modes.
+TEST(EquilibriumSensitivity, RefusesAStiffnessThatIsNotPositiveDefinite) {
+  const HangingStrip strip;
+  const Material m = Fig8();
+  ClothOptions weightless;
+  weightless.gravity.setZero();
+  ClothProblem p(strip.mesh, m, {}, weightless);
+  // Compressed along x by 1 %: the membrane's compressive stress makes out-of-plane modes
+  // negative against the bending (an Euler strut past its load).
+  Vertices x = strip.mesh.vertices;
+  x.col(0) *= 0.99;
+  std::vector<int> ends;
+  for (int v = 0; v < x.rows(); ++v)
+    if (strip.mesh.vertices(v, 0) < 1e-12 || strip.mesh.vertices(v, 0) > 0.08 - 1e-12) ends.push_back(v);
+  Vertices fixed(static_cast<long>(ends.size()), 3);
+  for (size_t k = 0; k < ends.size(); ++k) fixed.row(static_cast<long>(k)) = x.row(ends[k]);
+  p.FixVertices(ends, fixed);
+  EXPECT_THROW(EquilibriumSensitivity(&p, x, m, 1e30), ComputeError);
+}
+
+}  // namespace
+}  // namespace textile

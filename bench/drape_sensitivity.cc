@@ -57,8 +57,8 @@ Benchmark DrapeSensitivityBenchmark() {
             if (!r.converged) throw ComputeError("drape-sensitivity: " + r.message);
             const int parameters = static_cast<int>(r.sensitivities.size());
             double d_b1 = std::nan("");
-            for (const DrapeSensitivity& s : r.sensitivities)
-              if (s.parameter == "b1") d_b1 = s.d_dc_d_ln_p;
+            for (const ParameterInfluence& s : r.sensitivities)
+              if (s.parameter == "b1") d_b1 = s.d_q_d_ln_p;
             double fd = std::nan("");
             if (!ctx.quick) {
               const double b1 = m.bending.b1();

@@ -151,17 +151,8 @@ DrapeOptions Options(const DrapeArgs& a) {
   }
   if (a.seeds < 1 || a.seeds > 1000) throw InputError("--seeds: must be in 1..1000");
   o.seeds = a.seeds;
-  if (!a.sensitivity_params.empty() && !a.sensitivity)
-    throw InputError("--sensitivity-params: needs --sensitivity");
   o.sensitivity = a.sensitivity;
-  for (size_t from = 0; !a.sensitivity_params.empty() && from <= a.sensitivity_params.size();) {
-    const size_t comma = std::min(a.sensitivity_params.find(',', from), a.sensitivity_params.size());
-    const std::string name = a.sensitivity_params.substr(from, comma - from);
-    if (name.empty())
-      throw InputError("--sensitivity-params: '" + a.sensitivity_params + "' has an empty name");
-    o.sensitivity_parameters.push_back(name);
-    from = comma + 1;
-  }
+  o.sensitivity_parameters = SensitivityParameterList(a.sensitivity, a.sensitivity_params);
   o.first_seed = a.first_seed;
   if (a.resolution_mm) {
     const double h = finite(*a.resolution_mm, "--resolution-mm");
@@ -449,15 +440,15 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
     j["drape_coefficient_sigma_note"] = r.sigma_note;
     j["sensitivity_seconds"] = r.sensitivity_seconds;
     j["sensitivities"] = nlohmann::json::array();
-    for (const DrapeSensitivity& s : r.sensitivities)
+    for (const ParameterInfluence& s : r.sensitivities)
       j["sensitivities"].push_back({{"parameter", s.parameter},
                                     {"value", s.value},
                                     {"unit", s.unit},
                                     {"defaulted", s.defaulted},
-                                    {"d_dc_d_ln_p", s.d_dc_d_ln_p},
+                                    {"d_dc_d_ln_p", s.d_q_d_ln_p},
                                     {"uncertainty_ln", NumberOrNull(s.uncertainty_ln)},
                                     {"uncertainty_source", s.uncertainty_source},
-                                    {"dc_change", s.dc_change}});
+                                    {"dc_change", s.change}});
   }
   j["material"] = MaterialToJson(m);
   // Where the membrane's compression ratio came from: the file, or --compression-ratio over it.
@@ -466,20 +457,6 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
   j["material"]["file"] = a.material;
   j["seconds"] = r.seconds;
   return j;
-}
-
-// The DC's σ and the influence table, largest change first.
-void PrintSensitivities(const DrapeResult& r) {
-  std::cout << "DC sigma: "
-            << (std::isfinite(r.drape_coefficient_sigma) ? Num(r.drape_coefficient_sigma, 2)
-                                                         : std::string("none"))
-            << " (" << r.sigma_note << ")\n"
-            << "influence (dDC/dln p; DC change over the uncertainty):\n";
-  for (const DrapeSensitivity& s : r.sensitivities)
-    std::cout << "  " << s.parameter << " = " << Num(s.value, 4)
-              << (s.unit == "-" ? std::string() : " " + s.unit)
-              << (s.defaulted ? " (default)" : "") << ": " << Num(s.d_dc_d_ln_p, 3) << "; "
-              << Num(s.dc_change, 2) << " over " << s.uncertainty_source << "\n";
 }
 
 // The result as text on stdout (the JSON's figures, rounded for people).
@@ -535,7 +512,7 @@ void PrintText(const DrapeResult& r, const DrapeOptions& o, const Material& m, c
   }
   if (!note.empty()) std::cout << "\nnote: " << note;
   std::cout << "\n";
-  if (o.sensitivity) PrintSensitivities(r);
+  if (o.sensitivity) PrintInfluences("DC", "", 1.0, r.drape_coefficient_sigma, r.sigma_note, r.sensitivities);
   if (comparison) PrintComparison(*comparison, a, r.per_seed.size() > 1);
   std::cout << "time: " << Num(r.seconds, 3) << " s\nresult: " << a.out
             << "\noutline: " << outline_path << "\n";
@@ -563,7 +540,10 @@ void Run(const DrapeArgs& a) {
   const DrapeCompareOptions compare_options = CompareOptions(a);
   Material m = ReadMaterial(a.material);
   const std::optional<MeasuredDrape> measured = ReadMeasured(a, o);
-  if (a.compression_ratio) m.compression_ratio = *a.compression_ratio;
+  if (a.compression_ratio) {  // given, no longer the documented default
+    m.compression_ratio = *a.compression_ratio;
+    std::erase(m.defaulted, std::string("stretch.compression_ratio"));
+  }
   ChooseDrapeRim(m, a.rim_mm == "auto",
                  a.extrapolate      ? DrapeExtrapolation::kOn
                  : a.no_extrapolate ? DrapeExtrapolation::kOff

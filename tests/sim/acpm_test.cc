@@ -340,5 +340,48 @@ TEST(Acpm, NarrowSampleAndOneRay) {
   EXPECT_DOUBLE_EQ(r.rays[0].z, 0.025);
 }
 
+// The crossing length's sensitivities. A linear law's elastica scales as L ∝ (b2 / ρ)^(1/3):
+// dL/dln b2 = L/3 = -dL/dln ρ exactly, and β is b2's twin. A nonlinear law's β still mirrors ρ
+// (M_β = β M against the weight). A seam along (the shell) is refused before any work.
+TEST(Acpm, SensitivitiesOfTheCrossingLengthFollowTheElasticasScaling) {
+  AcpmOptions o;
+  o.num_rays = 3;
+  o.sensitivity = true;
+  const Material dress = Fabric(0.0973, 0.0973, 0.0453, 130);
+  const AcpmResult r = RunAcpm(dress, o);
+  const double length = r.rays[0].overhang;
+  const auto row = [&](const AcpmResult& res, const std::string& name) {
+    for (const ParameterInfluence& s : res.sensitivities)
+      if (s.parameter == name) return s;
+    ADD_FAILURE() << name << " missing";
+    return ParameterInfluence{};
+  };
+  ASSERT_EQ(r.sensitivities.size(), 3u);  // b2, beta, areal_density_gsm: b1, c1 move nothing
+  EXPECT_NEAR(row(r, "b2").d_q_d_ln_p, length / 3.0, 1e-6 * length);
+  EXPECT_NEAR(row(r, "areal_density_gsm").d_q_d_ln_p, -length / 3.0, 1e-6 * length);
+  EXPECT_NEAR(row(r, "beta").d_q_d_ln_p, length / 3.0, 1e-6 * length);
+  EXPECT_FALSE(std::isfinite(r.crossing_length_sigma));
+  const AcpmResult f = RunAcpm(Fig8(), o);
+  EXPECT_NEAR(row(f, "beta").d_q_d_ln_p, -row(f, "areal_density_gsm").d_q_d_ln_p,
+              1e-5 * f.rays[0].overhang);
+  EXPECT_GT(row(f, "b1").d_q_d_ln_p, 0.0);
+  // A covariance gives σ = √(gᵀ C g).
+  Material fitted = Fig8();
+  fitted.fit["covariance_kes"] = {{1e-4, 0.0, 0.0}, {0.0, 1e-4, 0.0}, {0.0, 0.0, 1e-6}};
+  const AcpmResult s = RunAcpm(fitted, o);
+  double expected = 0.0;
+  for (const char* name : {"b1", "b2", "c1"}) {
+    const ParameterInfluence i = row(s, name);
+    expected += i.change * i.change;  // independent: each term its sd times its slope
+  }
+  EXPECT_NEAR(s.crossing_length_sigma, std::sqrt(expected), 1e-9 * std::sqrt(expected));
+  AcpmOptions along = o;
+  along.seam.direction = AcpmSeamDirection::kAlong;
+  along.seam.profile = SeamPreset("C-plain");
+  EXPECT_THROW(RunAcpm(Fig8(), along), InputError);
+  o.sensitivity_parameters = {"stretch.stiffness_N_per_m"};
+  EXPECT_THROW(RunAcpm(Fig8(), o), InputError);
+}
+
 }  // namespace
 }  // namespace textile

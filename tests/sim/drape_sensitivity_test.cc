@@ -88,11 +88,11 @@ TEST(DrapeSensitivity, MatchesDifferencesOfWholeDrapes) {
   const DrapeResult r = SimulateDrape(m, o);
   ASSERT_TRUE(r.converged) << r.message;
   ASSERT_EQ(r.sensitivities.size(), 2u);
-  EXPECT_GE(r.sensitivities[0].dc_change, r.sensitivities[1].dc_change);  // largest first
+  EXPECT_GE(r.sensitivities[0].change, r.sensitivities[1].change);  // largest first
   EXPECT_NEAR(OutlineDc(r), r.drape_coefficient, 0.01);  // the outline's DC is the raster's
   DrapeOptions plain = Coarse();
   constexpr double kStep = 0.01;
-  for (const DrapeSensitivity& s : r.sensitivities) {
+  for (const ParameterInfluence& s : r.sensitivities) {
     const double p = GetMaterialParameter(m, s.parameter).si;
     const DrapeResult up = SimulateDrape(WithMaterialParameter(m, s.parameter, p * std::exp(kStep)), plain);
     const DrapeResult down =
@@ -100,15 +100,15 @@ TEST(DrapeSensitivity, MatchesDifferencesOfWholeDrapes) {
     ASSERT_TRUE(up.converged && down.converged);
     ASSERT_EQ(up.per_seed[0].nodes.angles.size(), down.per_seed[0].nodes.angles.size());
     const double fd = (OutlineDc(up) - OutlineDc(down)) / (2.0 * kStep);
-    EXPECT_NEAR(s.d_dc_d_ln_p, fd, 0.02 * std::abs(fd)) << s.parameter;
+    EXPECT_NEAR(s.d_q_d_ln_p, fd, 0.02 * std::abs(fd)) << s.parameter;
   }
   // Stiffer bends less, heavier hangs more.
   const auto find = [&](const char* name) {
     return *std::find_if(r.sensitivities.begin(), r.sensitivities.end(),
-                         [&](const DrapeSensitivity& s) { return s.parameter == name; });
+                         [&](const ParameterInfluence& s) { return s.parameter == name; });
   };
-  EXPECT_GT(find("b1").d_dc_d_ln_p, 0.0);
-  EXPECT_LT(find("areal_density_gsm").d_dc_d_ln_p, 0.0);
+  EXPECT_GT(find("b1").d_q_d_ln_p, 0.0);
+  EXPECT_LT(find("areal_density_gsm").d_q_d_ln_p, 0.0);
   EXPECT_FALSE(std::isfinite(r.drape_coefficient_sigma));  // no fit covariance
   EXPECT_NE(r.sigma_note.find("no fit covariance"), std::string::npos) << r.sigma_note;
 }
@@ -128,13 +128,13 @@ TEST(DrapeSensitivity, SigmaPropagatesTheFitCovarianceAndDefaultsAreNamed) {
   EXPECT_NEAR(r.drape_coefficient_sigma, std::sqrt(v.dot(c * v)), 1e-15);
   ASSERT_EQ(r.sensitivities.size(), 4u);
   for (size_t k = 1; k < r.sensitivities.size(); ++k)
-    EXPECT_GE(r.sensitivities[k - 1].dc_change, r.sensitivities[k].dc_change);
+    EXPECT_GE(r.sensitivities[k - 1].change, r.sensitivities[k].change);
   const auto stretch = std::find_if(r.sensitivities.begin(), r.sensitivities.end(),
-                                    [](const DrapeSensitivity& s) { return s.defaulted; });
+                                    [](const ParameterInfluence& s) { return s.defaulted; });
   ASSERT_NE(stretch, r.sensitivities.end());
   EXPECT_EQ(stretch->parameter, "stretch.stiffness_N_per_m");
   EXPECT_NEAR(stretch->uncertainty_ln, std::log(10.0), 1e-12);
-  EXPECT_NEAR(stretch->dc_change, 1e-5 * 1000.0 * std::log(10.0), 1e-12);
+  EXPECT_NEAR(stretch->change, 1e-5 * 1000.0 * std::log(10.0), 1e-12);
   EXPECT_NE(stretch->uncertainty_source.find("unmeasured default"), std::string::npos);
 }
 

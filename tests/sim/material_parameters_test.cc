@@ -85,6 +85,34 @@ TEST(MaterialParameters, SettingOneChangesOnlyItAndInvalidValuesAreNamed) {
   EXPECT_EQ(ParameterWithoutEffect(file, "b1"), "");
 }
 
+// A linear law with b1 = b2 moves as a line: b2 carries b1 with it. At the edge of a range the
+// difference is one-sided; a name twice, or one without effect, is refused before any work.
+TEST(MaterialParameters, LinearLawsAndRangeEdgesStillHaveADifference) {
+  const Material dress = LawOnlyMaterial(BendingLaw::FromKes(0.0973, 0.0973, 0.0453), 0.13);
+  const Material steeper = WithMaterialParameter(dress, "b2", units::KesStiffnessToSi(0.1));
+  EXPECT_NEAR(steeper.bending.b1_kes(), 0.1, 1e-12);
+  EXPECT_NEAR(steeper.bending.b2_kes(), 0.1, 1e-12);
+  const ParameterStep b2 = DifferenceStep(dress, "b2", 1e-4);
+  EXPECT_NEAR(b2.span, 2e-4 * dress.bending.b2(), 1e-15);  // central: both sides valid
+  Material stiff = ParseMaterialJson(kFig8, "fig8.json");
+  stiff = WithMaterialParameter(stiff, "stretch.compression_ratio", 1.0);
+  EXPECT_EQ(std::count(stiff.defaulted.begin(), stiff.defaulted.end(),
+                       "stretch.compression_ratio"),
+            0);
+  const ParameterStep edge = DifferenceStep(stiff, "stretch.compression_ratio", 1e-4);
+  EXPECT_EQ(edge.up.compression_ratio, 1.0);  // one-sided: 1.0001 is no material
+  EXPECT_NEAR(edge.down.compression_ratio, 1.0 - 1e-4, 1e-15);
+  EXPECT_NEAR(edge.span, 1e-4, 1e-15);
+  EXPECT_NE(Error([&] { CheckSensitivityParameters(stiff, {"b1", "b2", "b1"}, 1e-4); })
+                .find("b1: named twice"),
+            std::string::npos);
+  EXPECT_NE(Error([&] { CheckSensitivityParameters(dress, {"b2", "c1"}, 1e-4); })
+                .find("the law is linear"),
+            std::string::npos);
+  EXPECT_EQ(Error([&] { CheckSensitivityParameters(dress, MaterialParameterNames(dress), 1e-4); }),
+            "");
+}
+
 TEST(MaterialParameters, FitCovarianceIsReadInSiAndCheckedPositiveSemiDefinite) {
   Material m = ParseMaterialJson(kFig8, "fig8.json");
   EXPECT_FALSE(MaterialFitCovariance(m).has_value());
@@ -98,6 +126,12 @@ TEST(MaterialParameters, FitCovarianceIsReadInSiAndCheckedPositiveSemiDefinite) 
   EXPECT_NEAR(b1.ln, 0.1, 1e-12);
   EXPECT_NEAR(DefaultParameterUncertainty(m, "stretch.warp", c).ln, std::log(10.0), 1e-12);
   EXPECT_NEAR(DefaultParameterUncertainty(m, "areal_density_gsm", c).ln, 0.02, 1e-12);
+  // A constant the fit left undetermined (its sd null): the matrix is a pseudo-inverse, no σ.
+  Material undetermined = m;
+  undetermined.fit["c1_sd"] = nullptr;
+  std::string why;
+  EXPECT_FALSE(MaterialFitCovariance(undetermined, &why).has_value());
+  EXPECT_NE(why.find("left c1 undetermined"), std::string::npos) << why;
   m.fit["covariance_kes"][0][1] = 1.0;
   m.fit["covariance_kes"][1][0] = 1.0;
   EXPECT_NE(Error([&] { MaterialFitCovariance(m); }).find("not positive semi-definite"),

@@ -89,7 +89,7 @@ TEST(EquilibriumSensitivity, RefusesAStateThatIsNoEquilibriumAndUnknownParameter
   try {
     EquilibriumSensitivity s(problem.get(), bent, m);
     FAIL() << "took a state far from equilibrium";
-  } catch (const InputError& e) {
+  } catch (const ComputeError& e) {
     EXPECT_NE(std::string(e.what()).find("not an equilibrium"), std::string::npos) << e.what();
   }
   const Vertices x = strip.Solve(m, bent);

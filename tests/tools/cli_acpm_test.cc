@@ -51,6 +51,30 @@ TEST(CliAcpm, PlainSamplePrintsTheRayTableAndWritesJsonAndPng) {
 // A material whose law is the Fig. 8 law sampled as a spline (41 knots, 0 .. 4 /cm) crosses
 // where the law does: 33.5864 mm (the 41-knot spline moves L* by 1e-6 relative,
 // cantilever_outputs_test.cc), the rays' table unchanged to its printed digits.
+// --sensitivity: the crossing length's σ (null without a fit covariance) and influence table in
+// acpm.json (mm) and the text; the dress fabric's linear law moves with b2 alone, L/3 per ln.
+TEST(CliAcpm, SensitivityReportsTheLengthsInfluenceTable) {
+  const auto dir = Scratch("CliAcpm.Sensitivity");
+  const auto r = Textile("acpm --material samples/materials/pabst-dress.json --sensitivity -o " +
+                         (dir / "r.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("L sigma: none"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(ReadAll(dir / "r.json"));
+  EXPECT_TRUE(j["crossing_length_sigma_mm"].is_null());
+  const auto& table = j["sensitivities"];
+  ASSERT_EQ(table.size(), 3u);
+  const double length = j["plain"]["overhang_mm"].get<double>();
+  for (const auto& row : table) {
+    if (row["parameter"] == "b2") {
+      EXPECT_NEAR(row["d_length_mm_d_ln_p"].get<double>(), length / 3.0, 1e-4 * length);
+      EXPECT_NEAR(row["length_change_mm"].get<double>(), 0.1 * length / 3.0, 1e-4 * length);
+    }
+  }
+  const auto plain = Textile("acpm " + kFig8 + " -o " + (dir / "p.json").string());
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_FALSE(nlohmann::json::parse(ReadAll(dir / "p.json")).contains("sensitivities"));
+}
+
 TEST(CliAcpm, SplineMaterialCrossesWhereItsPabstLawDoes) {
   const auto dir = Scratch("CliAcpm.Spline");
   const BendingLaw fig8 = BendingLaw::FromKes(0.1, 0.0892, -0.0092);

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "textile/sim/core/error.h"
 #include "textile/sim/core/number_text.h"
 
 namespace textile::cli {
@@ -120,6 +121,35 @@ void RegisterAllCommands(CLI::App& app) {
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   for (const auto& [order, registrar] : commands) registrar(app);
   RefuseEmptyValues(app);
+}
+
+std::vector<std::string> SensitivityParameterList(bool sensitivity, const std::string& list) {
+  if (list.empty()) return {};
+  if (!sensitivity) throw InputError("--sensitivity-params: needs --sensitivity");
+  std::vector<std::string> names;
+  for (size_t from = 0; from <= list.size();) {
+    const size_t comma = std::min(list.find(',', from), list.size());
+    if (comma == from) throw InputError("--sensitivity-params: '" + list + "' has an empty name");
+    names.push_back(list.substr(from, comma - from));
+    from = comma + 1;
+  }
+  return names;
+}
+
+void PrintInfluences(const std::string& quantity, const std::string& unit, double scale,
+                     double sigma, const std::string& sigma_note,
+                     const std::vector<ParameterInfluence>& rows) {
+  const std::string in = unit.empty() ? "" : " " + unit;
+  std::cout << quantity << " sigma: "
+            << (std::isfinite(sigma) ? Num(scale * sigma, 2) + in : std::string("none")) << " ("
+            << sigma_note << ")\n"
+            << "influence (d" << quantity << "/dln p" << in
+            << "; change over the uncertainty):\n";
+  for (const ParameterInfluence& s : rows)
+    std::cout << "  " << s.parameter << " = " << Num(s.value, 4)
+              << (s.unit == "-" ? std::string() : " " + s.unit)
+              << (s.defaulted ? " (default)" : "") << ": " << Num(scale * s.d_q_d_ln_p, 3) << in
+              << "; " << Num(scale * s.change, 2) << in << " over " << s.uncertainty_source << "\n";
 }
 
 }  // namespace textile::cli

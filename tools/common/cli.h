@@ -8,6 +8,8 @@
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
+
+#include "textile/sim/law/material_parameters.h"
 #include <string>
 
 namespace textile::cli {
@@ -29,6 +31,17 @@ std::string Num(double v, int digits = 6);
 
 // True if s is valid UTF-8 (JSON output needs it; names and notes from flags are checked).
 bool IsValidUtf8(const std::string& s);
+
+// The parameters of `--sensitivity-params LIST` (drape, acpm): comma-separated names as the
+// material file spells them; none when the list is empty (every parameter). InputError for a
+// list without --sensitivity or with an empty name.
+std::vector<std::string> SensitivityParameterList(bool sensitivity, const std::string& list);
+// Prints a quantity's σ line and its influence table (largest change first) on stdout:
+// "<quantity> sigma: ..." then one line a parameter; `scale` turns Q into the printed `unit`
+// (1e3 and "mm" for metres; "" for none).
+void PrintInfluences(const std::string& quantity, const std::string& unit, double scale,
+                     double sigma, const std::string& sigma_note,
+                     const std::vector<ParameterInfluence>& rows);
 
 // Progress/info line on stderr (never on stdout, which may carry JSON).
 void Info(const std::string& line);

@@ -1,6 +1,8 @@
 #include "textile/sim/law/material_parameters.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -137,6 +139,7 @@ Material WithMaterialParameter(const Material& material, const std::string& name
     const BendingLaw law = *AddressedLaw(m, prefix);
     double k[3] = {law.b1(), law.b2(), law.c1()};
     k[constant == "b1" ? 0 : constant == "b2" ? 1 : 2] = si;
+    if (constant == "b2" && law.kappa0() == 0.0) k[0] = si;  // M = b2 κ: the line's slope
     if (const std::string why = BendingLaw::Invalidity(k[0], k[1], k[2]); !why.empty())
       throw InputError(name + " = " + NumberText(si) + " (SI) makes no valid law: " + why);
     const BendingLaw changed = BendingLaw::FromSi(k[0], k[1], k[2]);
@@ -157,12 +160,18 @@ Material WithMaterialParameter(const Material& material, const std::string& name
   } else if (name == "stretch.poisson") {
     m.poisson = si;
   } else if (name == "stretch.shear") {
+    if (!(si > 0.0)) throw InputError(name + ": must be > 0 N/m, got " + NumberText(si));
     m.orthotropic->shear_modulus = si;
   } else {  // stretch.warp, stretch.weft: the whole curve scaled
     if (!(si > 0.0)) throw InputError(name + ": must be > 0 N/m, got " + NumberText(si));
     TensileCurve& c = name == "stretch.warp" ? m.orthotropic->warp : m.orthotropic->weft;
     c = ScaledCurve(c, si / old.si);
   }
+  // The value is no longer the file's nor a default (material.h: code that replaces a
+  // membrane field erases it from stretch_given).
+  if (name.rfind("stretch.", 0) == 0 && m.stretch_given.is_object())
+    m.stretch_given.erase(name.substr(std::string("stretch.").size()));
+  std::erase(m.defaulted, name);
   if (std::string why; !m.Check(&why))
     throw InputError(name + " = " + NumberText(si) + " (SI) makes no valid material: " + why);
   return m;
@@ -176,8 +185,17 @@ double MaterialParameterScale(const Material& m, const std::string& name) {
   return 1.0;
 }
 
-std::optional<Eigen::Matrix3d> MaterialFitCovariance(const Material& m) {
-  if (!m.fit.is_object() || !m.fit.contains("covariance_kes")) return std::nullopt;
+std::optional<Eigen::Matrix3d> MaterialFitCovariance(const Material& m, std::string* why) {
+  const auto none = [why](const std::string& reason) {
+    if (why) *why = reason;
+    return std::nullopt;
+  };
+  if (!m.fit.is_object() || !m.fit.contains("covariance_kes"))
+    return none("the material carries no fit covariance (fit.covariance_kes)");
+  for (const char* k : {"b1_sd", "b2_sd", "c1_sd"})
+    if (m.fit.contains(k) && !m.fit[k].is_number())
+      return none(std::string("the fit left ") + std::string(k, 2) +
+                  " undetermined (fit." + k + " is null)");
   const nlohmann::json& c = m.fit["covariance_kes"];
   const double to_si[3] = {units::KesStiffnessToSi(1.0), units::KesStiffnessToSi(1.0),
                            units::KesQuadraticToSi(1.0)};
@@ -226,6 +244,84 @@ ParameterUncertainty DefaultParameterUncertainty(const Material& m, const std::s
   if (name == "stretch.poisson") return absolute(0.15, "±0.15 (unmeasured default)");
   if (name == "stretch.shear") return relative(std::log(2.5), "×/÷ 2.5 (unmeasured default)");
   return relative(decade, "×/÷ 10 (unmeasured default)");
+}
+
+ParameterStep DifferenceStep(const Material& m, const std::string& name, double relative_step) {
+  const double p = GetMaterialParameter(m, name).si;
+  const double h = relative_step * MaterialParameterScale(m, name);
+  const auto at = [&](double value) -> std::optional<Material> {
+    try {
+      return WithMaterialParameter(m, name, value);
+    } catch (const InputError&) {
+      return std::nullopt;  // outside the valid range on this side
+    }
+  };
+  std::optional<Material> up = at(p + h), down = at(p - h);
+  if (up && down) return {std::move(*up), std::move(*down), 2.0 * h};
+  if (up) return {std::move(*up), m, h};
+  if (down) return {m, std::move(*down), h};
+  throw InputError(name + ": no valid material within " + NumberText(relative_step) +
+                   " of its value on either side, so it has no derivative");
+}
+
+void CheckSensitivityParameters(const Material& m, const std::vector<std::string>& names,
+                                double relative_step) {
+  for (size_t k = 0; k < names.size(); ++k) {
+    if (std::find(names.begin(), names.begin() + static_cast<long>(k), names[k]) !=
+        names.begin() + static_cast<long>(k))
+      throw InputError(names[k] + ": named twice");
+    if (const std::string why = ParameterWithoutEffect(m, names[k]); !why.empty())
+      throw InputError(why);
+    DifferenceStep(m, names[k], relative_step);
+  }
+}
+
+InfluenceTable MakeInfluenceTable(const Material& material,
+                                  const std::vector<std::string>& parameters,
+                                  const std::vector<double>& d_q_d_p) {
+  std::string no_covariance;
+  const std::optional<Eigen::Matrix3d> covariance = MaterialFitCovariance(material, &no_covariance);
+  Eigen::Vector3d law_gradient = Eigen::Vector3d::Zero();  // ∂Q/∂{b1, b2, c1}
+  int law_terms = 0;
+  InfluenceTable table;
+  for (size_t k = 0; k < parameters.size(); ++k) {
+    ParameterInfluence row;
+    row.parameter = parameters[k];
+    const MaterialParameterValue v = GetMaterialParameter(material, row.parameter);
+    row.value = v.lab;
+    row.unit = v.unit;
+    row.defaulted = v.defaulted;
+    row.d_q_d_p = d_q_d_p[k];
+    row.d_q_d_ln_p = v.si * row.d_q_d_p;
+    const ParameterUncertainty u = DefaultParameterUncertainty(material, row.parameter, covariance);
+    row.uncertainty_ln = u.ln;
+    row.uncertainty_source = u.source;
+    row.change = std::abs(row.d_q_d_p) * u.si;
+    const std::array<const char*, 3> law = {"b1", "b2", "c1"};
+    for (int i = 0; i < 3; ++i)
+      if (row.parameter == law[i]) {
+        law_gradient(i) = row.d_q_d_p;
+        ++law_terms;
+      }
+    table.rows.push_back(std::move(row));
+  }
+  std::stable_sort(table.rows.begin(), table.rows.end(),
+                   [](const ParameterInfluence& a, const ParameterInfluence& b) {
+                     return a.change > b.change;
+                   });
+  if (!covariance) {
+    table.sigma_note = "no σ: " + no_covariance +
+                       "; the table gives each input's change over its stated or default "
+                       "uncertainty";
+  } else if (law_terms < 3) {
+    table.sigma_note = "no σ: b1, b2 and c1 must all be among the sensitivity's parameters";
+  } else {
+    table.sigma = std::sqrt(std::max(0.0, law_gradient.dot(*covariance * law_gradient)));
+    table.sigma_note =
+        "σ from the fit's covariance of b1, b2, c1 only; the other inputs' shares are the "
+        "table's";
+  }
+  return table;
 }
 
 }  // namespace textile

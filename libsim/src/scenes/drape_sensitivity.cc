@@ -101,6 +101,9 @@ double OutlineAreaDerivative(const ShadowOutline& outline, const Vertices& x, co
 
 namespace drape_internal {
 
+// EquilibriumSensitivity's relative step (sensitivity.cc), for the checks before the solve.
+constexpr double kSensitivityStep = 1e-4;
+
 // The outline's bins for the sensitivity: fine enough that the polar area is the raster's within
 // its cells whatever options.outline_bins (which is for the node count).
 constexpr int kSensitivityBins = 2048;
@@ -108,11 +111,11 @@ constexpr int kSensitivityBins = 2048;
 std::vector<std::string> SensitivityParameters(const Material& material, const DrapeOptions& o) {
   if (!o.sensitivity) return {};
   MaterialFitCovariance(material);  // a malformed covariance is refused now, not after the solve
-  if (o.sensitivity_parameters.empty()) return MaterialParameterNames(material);
-  for (const std::string& name : o.sensitivity_parameters)
-    if (const std::string why = ParameterWithoutEffect(material, name); !why.empty())
-      throw InputError(why);
-  return o.sensitivity_parameters;
+  std::vector<std::string> names = o.sensitivity_parameters.empty()
+                                       ? MaterialParameterNames(material)
+                                       : o.sensitivity_parameters;
+  CheckSensitivityParameters(material, names, kSensitivityStep);
+  return names;
 }
 
 std::vector<double> DcDerivatives(ClothProblem* problem, const Vertices& x,
@@ -134,48 +137,13 @@ void SummariseSensitivities(const Material& material, const std::vector<std::str
                             const std::vector<std::vector<double>>& seed_derivatives,
                             DrapeResult* result) {
   if (seed_derivatives.empty()) return;
-  const std::optional<Eigen::Matrix3d> covariance = MaterialFitCovariance(material);
-  Eigen::Vector3d law_gradient = Eigen::Vector3d::Zero();  // ∂DC/∂{b1, b2, c1}
-  int law_terms = 0;
-  result->sensitivities.clear();
-  for (size_t k = 0; k < parameters.size(); ++k) {
-    DrapeSensitivity s;
-    s.parameter = parameters[k];
-    const MaterialParameterValue v = GetMaterialParameter(material, s.parameter);
-    s.value = v.lab;
-    s.unit = v.unit;
-    s.defaulted = v.defaulted;
-    for (const std::vector<double>& d : seed_derivatives) s.d_dc_d_p += d[k];
-    s.d_dc_d_p /= static_cast<double>(seed_derivatives.size());
-    s.d_dc_d_ln_p = v.si * s.d_dc_d_p;
-    const ParameterUncertainty u = DefaultParameterUncertainty(material, s.parameter, covariance);
-    s.uncertainty_ln = u.ln;
-    s.uncertainty_source = u.source;
-    s.dc_change = std::abs(s.d_dc_d_p) * u.si;
-    for (int i = 0; i < 3; ++i)
-      if (s.parameter == std::array<const char*, 3>{"b1", "b2", "c1"}[i]) {
-        law_gradient(i) = s.d_dc_d_p;
-        ++law_terms;
-      }
-    result->sensitivities.push_back(std::move(s));
-  }
-  std::stable_sort(result->sensitivities.begin(), result->sensitivities.end(),
-                   [](const DrapeSensitivity& a, const DrapeSensitivity& b) {
-                     return a.dc_change > b.dc_change;
-                   });
-  result->drape_coefficient_sigma = std::numeric_limits<double>::quiet_NaN();
-  if (!covariance) {
-    result->sigma_note =
-        "no σ: the material carries no fit covariance (fit.covariance_kes); the table gives each "
-        "input's change over its stated or default uncertainty";
-  } else if (law_terms < 3) {
-    result->sigma_note = "no σ: b1, b2 and c1 must all be among the sensitivity's parameters";
-  } else {
-    result->drape_coefficient_sigma = std::sqrt(std::max(0.0, law_gradient.dot(*covariance * law_gradient)));
-    result->sigma_note =
-        "σ from the fit's covariance of b1, b2, c1 only; the membrane's and the density's "
-        "uncertainties are the table's";
-  }
+  std::vector<double> mean(parameters.size(), 0.0);
+  for (const std::vector<double>& d : seed_derivatives)
+    for (size_t k = 0; k < mean.size(); ++k) mean[k] += d[k] / static_cast<double>(seed_derivatives.size());
+  InfluenceTable table = MakeInfluenceTable(material, parameters, mean);
+  result->sensitivities = std::move(table.rows);
+  result->drape_coefficient_sigma = table.sigma;
+  result->sigma_note = std::move(table.sigma_note);
 }
 
 }  // namespace drape_internal

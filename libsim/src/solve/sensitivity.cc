@@ -38,11 +38,15 @@ EquilibriumSensitivity::EquilibriumSensitivity(ClothProblem* problem, const Vert
   problem->EnergyGradient(x, &grad);
   const double residual = problem->RelativeResidual(grad);
   if (!(residual <= max_residual))
-    throw InputError("sensitivity: the state is not an equilibrium (relative residual " +
-                     NumberText(residual, 3) + " > " + NumberText(max_residual, 3) + ")");
+    throw ComputeError("sensitivity: the state is not an equilibrium (relative residual " +
+                       NumberText(residual, 3) + " > " + NumberText(max_residual, 3) + ")");
   // SC section 4: K = ∇ₓR, the exact Hessian: a projected one would give another dx.
   const Eigen::SparseMatrix<double>& k = problem->Hessian(x, HessianProjection::kNone);
   factor_->cholmod.cholmod().print = 0;
+  // Supernodal LLᵀ: it fails on any non-positive pivot. The automatic choice takes simplicial
+  // LDLᵀ on small, sparse matrices, which fails on a zero pivot only and would pass an
+  // indefinite K.
+  factor_->cholmod.setMode(Eigen::CholmodSupernodalLLt);
   const SerialOpenMp serial;
   factor_->cholmod.compute(k);
   if (factor_->cholmod.info() != Eigen::Success)
@@ -69,14 +73,11 @@ Vertices EquilibriumSensitivity::Solve(const Vertices& residual_change) const {
 }
 
 Vertices EquilibriumSensitivity::ResidualDerivative(const std::string& parameter) const {
-  const double p = GetMaterialParameter(material_, parameter).si;
-  const double h = kParameterStep * MaterialParameterScale(material_, parameter);
+  const ParameterStep step = DifferenceStep(material_, parameter, kParameterStep);
   const int part = PartOf(parameter);
-  const Vertices up =
-      problem_->MaterialGradient(x_, WithMaterialParameter(material_, parameter, p + h), part);
-  const Vertices down =
-      problem_->MaterialGradient(x_, WithMaterialParameter(material_, parameter, p - h), part);
-  return (up - down) / (2.0 * h);
+  return (problem_->MaterialGradient(x_, step.up, part) -
+          problem_->MaterialGradient(x_, step.down, part)) /
+         step.span;
 }
 
 Vertices EquilibriumSensitivity::DisplacementPerUnit(const std::string& parameter) const {

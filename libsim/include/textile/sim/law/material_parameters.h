@@ -16,6 +16,7 @@
 // "stretch.compression_ratio".
 
 #include <Eigen/Core>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,18 +48,41 @@ std::string ParameterWithoutEffect(const Material& material, const std::string& 
 MaterialParameterValue GetMaterialParameter(const Material& material, const std::string& name);
 
 // The material with `name` set to `si` [SI]; everything else unchanged (a scaled tensile curve
-// keeps its shape). Throws InputError for an unknown name, or naming the parameter and value
-// when the material would not be valid (e.g. a law with κ0 < 0, a Poisson ratio ≥ 0.5).
+// keeps its shape), except that b2 of a law with b1 = b2 (κ0 = 0, M = b2 κ) moves b1 with it:
+// the line's slope. The field is no longer a default. Throws InputError for an unknown name,
+// or naming the parameter and value when the material would not be valid (e.g. a law with
+// κ0 < 0, a Poisson ratio ≥ 0.5).
 Material WithMaterialParameter(const Material& material, const std::string& name, double si);
+
+// The two materials a difference in `name` compares: p ± h (h = relative_step ×
+// MaterialParameterScale), or where one side leaves the valid range (a compression ratio of 1,
+// a Poisson ratio of 0, c1 = 0 of a law M = b1 κ) that side is p itself, a one-sided
+// difference; span is the distance in p between them [SI]. Throws InputError naming the
+// parameter when neither side is valid.
+struct ParameterStep {
+  Material up, down;
+  double span = 0.0;
+};
+ParameterStep DifferenceStep(const Material& material, const std::string& name,
+                             double relative_step);
+
+// The parameters of a sensitivity request checked before any work: each known, none twice,
+// each able to move the material (ParameterWithoutEffect) and to be differenced
+// (DifferenceStep). Throws InputError naming the first problem.
+void CheckSensitivityParameters(const Material& material, const std::vector<std::string>& names,
+                                double relative_step);
 
 // A step scale for differences in `name` [SI]: |value|, or where the value is 0 (c1 of a
 // linear law) the size it takes in the law's curvature range (b1 × 1 cm).
 double MaterialParameterScale(const Material& material, const std::string& name);
 
 // The covariance of the `bending` law's {b1, b2, c1} [SI] that a fit wrote into the material
-// (fit.covariance_kes, gf·cm and gf·cm²); none when the material carries none. Throws
-// InputError when it is not a symmetric 3×3 matrix of numbers or not positive semi-definite.
-std::optional<Eigen::Matrix3d> MaterialFitCovariance(const Material& material);
+// (fit.covariance_kes, gf·cm and gf·cm²); none, with the reason in *why when given, when the
+// material carries none or the fit left a constant undetermined (its b1_sd, b2_sd or c1_sd
+// null: the matrix is then a pseudo-inverse without that direction). Throws InputError when it
+// is not a symmetric 3×3 matrix of numbers or not positive semi-definite.
+std::optional<Eigen::Matrix3d> MaterialFitCovariance(const Material& material,
+                                                     std::string* why = nullptr);
 
 // A parameter's uncertainty for the influence tables (docs/methods/sensitivity.md,
 // "Uncertainties"): as a relative change Δln p (NaN for a parameter that is 0), the absolute
@@ -70,6 +94,33 @@ struct ParameterUncertainty {
 };
 ParameterUncertainty DefaultParameterUncertainty(const Material& material, const std::string& name,
                                                  const std::optional<Eigen::Matrix3d>& covariance);
+
+// One parameter's influence on a scalar result Q of a simulation (a drape's DC, an ACPM
+// crossing length), in Q's unit.
+struct ParameterInfluence {
+  std::string parameter;  // as the material file names it
+  double value = 0.0;     // in `unit`
+  std::string unit;
+  bool defaulted = false;          // a documented default, not a measured value
+  double d_q_d_p = 0.0;            // ∂Q/∂p [per SI unit of p]
+  double d_q_d_ln_p = 0.0;         // ∂Q/∂ln p = p ∂Q/∂p
+  double uncertainty_ln = 0.0;     // Δp/p of DefaultParameterUncertainty (NaN for p = 0)
+  std::string uncertainty_source;  // where Δp comes from
+  double change = 0.0;             // |∂Q/∂p| Δp, the first-order change over the uncertainty
+};
+// The influences, the largest change first, and Q's 1-σ from the fit's covariance of the
+// `bending` law's b1, b2, c1: √(gᵀ C g), g = ∂Q/∂{b1, b2, c1}; NaN when the material carries no
+// covariance or the three are not all among `parameters`, with the reason in sigma_note.
+struct InfluenceTable {
+  std::vector<ParameterInfluence> rows;
+  double sigma = std::numeric_limits<double>::quiet_NaN();
+  std::string sigma_note;
+};
+// d_q_d_p: ∂Q/∂p for each of `parameters`, in order. Throws InputError for an unknown name or a
+// malformed covariance.
+InfluenceTable MakeInfluenceTable(const Material& material,
+                                  const std::vector<std::string>& parameters,
+                                  const std::vector<double>& d_q_d_p);
 
 }  // namespace textile
 

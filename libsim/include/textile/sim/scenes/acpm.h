@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "textile/sim/core/note.h"
+#include "textile/sim/law/material_parameters.h"
 #include "textile/sim/scenes/acpm_types.h"
 #include "textile/sim/mesh/mesh.h"
 
@@ -70,6 +71,12 @@ struct AcpmResult {
   // sample has a membrane; empty for the elastica, which has none.
   std::vector<Note> membrane_defaults;
   TriangleMesh shape;  // the sample at that crossing (AcpmCrossings::shape), for --obj
+  // With options.sensitivity: the crossing length's influences (Q = the rays' mean overhang
+  // [m]; the elastica's rays are cut together), the largest change first, and its 1-σ from the
+  // fit's covariance (NaN with sigma_note when the material carries none).
+  std::vector<ParameterInfluence> sensitivities;
+  double crossing_length_sigma = std::numeric_limits<double>::quiet_NaN();
+  std::string sigma_note;
 
   // One line: model, crossing range, factor range, device time.
   std::string BriefReport() const;

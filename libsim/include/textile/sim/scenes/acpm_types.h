@@ -87,6 +87,11 @@ struct AcpmOptions {
   AcpmModelKind model = AcpmModelKind::kAuto;
   AcpmSeam seam;
   AcpmModel shell_model;  // empty: ShellAcpmModel()
+  // The crossing length's sensitivities (docs/methods/sensitivity.md, "ACPM"): for each of
+  // sensitivity_parameters (empty: every parameter the elastica takes: the `bending` law's
+  // constants, beta, areal_density_gsm). The elastica model only.
+  bool sensitivity = false;
+  std::vector<std::string> sensitivity_parameters;
 
   // False with "<field>: <problem>" in *why (names as the CLI flags say them, in mm).
   bool Check(std::string* why) const;

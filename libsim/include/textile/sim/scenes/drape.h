@@ -48,6 +48,7 @@
 #include <vector>
 
 #include "textile/sim/law/material.h"
+#include "textile/sim/law/material_parameters.h"
 #include "textile/sim/mesh/mesh.h"
 #include "textile/sim/core/note.h"
 #include "textile/sim/law/seam.h"
@@ -285,7 +286,7 @@ struct DrapeResult {
   // With options.sensitivity (and converged): each parameter's influence, the largest
   // dc_change first; the DC's 1-σ from the fit's covariance of the bending law's b1, b2, c1
   // (NaN when the material carries none, sigma_note saying so).
-  std::vector<DrapeSensitivity> sensitivities;
+  std::vector<ParameterInfluence> sensitivities;  // Q = the DC
   double drape_coefficient_sigma = std::numeric_limits<double>::quiet_NaN();
   std::string sigma_note;
   // Wall time of the sensitivities, all seeds and equilibria: factorisations, the parameters'

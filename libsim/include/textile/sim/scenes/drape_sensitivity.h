@@ -38,19 +38,6 @@ ShadowOutline TraceShadowOutline(const Vertices& x, const Triangles& triangles, 
 // dA for vertex displacements dx (#V×3 [m]) [m²], to first order.
 double OutlineAreaDerivative(const ShadowOutline& outline, const Vertices& x, const Vertices& dx);
 
-// One parameter's influence on the DC.
-struct DrapeSensitivity {
-  std::string parameter;  // as the material file names it (material_parameters.h)
-  double value = 0.0;     // in `unit`
-  std::string unit;
-  bool defaulted = false;           // a documented default, not a measured value
-  double d_dc_d_ln_p = 0.0;         // ∂DC/∂ln p
-  double d_dc_d_p = 0.0;            // ∂DC/∂p [per SI unit]
-  double uncertainty_ln = 0.0;      // Δln p of the parameter's stated or default uncertainty
-  std::string uncertainty_source;   // where Δln p comes from
-  double dc_change = 0.0;           // |∂DC/∂ln p| Δln p, the first-order change
-};
-
 }  // namespace textile
 
 #endif  // TEXTILE_SIM_SCENES_DRAPE_SENSITIVITY_H_

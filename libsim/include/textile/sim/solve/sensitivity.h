@@ -13,9 +13,10 @@
 //   textile::EquilibriumSensitivity s(&problem, x, material);   // factorises K once
 //   textile::Vertices dx = s.Displacement("b1");                // ∂x/∂ln b1 [m]
 //
-// ∂R/∂p is a central difference of ClothProblem::MaterialGradient at fixed x over
-// p e^(±1e-4) (the elements are not differentiated by hand; the step's truncation error is
-// ~1e-8 relative). Contact and friction anchors stay as they are: the contact set is frozen.
+// ∂R/∂p is a central difference of ClothProblem::MaterialGradient at fixed x over p ± 1e-4 of
+// its scale (DifferenceStep: one-sided at the edge of a parameter's range; the elements are not
+// differentiated by hand; the truncation error is ~1e-8 relative, 1e-4 one-sided). Contact and
+// friction anchors stay as they are: the contact set is frozen.
 
 #include <memory>
 #include <string>
@@ -28,9 +29,10 @@ namespace textile {
 class EquilibriumSensitivity {
  public:
   // Factorises K at x (#V×3 [m], fixed vertices in place). `material` is the one `problem`
-  // was built with. Throws InputError when x is not an equilibrium of the problem (relative
-  // residual above max_residual: a sensitivity there means nothing), ComputeError when K is not
-  // positive definite (a buckling point, where the branch may change; no sensitivity exists).
+  // was built with. Throws InputError for a state of the wrong size or not finite;
+  // ComputeError when x is not an equilibrium of the problem (relative residual above
+  // max_residual: a sensitivity there means nothing) or K is not positive definite (a buckling
+  // point, where the branch may change; no sensitivity exists).
   EquilibriumSensitivity(ClothProblem* problem, const Vertices& x, const Material& material,
                          double max_residual = 1e-4);
   ~EquilibriumSensitivity();

@@ -36,7 +36,7 @@ struct Benchmark {
 //   const bool kRegistered = AddBenchmark(40, FitAccuracyBenchmark);
 // `order` follows docs/spec/benchmarks.md: bend-force 10, hinge-curve 15, stability 20,
 // acpm-accuracy 30, fit-accuracy 40, elastica 45, extract-accuracy 50, drape-convergence 60,
-// drape-measure-mesh 62, drape-sensitivity 64, drape-measure-photo 65, stress 70.
+// drape-measure-mesh 62, drape-sensitivity 64, drape-measure-photo 65, what-if 66, stress 70.
 bool AddBenchmark(int order, Benchmark (*make)());
 // All registered benchmarks, in order.
 const std::vector<Benchmark>& Registry();

@@ -30,8 +30,7 @@ struct AcpmArgs {
   double speed_cm_per_min = 12, crossing_tol_mm = 0.05;
   int rays = 17;
   bool json = false;
-  bool sensitivity = false;
-  std::string sensitivity_params;
+  SensitivityArgs sensitivity;
 };
 
 constexpr double kDegree = std::numbers::pi / 180.0;
@@ -71,8 +70,10 @@ AcpmOptions Options(const AcpmArgs& a) {
       o.seam.position = units::MmToM(*a.seam_at_mm);
     }
   }
-  o.sensitivity = a.sensitivity;
-  o.sensitivity_parameters = SensitivityParameterList(a.sensitivity, a.sensitivity_params);
+  o.sensitivity = a.sensitivity.sensitivity;
+  o.sensitivity_parameters = a.sensitivity.Parameters();
+  o.monte_carlo_samples = a.sensitivity.monte_carlo;
+  o.monte_carlo_seed = a.sensitivity.monte_carlo_seed;
   if (std::string why; !o.Check(&why)) throw InputError("acpm: " + why);
   // RunAcpm refuses this too; here it is the flags' fault, not the material's.
   if (o.model == AcpmModelKind::kElastica && o.seam.direction == AcpmSeamDirection::kAlong)
@@ -250,8 +251,9 @@ void Run(const AcpmArgs& a) {
             << "device time " << Num(r.device_time, 4) << " s; computed in " << Num(ms, 3)
             << " ms (" << r.solves << " solves)\n";
   for (const Note& n : r.membrane_defaults) std::cout << "note: " << n.text << "\n";
-  if (o.sensitivity)
+  if (o.sensitivity || o.monte_carlo_samples > 0)
     PrintInfluences("L", "mm", 1e3, r.crossing_length_sigma, r.sigma_note, r.sensitivities);
+  if (r.monte_carlo) PrintMonteCarlo("L", "mm", 1e3, *r.monte_carlo);
   std::cout << "wrote " << a.out << (a.png.empty() ? "" : ", " + a.png)
             << (a.obj.empty() ? "" : ", " + a.obj) << "\n";
 }
@@ -300,13 +302,8 @@ void RegisterAcpm(CLI::App& app) {
   sub->add_option(
       "--crossing-tol-mm", a->crossing_tol_mm,
       "Crossing refinement of stepping models [mm] (default 0.05; the elastica is exact)");
-  sub->add_flag("--sensitivity", a->sensitivity,
-                "Each parameter's influence on the crossing length L (dL/dln p, and L's change "
-                "over the parameter's uncertainty) and L's sigma from the fit's covariance; the "
-                "elastica model only (docs/methods/sensitivity.md)");
-  sub->add_option("--sensitivity-params", a->sensitivity_params,
-                  "--sensitivity: only these parameters, comma-separated (b1,b2,c1,beta,"
-                  "areal_density_gsm)");
+  AddSensitivityFlags(sub, &a->sensitivity, "the crossing length L", "the elastica model only",
+                      "b1,b2,c1,beta,areal_density_gsm");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   sub->callback([a] { Run(*a); });
 }

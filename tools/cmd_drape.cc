@@ -25,6 +25,7 @@
 #include "textile/sim/scenes/drape.h"
 #include "textile/sim/scenes/drape_compare.h"
 #include "textile/sim/scenes/drape_measure.h"
+#include "textile/sim/scenes/drape_what_if.h"
 
 namespace textile::cli {
 namespace {
@@ -56,9 +57,12 @@ struct DrapeArgs {
   std::string compare;
   std::optional<double> dc_tol, node_tol, outline_tol_mm;
   bool strict = false;
-  // --sensitivity, and the parameters it is taken for (comma-separated; empty: all).
-  bool sensitivity = false;
-  std::string sensitivity_params;
+  // --sensitivity, the parameters it is taken for, --monte-carlo.
+  SensitivityArgs sensitivity;
+  // --cache DIR keeps the drape with its sensitivities; --what-if EDITS predicts from it.
+  std::string cache, what_if;
+  double what_if_reach_percent = 10.0;
+  double what_if_max_error = 0.01;
 };
 
 SeamProfile LoadSeamProfile(const DrapeArgs& a) {
@@ -151,8 +155,10 @@ DrapeOptions Options(const DrapeArgs& a) {
   }
   if (a.seeds < 1 || a.seeds > 1000) throw InputError("--seeds: must be in 1..1000");
   o.seeds = a.seeds;
-  o.sensitivity = a.sensitivity;
-  o.sensitivity_parameters = SensitivityParameterList(a.sensitivity, a.sensitivity_params);
+  o.sensitivity = a.sensitivity.sensitivity;
+  o.sensitivity_parameters = a.sensitivity.Parameters();
+  o.monte_carlo_samples = a.sensitivity.monte_carlo;
+  o.monte_carlo_seed = a.sensitivity.monte_carlo_seed;
   o.first_seed = a.first_seed;
   if (a.resolution_mm) {
     const double h = finite(*a.resolution_mm, "--resolution-mm");
@@ -435,7 +441,7 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
     j["scene"]["seam_profile"] = SeamProfileToJson(o.seam_profile);
     if (o.seams == DrapeSeams::kShifted) j["scene"]["shift_mm"] = units::MToMm(o.seam_shift);
   }
-  if (o.sensitivity) {
+  if (o.sensitivity || o.monte_carlo_samples > 0) {
     j["drape_coefficient_sigma"] = NumberOrNull(r.drape_coefficient_sigma);
     j["drape_coefficient_sigma_note"] = r.sigma_note;
     j["sensitivity_seconds"] = r.sensitivity_seconds;
@@ -449,6 +455,10 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
                                     {"uncertainty_ln", NumberOrNull(s.uncertainty_ln)},
                                     {"uncertainty_source", s.uncertainty_source},
                                     {"dc_change", s.change}});
+  }
+  if (r.monte_carlo) {
+    j["monte_carlo"] = MonteCarloJson(*r.monte_carlo, 1.0, "-");
+    j["monte_carlo"]["node_changes"] = r.monte_carlo_node_changes;
   }
   j["material"] = MaterialToJson(m);
   // Where the membrane's compression ratio came from: the file, or --compression-ratio over it.
@@ -512,7 +522,9 @@ void PrintText(const DrapeResult& r, const DrapeOptions& o, const Material& m, c
   }
   if (!note.empty()) std::cout << "\nnote: " << note;
   std::cout << "\n";
-  if (o.sensitivity) PrintInfluences("DC", "", 1.0, r.drape_coefficient_sigma, r.sigma_note, r.sensitivities);
+  if (o.sensitivity || o.monte_carlo_samples > 0)
+    PrintInfluences("DC", "", 1.0, r.drape_coefficient_sigma, r.sigma_note, r.sensitivities);
+  if (r.monte_carlo) PrintMonteCarlo("DC", "", 1.0, *r.monte_carlo);
   if (comparison) PrintComparison(*comparison, a, r.per_seed.size() > 1);
   std::cout << "time: " << Num(r.seconds, 3) << " s\nresult: " << a.out
             << "\noutline: " << outline_path << "\n";
@@ -521,7 +533,44 @@ void PrintText(const DrapeResult& r, const DrapeOptions& o, const Material& m, c
   if (!a.ply.empty()) std::cout << "mesh (PLY): " << a.ply << "\n";
 }
 
+// --what-if answered from the cache: the result file holds the prediction, the edited material
+// and the scene; no outline, picture or mesh (there is no drape).
+void WritePrediction(const DrapeWhatIfPrediction& p, const DrapeOptions& o, const DrapeArgs& a) {
+  nlohmann::json j = {{"what_if", DrapeWhatIfJson(p.what_if)},
+                      {"drape_coefficient", p.what_if.drape_coefficient},
+                      {"drape_coefficient_error_estimate", p.what_if.error_estimate},
+                      {"scene", DrapeSceneJson(o)},
+                      {"material", MaterialToJson(p.material)},
+                      {"seconds", p.seconds}};
+  j["what_if"]["edits"] = a.what_if;
+  j["what_if"]["cache"] = a.cache;
+  j["material"]["file"] = a.material;
+  AtomicFileSet outputs;
+  outputs.Add(a.out).Write(j.dump(2) + "\n");
+  outputs.Commit();
+  if (a.json) {
+    j["output"] = a.out;
+    PrintJson(j);
+    return;
+  }
+  std::cout << "what-if " << a.what_if << ": DC " << Num(p.what_if.drape_coefficient, 4) << " ± "
+            << Num(p.what_if.error_estimate, 2) << " (" << p.what_if.reason << ") in "
+            << Num(1e3 * p.seconds, 3) << " ms\nresult: " << a.out << "\n";
+}
+
+// The what-if flags' own checks: --what-if needs --cache, and answers with a DC only.
+void CheckWhatIfArgs(const DrapeArgs& a) {
+  if (a.what_if.empty()) return;
+  if (a.cache.empty()) throw InputError("--what-if: needs --cache DIR (the solved drapes it predicts from)");
+  for (const auto& [flag, value] : {std::pair{"--png", a.png}, {"--obj", a.obj}, {"--ply", a.ply},
+                                    {"--compare", a.compare}})
+    if (!value.empty())
+      throw InputError(std::string("--what-if: predicts the DC only; ") + flag +
+                       " needs a drape (run without --what-if)");
+}
+
 void Run(const DrapeArgs& a) {
+  CheckWhatIfArgs(a);
   DrapeOptions o = Options(a);
   if (a.compression_ratio &&
       !(*a.compression_ratio >= kMinCompressionRatio && *a.compression_ratio <= 1.0))
@@ -550,6 +599,22 @@ void Run(const DrapeArgs& a) {
                                     : DrapeExtrapolation::kDefault,
                  &o);
   if (std::string why; !o.Check(&why)) throw InputError("drape: " + why);
+  // --what-if: the scene is the file material's (its rim), the material the edited one.
+  std::optional<DrapeWhatIf> what_if;
+  if (!a.what_if.empty()) {
+    DrapeWhatIfPrediction p;
+    try {
+      p = PredictDrapeWhatIf(m, a.what_if, o, a.cache,
+                             {a.what_if_reach_percent / 100.0, a.what_if_max_error});
+    } catch (const InputError& e) {
+      throw InputError(a.material + ": " + e.what());
+    }
+    if (p.what_if.predicted) return WritePrediction(p, o, a);
+    Progress("drape: what-if: solving, " + p.what_if.reason, a.progress);
+    m = std::move(p.material);
+    what_if = std::move(p.what_if);
+  }
+  if (!a.cache.empty()) o.sensitivity = true;  // a cached drape carries them
   AtomicFileSet outputs;
   AtomicFile& result_file = outputs.Add(a.out);
   AtomicFile& outline_file = outputs.Add(outline_path);
@@ -565,7 +630,7 @@ void Run(const DrapeArgs& a) {
   };
   DrapeResult r;
   try {
-    r = SimulateDrape(m, o);
+    r = a.cache.empty() ? SimulateDrape(m, o) : SimulateDrapeCached(m, o, a.cache);
   } catch (const InputError& e) {
     throw InputError(a.material + ": " + e.what());
   }
@@ -586,6 +651,11 @@ void Run(const DrapeArgs& a) {
     j["comparison"] = DrapeComparisonJson(*comparison);
     j["comparison"]["measured_file"] = a.compare;
   }
+  if (what_if) {
+    j["what_if"] = DrapeWhatIfJson(*what_if);
+    j["what_if"]["edits"] = a.what_if;
+  }
+  if (!a.cache.empty()) j["cache"] = a.cache;
   j["outline_csv"] = outline_file.path();
   outline_file.Write(OutlineCsv(first.shadow));  // drape_measure.h: the shared columns
   if (png_file) {
@@ -613,6 +683,8 @@ void Run(const DrapeArgs& a) {
     return;
   }
   PrintText(r, o, m, a, outline_file.path(), comparison);
+  if (what_if) std::cout << "what-if " << a.what_if << ": solved, " << what_if->reason << "\n";
+  if (!a.cache.empty()) std::cout << "cached in: " << a.cache << "\n";
 }
 
 }  // namespace
@@ -716,13 +788,21 @@ void RegisterDrape(CLI::App& app) {
                   "rotation [mm] (default: reported, not judged)");
   sub->add_flag("--strict", a->strict,
                 "--compare: a failed verdict is an error (exit 3, nothing written)");
-  sub->add_flag("--sensitivity", a->sensitivity,
-                "Each material parameter's influence on the DC (dDC/dln p, and the DC's change "
-                "over the parameter's uncertainty) and the DC's sigma from the fit's covariance; "
-                "clamped mount only (docs/methods/sensitivity.md)");
-  sub->add_option("--sensitivity-params", a->sensitivity_params,
-                  "--sensitivity: only these parameters, comma-separated as the material file "
-                  "names them (b1,b2,c1,beta,areal_density_gsm,stretch.warp,...)");
+  AddSensitivityFlags(sub, &a->sensitivity, "the DC", "clamped mount only",
+                      "b1,b2,c1,beta,areal_density_gsm,stretch.warp,...");
+  sub->add_option("--cache", a->cache,
+                  "Keep this drape, with every parameter's sensitivity, in this folder for "
+                  "--what-if (created if missing; implies --sensitivity)");
+  sub->add_option("--what-if", a->what_if,
+                  "Predict the DC of the material with these edits, NAME=VALUE,... in the "
+                  "material file's names and units (b1=0.11,stretch.warp=3300), from the drapes "
+                  "in --cache; solves (and caches) when none is near enough");
+  sub->add_option("--what-if-reach-pct", a->what_if_reach_percent,
+                  "--what-if: a cached drape answers within this change of every parameter [%] "
+                  "(default 10)");
+  sub->add_option("--what-if-max-error", a->what_if_max_error,
+                  "--what-if: solve instead when the prediction's error estimate is above this "
+                  "(default 0.01 DC)");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   sub->callback([a] { Run(*a); });
 }

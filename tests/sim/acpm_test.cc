@@ -10,6 +10,7 @@
 #include "textile/sim/elastica/elastica.h"
 #include "textile/sim/core/error.h"
 #include "textile/sim/core/units.h"
+#include "textile/sim/law/material.h"
 
 namespace textile {
 namespace {
@@ -381,6 +382,41 @@ TEST(Acpm, SensitivitiesOfTheCrossingLengthFollowTheElasticasScaling) {
   EXPECT_THROW(RunAcpm(Fig8(), along), InputError);
   o.sensitivity_parameters = {"stretch.stiffness_N_per_m"};
   EXPECT_THROW(RunAcpm(Fig8(), o), InputError);
+}
+
+// --monte-carlo: where the covariance is small the law is linear over it and the sampled σ is
+// the linear one; the shipped fit's covariance (c1 ±61 %) is not, and the note says so.
+TEST(Acpm, MonteCarloSigmaMatchesTheLinearOneWhereTheLawIsLinearOverTheCovariance) {
+  AcpmOptions o;
+  o.num_rays = 1;
+  o.monte_carlo_samples = 400;
+  Material small = Fig8();
+  small.fit["covariance_kes"] = {{1e-8, 0.0, 0.0}, {0.0, 1e-8, 0.0}, {0.0, 0.0, 1e-9}};
+  const AcpmResult r = RunAcpm(small, o);
+  ASSERT_TRUE(r.monte_carlo.has_value());
+  EXPECT_FALSE(r.sensitivities.empty());  // implied: the linear σ beside the sampled one
+  EXPECT_EQ(r.monte_carlo->samples, 400);
+  EXPECT_EQ(r.monte_carlo->failed, 0);
+  EXPECT_DOUBLE_EQ(r.monte_carlo->linear_sigma, r.crossing_length_sigma);
+  EXPECT_NEAR(r.monte_carlo->ratio, 1.0, 0.12);  // sampling error 3.5 %
+  EXPECT_NEAR(r.monte_carlo->mean, r.rays[0].overhang, 3.0 * r.crossing_length_sigma / 20.0);
+  const nlohmann::json j = AcpmResultToJson(r, small, o);
+  EXPECT_NEAR(j["monte_carlo"]["sigma"].get<double>(), 1e3 * r.monte_carlo->sigma, 1e-12);
+  EXPECT_TRUE(j["crossing_length_sigma_mm"].is_number());
+
+  const Material fitted = ReadMaterial(std::string(TEXTILE_SOURCE_DIR) +
+                                           "/tests/data/sensitivity/fig8-fitted.json");
+  const AcpmResult wide = RunAcpm(fitted, o);
+  ASSERT_TRUE(wide.monte_carlo.has_value());
+  EXPECT_GT(wide.monte_carlo->ratio, 1.4);
+  EXPECT_NE(wide.monte_carlo->note.find("not linear"), std::string::npos) << wide.monte_carlo->note;
+
+  o.model = AcpmModelKind::kShell;
+  EXPECT_THROW(RunAcpm(small, o), InputError);  // the elastica only, refused before any solve
+  o.model = AcpmModelKind::kAuto;
+  EXPECT_THROW(RunAcpm(Fig8(), o), InputError);  // no covariance
+  o.monte_carlo_samples = 1;
+  EXPECT_THROW(RunAcpm(small, o), InputError);
 }
 
 }  // namespace

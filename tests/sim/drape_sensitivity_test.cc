@@ -138,6 +138,33 @@ TEST(DrapeSensitivity, SigmaPropagatesTheFitCovarianceAndDefaultsAreNamed) {
   EXPECT_NE(stretch->uncertainty_source.find("unmeasured default"), std::string::npos);
 }
 
+// --monte-carlo: each sample is solved from the seed's equilibrium; with a covariance tiny
+// against the law the samples are the nominal drape, and the spread is the linear σ's.
+TEST(DrapeSensitivity, MonteCarloSamplesStartFromTheSeedsEquilibrium) {
+  DrapeOptions o = Coarse();
+  o.monte_carlo_samples = 6;
+  Material m = Fig8();
+  m.fit["covariance_kes"] = {{1e-8, 0.0, 0.0}, {0.0, 1e-8, 0.0}, {0.0, 0.0, 1e-10}};
+  const DrapeResult r = SimulateDrape(m, o);
+  ASSERT_TRUE(r.converged) << r.message;
+  ASSERT_TRUE(r.monte_carlo.has_value());
+  EXPECT_FALSE(r.sensitivities.empty());  // implied
+  EXPECT_EQ(r.monte_carlo->samples, 6);
+  EXPECT_EQ(r.monte_carlo->failed, 0);
+  EXPECT_EQ(r.monte_carlo_node_changes, 0);
+  EXPECT_DOUBLE_EQ(r.monte_carlo->linear_sigma, r.drape_coefficient_sigma);
+  // b1, b2 within 0.1 % (sd 1e-4 gf·cm): the samples' mean is the nominal DC within its
+  // sampling error (a sample on another branch, or measured otherwise, would be far off).
+  EXPECT_NEAR(r.monte_carlo->mean, r.drape_coefficient,
+              3.0 * r.drape_coefficient_sigma / std::sqrt(6.0) + 1e-6);
+  EXPECT_GT(r.monte_carlo->sigma, 0.0);
+  EXPECT_LT(r.monte_carlo->sigma, 3.0 * r.drape_coefficient_sigma);
+  o.monte_carlo_samples = 4;
+  EXPECT_THROW(SimulateDrape(Fig8(), o), InputError);  // no covariance: before any solve
+  o.monte_carlo_samples = 1;
+  EXPECT_THROW(SimulateDrape(m, o), InputError);
+}
+
 TEST(DrapeSensitivity, BadRequestsAreRefusedBeforeAnySolve) {
   DrapeOptions o = Coarse();
   o.sensitivity = true;

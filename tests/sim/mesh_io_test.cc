@@ -9,6 +9,7 @@
 #include <random>
 #include <sstream>
 
+#include "scratch_dir.h"
 #include "textile/sim/core/error.h"
 #include "textile/sim/mesh/mesh.h"
 #include "textile/sim/mesh/pattern_mesh.h"
@@ -17,13 +18,6 @@ namespace textile {
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path ScratchDir(const std::string& name) {
-  fs::path d = fs::path(TEXTILE_BINARY_DIR) / "test_scratch" / ("mesh_io_" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
 
 // A small mesh with awkward coordinates (not short in decimal).
 TriangleMesh AwkwardMesh() {
@@ -50,7 +44,7 @@ TEST(MeshIo, ObjRoundTripsBitForBit) {
   EXPECT_EQ(back.vertices, m.vertices);
   EXPECT_EQ(back.triangles, m.triangles);
   // Through a file too, with colours (ignored on reading).
-  const fs::path dir = ScratchDir("obj");
+  const fs::path dir = ScratchDir("mesh_io_obj");
   VertexScalar s{"seam_multiplier", Eigen::VectorXd::LinSpaced(m.num_vertices(), 1.0, 9.07)};
   WriteObj((dir / "m.obj").string(), m, &s);
   const TriangleMesh from_file = ReadObj((dir / "m.obj").string());
@@ -109,7 +103,7 @@ TEST(MeshIo, PlyCarriesScalarsAsProperties) {
   }
   EXPECT_TRUE(static_cast<bool>(in));
   // Through a path.
-  const fs::path dir = ScratchDir("ply");
+  const fs::path dir = ScratchDir("mesh_io_ply");
   WritePly((dir / "m.ply").string(), m, {{"seam_multiplier", a}});
   std::ifstream file(dir / "m.ply");
   std::stringstream content;

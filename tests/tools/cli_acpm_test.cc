@@ -75,6 +75,28 @@ TEST(CliAcpm, SensitivityReportsTheLengthsInfluenceTable) {
   EXPECT_FALSE(nlohmann::json::parse(ReadAll(dir / "p.json")).contains("sensitivities"));
 }
 
+// --monte-carlo N: the sampled σ beside the linear one in acpm.json and the text, the same draws
+// for the same seed; it implies --sensitivity.
+TEST(CliAcpm, MonteCarloPutsTheSampledSigmaBesideTheLinearOne) {
+  const auto dir = Scratch("CliAcpm.MonteCarlo");
+  const std::string run = "acpm --material tests/data/sensitivity/fig8-fitted.json --rays 1 "
+                          "--monte-carlo 50 -o ";
+  const auto r = Textile(run + (dir / "a.json").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("L Monte Carlo: sigma"), std::string::npos) << r.out;
+  const auto a = nlohmann::json::parse(ReadAll(dir / "a.json"));
+  ASSERT_TRUE(a.contains("monte_carlo")) << a.dump();
+  const auto& mc = a["monte_carlo"];
+  EXPECT_EQ(mc["samples"], 50);
+  EXPECT_EQ(mc["unit"], "mm");
+  EXPECT_NEAR(mc["linear_sigma"].get<double>(), a["crossing_length_sigma_mm"].get<double>(), 1e-12);
+  EXPECT_GT(mc["sigma"].get<double>(), 0.0);
+  EXPECT_FALSE(a["sensitivities"].empty());
+  const auto again = Textile(run + (dir / "b.json").string());
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(nlohmann::json::parse(ReadAll(dir / "b.json"))["monte_carlo"]["sigma"], mc["sigma"]);
+}
+
 TEST(CliAcpm, SplineMaterialCrossesWhereItsPabstLawDoes) {
   const auto dir = Scratch("CliAcpm.Spline");
   const BendingLaw fig8 = BendingLaw::FromKes(0.1, 0.0892, -0.0092);

@@ -469,6 +469,44 @@ TEST(CliDrape, CompressionRatioOverridesTheMaterialsAndIsReported) {
   EXPECT_GT(s["drape_coefficient"].get<double>(), p["drape_coefficient"].get<double>() + 0.08);
 }
 
+// --cache keeps a drape with its sensitivities; --what-if then predicts a nearby material's DC
+// from it without a drape (no outline), and solves, caching it, when the edit is too far.
+TEST(CliDrape, WhatIfPredictsFromTheCacheAndSolvesWhenTooFar) {
+  const auto dir = Scratch("CliDrape.WhatIf");
+  const std::string cache = " --cache " + (dir / "cache").string();
+  const auto base = Textile("drape " + kFig8 + kCoarse + cache + " -o " + (dir / "b.json").string());
+  ASSERT_EQ(base.exit_code, 0) << base.err;
+  const auto b = nlohmann::json::parse(ReadAll(dir / "b.json"));
+  EXPECT_FALSE(b["sensitivities"].empty());  // implied by --cache
+  const auto near = Textile("drape " + kFig8 + kCoarse + cache + " --what-if b1=0.102 -o " +
+                            (dir / "n.json").string());
+  ASSERT_EQ(near.exit_code, 0) << near.err;
+  EXPECT_NE(near.out.find("what-if b1=0.102: DC"), std::string::npos) << near.out;
+  const auto n = nlohmann::json::parse(ReadAll(dir / "n.json"));
+  EXPECT_TRUE(n["what_if"]["predicted"].get<bool>());
+  EXPECT_EQ(n["what_if"]["entries_used"], 1);
+  const double db1 = 0.002 / 0.1;  // b1's relative change
+  double d_ln_b1 = 0.0;
+  for (const auto& row : b["sensitivities"])
+    if (row["parameter"] == "b1") d_ln_b1 = row["d_dc_d_ln_p"].get<double>();
+  EXPECT_NEAR(n["drape_coefficient"].get<double>(),
+              b["drape_coefficient"].get<double>() + d_ln_b1 * db1, 1e-6);
+  EXPECT_FALSE(fs::exists(dir / "n.outline.csv"));
+  // 30 % away: beyond the reach, so solved and cached.
+  const auto far = Textile("drape " + kFig8 + kCoarse + cache + " --what-if b1=0.13 -o " +
+                           (dir / "f.json").string());
+  ASSERT_EQ(far.exit_code, 0) << far.err;
+  EXPECT_NE(far.out.find("what-if b1=0.13: solved, the nearest of 1 cached drapes"), std::string::npos)
+      << far.out;
+  const auto f = nlohmann::json::parse(ReadAll(dir / "f.json"));
+  EXPECT_FALSE(f["what_if"]["predicted"].get<bool>());
+  EXPECT_NE(f["what_if"]["reason"].get<std::string>().find("beyond the reach"), std::string::npos);
+  EXPECT_GT(f["drape_coefficient"].get<double>(), b["drape_coefficient"].get<double>());
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(dir / "cache")) entries += e.path().extension() == ".json";
+  EXPECT_EQ(entries, 2);
+}
+
 // --sensitivity adds the DC's σ (null without a fit covariance, with the reason) and the
 // influence table, largest change first, to drape.json and the text; the unmeasured membrane
 // default (compression ratio) leads for the Fig. 8 file.

@@ -136,6 +136,33 @@ std::vector<std::string> SensitivityParameterList(bool sensitivity, const std::s
   return names;
 }
 
+void AddSensitivityFlags(CLI::App* sub, SensitivityArgs* a, const std::string& quantity,
+                         const std::string& scope, const std::string& names) {
+  sub->add_flag("--sensitivity", a->sensitivity,
+                "Each material parameter's influence on " + quantity +
+                    " (its derivative per ln p, and its change over the parameter's "
+                    "uncertainty) and its sigma from the fit's covariance; " + scope +
+                    " (docs/methods/sensitivity.md)");
+  sub->add_option("--sensitivity-params", a->params,
+                  "--sensitivity: only these parameters, comma-separated as the material file "
+                  "names them (" + names + ")");
+  sub->add_option("--monte-carlo", a->monte_carlo,
+                  "Check the sigma: simulate N materials drawn from the fit's covariance of b1, "
+                  "b2, c1 and compare their spread with the linear sigma (implies "
+                  "--sensitivity; needs a fitted material)");
+  sub->add_option("--monte-carlo-seed", a->monte_carlo_seed,
+                  "--monte-carlo: the draws' seed (default 1)");
+}
+
+void PrintMonteCarlo(const std::string& quantity, const std::string& unit, double scale,
+                     const MonteCarloSpread& s) {
+  const std::string in = unit.empty() ? "" : " " + unit;
+  std::cout << quantity << " Monte Carlo: sigma "
+            << (std::isfinite(s.sigma) ? Num(scale * s.sigma, 2) + in : std::string("none"))
+            << ", mean " << Num(scale * s.mean, 4) << in << " over " << s.samples << " samples in "
+            << Num(s.seconds, 3) << " s (" << s.note << ")\n";
+}
+
 void PrintInfluences(const std::string& quantity, const std::string& unit, double scale,
                      double sigma, const std::string& sigma_note,
                      const std::vector<ParameterInfluence>& rows) {

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "textile/sim/law/material_parameters.h"
+#include "textile/sim/law/monte_carlo.h"
 #include <string>
 
 namespace textile::cli {
@@ -36,6 +37,25 @@ bool IsValidUtf8(const std::string& s);
 // material file spells them; none when the list is empty (every parameter). InputError for a
 // list without --sensitivity or with an empty name.
 std::vector<std::string> SensitivityParameterList(bool sensitivity, const std::string& list);
+
+// The flags of sensitivities and their Monte Carlo check (drape, acpm): --sensitivity,
+// --sensitivity-params LIST, --monte-carlo N, --monte-carlo-seed S. `quantity` names the result
+// ("the DC", "the crossing length L"), `scope` where it applies, `names` example parameters.
+struct SensitivityArgs {
+  bool sensitivity = false;
+  std::string params;
+  int monte_carlo = 0;
+  unsigned monte_carlo_seed = 1;
+  // --sensitivity's parameters (SensitivityParameterList); --monte-carlo implies --sensitivity.
+  std::vector<std::string> Parameters() const {
+    return SensitivityParameterList(sensitivity || monte_carlo > 0, params);
+  }
+};
+void AddSensitivityFlags(CLI::App* sub, SensitivityArgs* a, const std::string& quantity,
+                         const std::string& scope, const std::string& names);
+// Prints the Monte Carlo line: "<quantity> Monte Carlo: sigma ... over N samples (...)".
+void PrintMonteCarlo(const std::string& quantity, const std::string& unit, double scale,
+                     const MonteCarloSpread& spread);
 // Prints a quantity's σ line and its influence table (largest change first) on stdout:
 // "<quantity> sigma: ..." then one line a parameter; `scale` turns Q into the printed `unit`
 // (1e3 and "mm" for metres; "" for none).

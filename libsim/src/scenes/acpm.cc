@@ -1,6 +1,7 @@
 #include "textile/sim/scenes/acpm.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -221,6 +222,9 @@ bool AcpmOptions::Check(std::string* why) const {
         << " mm long sample";
     }
   }
+  if (s.str().empty() && (monte_carlo_samples < 0 || monte_carlo_samples == 1 ||
+                          monte_carlo_samples > 100000))
+    s << "monte carlo: must be 0 (none) or 2..100000 samples, got " << monte_carlo_samples;
   if (why != nullptr) *why = s.str();
   return s.str().empty();
 }
@@ -316,6 +320,21 @@ void AcpmSensitivities(const Material& material, const AcpmOptions& o,
   result->sigma_note = std::move(table.sigma_note);
 }
 
+// The mean crossing length's spread over materials drawn from the fit's covariance, each
+// through the elastica, beside the linear σ; into result->monte_carlo.
+void AcpmMonteCarlo(const CovarianceSamples& draws, const AcpmOptions& o,
+                    const std::vector<double>& z, AcpmResult* result) {
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<double> lengths;
+  for (const Material& sample : draws.materials) {
+    const AcpmCrossings c = ElasticaModel(sample, o, z);
+    lengths.push_back(c.converged ? MeanOverhang(c) : std::numeric_limits<double>::quiet_NaN());
+  }
+  result->monte_carlo = SummariseMonteCarlo(lengths, draws.rejected, result->crossing_length_sigma);
+  result->monte_carlo->seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 }  // namespace
 
 AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
@@ -323,6 +342,7 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
   if (!(std::isfinite(material.areal_density) && material.areal_density > 0.0))
     throw InputError("material: areal density must be > 0");
   AcpmOptions o = options;
+  if (o.monte_carlo_samples > 0) o.sensitivity = true;  // the linear σ beside the sampled one
   if (o.seam.direction == AcpmSeamDirection::kAlong && std::isnan(o.seam.position))
     o.seam.position = o.width / 2.0;
 
@@ -364,8 +384,13 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
   const std::vector<std::string> parameters = AcpmSensitivityParameters(material, o);
   if (o.sensitivity && !use_elastica)
     throw InputError(
-        "sensitivity: the elastica model only (plain samples and seams across the push); the "
-        "shell's are not built");
+        std::string(options.sensitivity ? "sensitivity" : "monte carlo") +
+        ": the elastica model only (plain samples and seams across the push); the shell's are "
+        "not built");
+  const CovarianceSamples draws =
+      o.monte_carlo_samples > 0
+          ? SampleFitCovariance(material, o.monte_carlo_samples, o.monte_carlo_seed)
+          : CovarianceSamples{};
   const std::vector<double> z = o.RayPositions();
   AcpmCrossings crossings;
   if (use_elastica) {
@@ -373,6 +398,7 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
     crossings = ElasticaModel(material, o, z);
     if (o.sensitivity && crossings.converged)
       AcpmSensitivities(material, o, z, parameters, &result);
+    if (o.monte_carlo_samples > 0 && crossings.converged) AcpmMonteCarlo(draws, o, z, &result);
   } else {
     result.model = AcpmModelKind::kShell;
     const AcpmModel shell = o.shell_model ? o.shell_model : ShellAcpmModel();
@@ -500,7 +526,7 @@ nlohmann::json AcpmResultToJson(const AcpmResult& r, const Material& material,
   j["solves"] = r.solves;
   if (!r.notes.empty()) j["notes"] = r.notes;
   if (!r.membrane_defaults.empty()) j["membrane_defaults"] = NotesJson(r.membrane_defaults);
-  if (o.sensitivity) {
+  if (o.sensitivity || o.monte_carlo_samples > 0) {
     j["crossing_length_sigma_mm"] =
         std::isfinite(r.crossing_length_sigma) ? json(units::MToMm(r.crossing_length_sigma)) : json();
     j["crossing_length_sigma_note"] = r.sigma_note;
@@ -517,6 +543,7 @@ nlohmann::json AcpmResultToJson(const AcpmResult& r, const Material& material,
                       {"length_change_mm", units::MToMm(s.change)}});
     j["sensitivities"] = rows;
   }
+  if (r.monte_carlo) j["monte_carlo"] = MonteCarloJson(*r.monte_carlo, 1e3, "mm");
   return j;
 }
 

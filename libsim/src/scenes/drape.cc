@@ -16,6 +16,7 @@
 #include "textile/sim/solve/cloth_problem.h"
 #include "textile/sim/elements/contact.h"
 #include "textile/sim/core/error.h"
+#include "textile/sim/core/number_text.h"
 #include "textile/sim/mesh/pattern_mesh.h"
 
 namespace textile {
@@ -372,10 +373,12 @@ bool DrapeOptions::Check(std::string* why) const {
   if (!Finite(node_prominence_relative) || node_prominence_relative < 0.0 ||
       node_prominence_relative >= 1.0)
     return Fail(why, "node_prominence_relative: must be in [0, 1)");
-  if (sensitivity && mount != DrapeMount::kClamped)
+  if ((sensitivity || monte_carlo_samples > 0) && mount != DrapeMount::kClamped)
     return Fail(why,
                 "sensitivity: clamped mount only (the resting mount's friction state has no "
                 "derivative here)");
+  if (monte_carlo_samples < 0 || monte_carlo_samples == 1 || monte_carlo_samples > 10000)
+    return Fail(why, "monte_carlo_samples: must be 0 (none) or in 2..10000");
   return true;
 }
 
@@ -684,6 +687,14 @@ struct SeedState {
   std::vector<double> d_dc_d_p;  // with options.sensitivity: ∂DC/∂p per parameter [per SI unit]
 };
 
+// What a Monte Carlo sample of a seed starts from: the seed's nominal equilibrium on the base
+// mesh, and its node count.
+struct SeedStart {
+  unsigned seed = 0;
+  Vertices base_positions;
+  size_t nodes = 0;
+};
+
 // The shadow of x on `mesh` into *shadow, and its DC.
 double MeasureDrape(const Vertices& x, const TriangleMesh& mesh, const DrapeOptions& o,
                     const DrapeResult& result, DrapeShadow* shadow) {
@@ -806,6 +817,55 @@ void MeasureSeed(const DrapeOptions& o, const DrapeScene& scene, const DrapeResu
   seed->mean_radius = seed->shadow.radii.mean();
 }
 
+// Stage 6 (Monte Carlo): a drawn material's drape for one seed, solved from the seed's nominal
+// equilibrium (so on its branch) and measured like the seed; *nodes its node count. NaN when
+// it fails.
+double SampleSeedDc(const Material& sample, const DrapeOptions& o, const DrapeScene& scene,
+                    const DrapeResult& result, const SeedStart& start, size_t* nodes) {
+  SeedState st;
+  st.seed.seed = start.seed;
+  st.fine_problem = MakeProblem(scene.fine, sample, scene.seams, o);
+  st.seed.positions = start.base_positions;
+  st.seed.summary = SolveStatic(st.fine_problem.get(), &st.seed.positions, o.solver);
+  st.seed.converged = st.seed.summary.converged;
+  SettleSplit(sample, o, scene, result, &st);
+  MeasureSeed(o, scene, result, &st.seed);
+  if (!st.seed.converged) return kNaN;
+  *nodes = st.seed.nodes.angles.size();
+  return st.seed.drape_coefficient;
+}
+
+// Stage 7 (Monte Carlo): the DC's spread over materials drawn from the fit's covariance, each
+// the mean over the seeds, beside the linear σ; into result->monte_carlo.
+void MonteCarloDc(const CovarianceSamples& draws, const DrapeOptions& options,
+                  const DrapeScene& scene, const std::vector<SeedStart>& starts,
+                  DrapeResult* result) {
+  const auto start = std::chrono::steady_clock::now();
+  DrapeOptions o = options;
+  o.progress = nullptr;  // a line a sample's seed would drown the run's own
+  std::vector<double> dcs;
+  for (size_t i = 0; i < draws.materials.size(); ++i) {
+    double sum = 0.0;
+    bool changed = false;
+    for (const SeedStart& s : starts) {
+      size_t nodes = 0;
+      sum += SampleSeedDc(draws.materials[i], o, scene, *result, s, &nodes);
+      changed = changed || (std::isfinite(sum) && nodes != s.nodes);
+    }
+    dcs.push_back(sum / static_cast<double>(starts.size()));
+    if (changed) ++result->monte_carlo_node_changes;
+    Say(options, "Monte Carlo: sample " + std::to_string(i + 1) + " of " +
+                     std::to_string(draws.materials.size()) + ": DC " + NumberText(dcs.back(), 4));
+  }
+  result->monte_carlo =
+      SummariseMonteCarlo(dcs, draws.rejected, result->drape_coefficient_sigma);
+  if (result->monte_carlo_node_changes > 0)
+    result->monte_carlo->note += "; " + std::to_string(result->monte_carlo_node_changes) +
+                                 " samples changed the node count (another branch)";
+  result->monte_carlo->seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 std::string SeedReport(const DrapeSeedResult& seed, bool split) {
   std::ostringstream line;
   line << "seed " << seed.seed << ": "
@@ -859,13 +919,21 @@ void SummariseSeeds(DrapeResult* result) {
 
 }  // namespace drape_internal
 
-DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
+DrapeResult SimulateDrape(const Material& material, const DrapeOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  if (std::string why; !o.Check(&why)) throw InputError("drape options: " + why);
+  if (std::string why; !options.Check(&why)) throw InputError("drape options: " + why);
+  DrapeOptions o = options;
+  if (o.monte_carlo_samples > 0) o.sensitivity = true;  // the linear σ beside the sampled one
   DrapeResult result;
   result.rim_turn_down = RimTurnDownLength(material, o);
-  // Sensitivities: the names and the covariance checked before any work (InputError).
+  // Sensitivities and Monte Carlo draws: the names and the covariance checked before any work
+  // (InputError).
   const std::vector<std::string> parameters = drape_internal::SensitivityParameters(material, o);
+  const CovarianceSamples draws =
+      o.monte_carlo_samples > 0
+          ? SampleFitCovariance(material, o.monte_carlo_samples, o.monte_carlo_seed)
+          : CovarianceSamples{};
+  std::vector<SeedStart> starts;
   const DrapeScene scene = BuildScene(o, &result);
   Say(o, SceneReport(scene, result));
   std::string failure;  // the first failing seed's
@@ -882,6 +950,9 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
       result.sensitivity_equilibria += scene.split ? 2 : 1;
     }
     if (!st.d_dc_d_p.empty()) seed_derivatives.push_back(std::move(st.d_dc_d_p));
+    if (o.monte_carlo_samples > 0 && st.seed.converged)
+      starts.push_back({st.seed.seed, scene.split ? st.base_positions : st.seed.positions,
+                        st.seed.nodes.angles.size()});
     Say(o, SeedReport(st.seed, scene.split != nullptr));
     if (!st.seed.converged && failure.empty())
       failure = "seed " + std::to_string(st.seed.seed) + ": " + st.failure;
@@ -891,6 +962,7 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& o) {
   if (!result.converged) result.message = failure;
   if (o.sensitivity && result.converged)
     drape_internal::SummariseSensitivities(material, parameters, seed_derivatives, &result);
+  if (o.monte_carlo_samples > 0 && result.converged) MonteCarloDc(draws, o, scene, starts, &result);
   bool rim_capped = false;
   if (o.rim_auto) AutoRimElementSize(material, o, o.rim_extrapolation, &rim_capped);
   result.notes = drape_internal::DrapeNotes(o, result, rim_capped);

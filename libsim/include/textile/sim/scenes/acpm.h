@@ -29,11 +29,13 @@
 
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "textile/sim/core/note.h"
 #include "textile/sim/law/material_parameters.h"
+#include "textile/sim/law/monte_carlo.h"
 #include "textile/sim/scenes/acpm_types.h"
 #include "textile/sim/mesh/mesh.h"
 
@@ -77,6 +79,9 @@ struct AcpmResult {
   std::vector<ParameterInfluence> sensitivities;
   double crossing_length_sigma = std::numeric_limits<double>::quiet_NaN();
   std::string sigma_note;
+  // With options.monte_carlo_samples: the crossing length's spread over the samples [m],
+  // beside the linear σ.
+  std::optional<MonteCarloSpread> monte_carlo;
 
   // One line: model, crossing range, factor range, device time.
   std::string BriefReport() const;

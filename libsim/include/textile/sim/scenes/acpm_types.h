@@ -92,6 +92,11 @@ struct AcpmOptions {
   // constants, beta, areal_density_gsm). The elastica model only.
   bool sensitivity = false;
   std::vector<std::string> sensitivity_parameters;
+  // Monte Carlo check of the σ (law/monte_carlo.h): this many materials drawn from the fit's
+  // covariance of b1, b2, c1 (0: none; else 2..100000), each pushed through the elastica.
+  // Implies sensitivity (the linear σ beside it). Needs a material with a fit covariance.
+  int monte_carlo_samples = 0;
+  unsigned monte_carlo_seed = 1;
 
   // False with "<field>: <problem>" in *why (names as the CLI flags say them, in mm).
   bool Check(std::string* why) const;

@@ -44,11 +44,13 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "textile/sim/law/material.h"
 #include "textile/sim/law/material_parameters.h"
+#include "textile/sim/law/monte_carlo.h"
 #include "textile/sim/mesh/mesh.h"
 #include "textile/sim/core/note.h"
 #include "textile/sim/law/seam.h"
@@ -174,6 +176,12 @@ struct DrapeOptions {
   // MaterialParameterNames), its influence and the DC's 1-σ. Clamped mount only.
   bool sensitivity = false;
   std::vector<std::string> sensitivity_parameters;
+  // Monte Carlo check of the σ (law/monte_carlo.h, docs/methods/sensitivity.md): this many
+  // materials drawn from the fit's covariance of b1, b2, c1 (0: none; else ≥ 2), each draped
+  // for every seed from that seed's equilibrium, so on its branch, as the linear σ assumes.
+  // Implies sensitivity (the linear σ beside it). Needs a material with a fit covariance.
+  int monte_carlo_samples = 0;
+  unsigned monte_carlo_seed = 1;
 
   // False with "<field>: <problem>" when a field is out of range.
   bool Check(std::string* why) const;
@@ -293,6 +301,11 @@ struct DrapeResult {
   // differences and back-substitutions, the outlines [s].
   double sensitivity_seconds = 0.0;
   int sensitivity_equilibria = 0;  // equilibria differentiated (two a seed with a split rim)
+  // With options.monte_carlo_samples (and converged): the DC's spread over the samples (each
+  // the mean over the seeds), beside the linear σ; monte_carlo_node_changes samples whose node
+  // count differed from the nominal drape's for some seed (another branch).
+  std::optional<MonteCarloSpread> monte_carlo;
+  int monte_carlo_node_changes = 0;
 };
 
 // The largest |seam_shift| [m] a shifted seam may have: one element (element_size) inside the

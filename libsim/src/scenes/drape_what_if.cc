@@ -1,0 +1,471 @@
+#include "textile/sim/scenes/drape_what_if.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+#include "textile/sim/core/content_hash.h"
+#include "textile/sim/core/error.h"
+#include "textile/sim/core/number_text.h"
+#include "textile/sim/core/units.h"
+#include "textile/sim/law/material_parameters.h"
+#include "textile/sim/law/seam.h"
+
+namespace textile {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr const char* kEntrySuffix = ".drape-cache.json";
+constexpr int kEntryVersion = 1;
+// SC §4's weight 1/(|d − d_m|² + ε²), in relative parameter changes: ε = 0.1 %.
+constexpr double kWeightEpsilon2 = 1e-6;
+
+// The law constants' prefix of a parameter name ("", "bending_weft.", "bending_bias."), or none.
+std::optional<std::string> LawPrefix(const std::string& name) {
+  const size_t dot = name.rfind('.');
+  const std::string constant = dot == std::string::npos ? name : name.substr(dot + 1);
+  if (constant != "b1" && constant != "b2" && constant != "c1") return std::nullopt;
+  const std::string prefix = dot == std::string::npos ? "" : name.substr(0, dot + 1);
+  if (!prefix.empty() && prefix != "bending_weft." && prefix != "bending_bias.") return std::nullopt;
+  return prefix;
+}
+
+// 0, 1, 2 for a name ending in b1, b2, c1.
+int ConstantIndex(const std::string& name) {
+  return name.ends_with("b1") ? 0 : name.ends_with("b2") ? 1 : 2;
+}
+
+std::optional<BendingLaw>* LawOf(Material* m, const std::string& prefix) {
+  return prefix == "bending_weft." ? &m->bending_weft : prefix == "bending_bias." ? &m->bending_bias : nullptr;
+}
+
+// The material with `names` set to `values` [SI]: each law's constants together (a law that is
+// valid at both ends may not be with one constant moved), the others one by one
+// (WithMaterialParameter, which also clears their defaulted and given forms). Throws
+// InputError when the values make no valid material.
+Material WithParameterValues(const Material& material, const std::vector<std::string>& names,
+                             const std::vector<double>& values) {
+  Material m = material;
+  for (const std::string prefix : {"", "bending_weft.", "bending_bias."}) {
+    BendingLaw law = prefix.empty() ? m.bending : LawOf(&m, prefix)->value_or(m.bending);
+    if (law.is_spline()) continue;
+    double k[3] = {law.b1(), law.b2(), law.c1()};
+    bool any = false, b1_named = false;
+    for (size_t i = 0; i < names.size(); ++i) {
+      const std::optional<std::string> p = LawPrefix(names[i]);
+      if (!p || *p != prefix) continue;
+      k[ConstantIndex(names[i])] = values[i];
+      b1_named = b1_named || names[i] == prefix + "b1";
+      any = true;
+    }
+    if (!any) continue;
+    if (law.kappa0() == 0.0 && !b1_named) k[0] = k[1];  // M = b2 κ: b2 is the line's slope
+    if (const std::string why = BendingLaw::Invalidity(k[0], k[1], k[2]); !why.empty())
+      throw InputError(why);
+    if (prefix.empty())
+      m.bending = BendingLaw::FromSi(k[0], k[1], k[2]);
+    else
+      *LawOf(&m, prefix) = BendingLaw::FromSi(k[0], k[1], k[2]);
+  }
+  for (size_t i = 0; i < names.size(); ++i)
+    if (!LawPrefix(names[i])) m = WithMaterialParameter(m, names[i], values[i]);
+  for (const std::string& name : names) std::erase(m.defaulted, name);
+  return m;
+}
+
+// What of a material must match for an entry to answer: its file form with the parameters set
+// through WithParameterValues, without the name and the fit (which move no drape).
+json MaterialForm(const Material& m) {
+  json j = MaterialToJson(m);
+  j.erase("name");
+  j.erase("fit");
+  return j;
+}
+
+// The two forms agree: the same keys and strings, numbers to 1e-9 relative (a tensile curve
+// scaled there and back is the same curve to round-off).
+bool SameForm(const json& a, const json& b) {
+  if (a.is_number() && b.is_number()) {
+    const double x = a.get<double>(), y = b.get<double>();
+    return std::abs(x - y) <= 1e-9 * std::max(std::abs(x), std::abs(y));
+  }
+  if (a.type() != b.type() || a.size() != b.size()) return false;
+  if (a.is_object()) {
+    for (auto it = a.begin(); it != a.end(); ++it)
+      if (!b.contains(it.key()) || !SameForm(it.value(), b[it.key()])) return false;
+    return true;
+  }
+  if (a.is_array()) {
+    for (size_t i = 0; i < a.size(); ++i)
+      if (!SameForm(a[i], b[i])) return false;
+    return true;
+  }
+  return a == b;
+}
+
+std::vector<std::string> Names(const DrapeCacheEntry& e) {
+  std::vector<std::string> names;
+  for (const DrapeCacheEntry::Parameter& p : e.parameters) names.push_back(p.name);
+  return names;
+}
+
+json EntryJson(const DrapeCacheEntry& e) {
+  json parameters = json::array();
+  for (const DrapeCacheEntry::Parameter& p : e.parameters)
+    parameters.push_back(
+        {{"name", p.name}, {"value_si", p.value}, {"scale_si", p.scale}, {"d_dc_d_p", p.d_dc_d_p}});
+  return {{"textile_drape_cache", kEntryVersion}, {"scene_key", e.scene_key},
+          {"material", e.material},               {"parameters", parameters},
+          {"drape_coefficient", e.drape_coefficient}, {"nodes", e.nodes}};
+}
+
+DrapeCacheEntry EntryFromJson(const json& j, const std::string& path) {
+  const auto bad = [&path](const std::string& why) {
+    return InputError(path + ": not a drape cache entry (" + why + ")");
+  };
+  if (!j.is_object() || !j.contains("textile_drape_cache")) throw bad("no textile_drape_cache");
+  if (j["textile_drape_cache"] != kEntryVersion)
+    throw bad("version " + j["textile_drape_cache"].dump() + ", this textile reads " +
+              std::to_string(kEntryVersion));
+  try {
+    DrapeCacheEntry e;
+    e.scene_key = j.at("scene_key").get<std::string>();
+    e.material = j.at("material");
+    for (const json& p : j.at("parameters"))
+      e.parameters.push_back({p.at("name").get<std::string>(), p.at("value_si").get<double>(),
+                              p.at("scale_si").get<double>(), p.at("d_dc_d_p").get<double>()});
+    e.drape_coefficient = j.at("drape_coefficient").get<double>();
+    e.nodes = j.at("nodes").get<double>();
+    for (const DrapeCacheEntry::Parameter& p : e.parameters)
+      if (!std::isfinite(p.value) || !(p.scale > 0.0) || !std::isfinite(p.d_dc_d_p))
+        throw bad(p.name + ": a value, scale or derivative that is not a finite number");
+    return e;
+  } catch (const json::exception& x) {
+    throw bad(x.what());
+  }
+}
+
+// A value in the material file's unit, in SI.
+double LabToSi(const std::string& unit, double lab) {
+  if (unit == "gf·cm") return units::KesStiffnessToSi(lab);
+  if (unit == "gf·cm²") return units::KesQuadraticToSi(lab);
+  if (unit == "g/m²") return units::GsmToSi(lab);
+  return lab;  // N/m, N/m/rad, -
+}
+
+// One cached drape's view of the target: where the target lies from it, relative to each
+// parameter's scale, and the entry's DC and gradient in those units.
+struct EntryView {
+  Eigen::VectorXd offset;    // d_e − d: the entry's relative position from the target
+  Eigen::VectorXd gradient;  // ∂DC/∂d [per relative change]
+  double dc = 0.0;
+  double distance = 0.0;     // max |offset|
+};
+
+std::optional<EntryView> ViewFrom(const DrapeCacheEntry& e, const Material& target,
+                                  const json& target_form_at_entry) {
+  if (!SameForm(e.material, target_form_at_entry)) return std::nullopt;
+  EntryView v;
+  const size_t n = e.parameters.size();
+  v.offset.resize(static_cast<long>(n));
+  v.gradient.resize(static_cast<long>(n));
+  for (size_t k = 0; k < n; ++k) {
+    const DrapeCacheEntry::Parameter& p = e.parameters[k];
+    const double scale = MaterialParameterScale(target, p.name);
+    v.offset(static_cast<long>(k)) = (p.value - GetMaterialParameter(target, p.name).si) / scale;
+    v.gradient(static_cast<long>(k)) = p.d_dc_d_p * scale;
+  }
+  v.dc = e.drape_coefficient;
+  v.distance = n ? v.offset.cwiseAbs().maxCoeff() : 0.0;
+  return v;
+}
+
+// SC §4's GMLS with the linear basis p(d) = (1, d): the coefficients a minimise
+// Σ w_m (a·p(d_m) − DC_m)² + Σ w_m Σ_j (a·∂p/∂d_j − s_j^m)², w_m = 1/(|d_m − d|² + ε²), d the
+// target (0 here); the prediction is a·p(0) = a_0.
+double Gmls(const std::vector<EntryView>& views) {
+  const long n = views.front().offset.size() + 1;
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(n, n);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
+  for (const EntryView& v : views) {
+    const double w = 1.0 / (v.offset.squaredNorm() + kWeightEpsilon2);
+    Eigen::VectorXd p(n);
+    p << 1.0, v.offset;
+    g += w * p * p.transpose();
+    rhs += w * v.dc * p;
+    for (long j = 1; j < n; ++j) {  // ∂p/∂d_j = e_j
+      g(j, j) += w;
+      rhs(j) += w * v.gradient(j - 1);
+    }
+  }
+  return g.ldlt().solve(rhs)(0);
+}
+
+// The error estimate of a prediction `dc` (docs/methods/sensitivity.md, "What-if"), the largest
+// of: the entries' disagreement at the target (their first-order values against dc); from the
+// nearest entry, the second-order term ½ Σ |∂DC/∂d_k| d_k² and half its first-order change
+// (the what-if bench: the DC curved by up to that much within ±10 %); and, for any change at
+// all, the DC's jitter between neighbouring solves (kJitter).
+constexpr double kJitter = 0.002;
+double ErrorEstimate(const EntryView& nearest, const std::vector<EntryView>& views, double dc) {
+  double spread = 0.0;
+  for (const EntryView& v : views)
+    spread = std::max(spread, std::abs(v.dc - v.gradient.dot(v.offset) - dc));
+  double second_order = 0.0;
+  for (long k = 0; k < nearest.offset.size(); ++k)
+    second_order += 0.5 * std::abs(nearest.gradient(k)) * nearest.offset(k) * nearest.offset(k);
+  const double half_change = 0.5 * std::abs(nearest.gradient.dot(nearest.offset));
+  const double jitter = nearest.distance > 0.0 ? kJitter : 0.0;
+  return std::max({spread, second_order, half_change, jitter});
+}
+
+}  // namespace
+
+json DrapeSceneJson(const DrapeOptions& o) {
+  // Each field that shapes the DC. A field added to DrapeOptions must be added here or to the
+  // list of those that do not (progress, sensitivity, Monte Carlo): the size check says so.
+  static_assert(sizeof(void*) != 8 || sizeof(DrapeOptions) == 640, "DrapeOptions changed: update DrapeSceneJson");
+  return {{"specimen_radius", o.specimen_radius},
+          {"support_radius", o.support_radius},
+          {"mount", DrapeMountName(o.mount)},
+          {"support_thickness", o.support_thickness},
+          {"rim_rounding", o.rim_rounding},
+          {"drop_height", o.drop_height},
+          {"contact_sink", o.contact_sink},
+          {"seeds", o.seeds},
+          {"first_seed", o.first_seed},
+          {"perturbation", o.perturbation},
+          {"start_droop", o.start_droop},
+          {"harmonics", {o.min_harmonic, o.max_harmonic}},
+          {"frame_angle", o.frame_angle},
+          {"element_size", o.element_size},
+          {"rim_element_size", o.rim_element_size},
+          {"rim_band", o.rim_band},
+          {"rim_extrapolation", o.rim_extrapolation},
+          {"coarse_to_fine", o.coarse_to_fine},
+          {"coarse_factor", o.coarse_factor},
+          {"circle_segments", o.circle_segments},
+          {"seams", DrapeSeamsName(o.seams)},
+          {"seam_profile", o.seams == DrapeSeams::kNone ? json() : SeamProfileToJson(o.seam_profile)},
+          {"seam_shift", o.seam_shift},
+          {"seam_refinement_range", o.seam_refinement_range},
+          {"solver", {{"method", SolverMethodName(o.solver.method)}, {"tolerance", o.solver.tolerance}}},
+          {"raster_cell", o.raster_cell},
+          {"outline_bins", o.outline_bins},
+          {"smoothing_bins", o.smoothing_bins},
+          {"node_prominence", o.node_prominence},
+          {"node_prominence_relative", o.node_prominence_relative}};
+}
+
+std::string DrapeSceneKey(const DrapeOptions& options) {
+  return HashContent(DrapeSceneJson(options).dump()).Hex();
+}
+
+DrapeCacheEntry MakeDrapeCacheEntry(const Material& material, const DrapeOptions& options,
+                                    const DrapeResult& result) {
+  if (!result.converged) throw InputError("drape cache: the drape did not converge");
+  if (result.sensitivities.empty())
+    throw InputError("drape cache: the drape has no sensitivities (run it with them)");
+  DrapeCacheEntry e;
+  e.scene_key = DrapeSceneKey(options);
+  std::vector<std::string> names;
+  std::vector<double> values;
+  for (const std::string& name : MaterialParameterNames(material)) {
+    const auto row = std::find_if(result.sensitivities.begin(), result.sensitivities.end(),
+                                  [&](const ParameterInfluence& s) { return s.parameter == name; });
+    if (row == result.sensitivities.end())
+      throw InputError("drape cache: the drape has no sensitivity for " + name +
+                       " (a cached drape needs every parameter's)");
+    const double value = GetMaterialParameter(material, name).si;
+    e.parameters.push_back({name, value, MaterialParameterScale(material, name), row->d_q_d_p});
+    names.push_back(name);
+    values.push_back(value);
+  }
+  e.material = MaterialForm(WithParameterValues(material, names, values));
+  e.drape_coefficient = result.drape_coefficient;
+  e.nodes = result.nodes;
+  return e;
+}
+
+void WriteDrapeCacheEntry(const std::string& dir, const DrapeCacheEntry& entry) {
+  std::error_code error;
+  fs::create_directories(dir, error);
+  if (error) throw InputError("--cache " + dir + ": cannot create the folder: " + error.message());
+  const json j = EntryJson(entry);
+  std::string identity = entry.scene_key + entry.material.dump();
+  for (const DrapeCacheEntry::Parameter& p : entry.parameters) identity += NumberText(p.value, 17);
+  const fs::path path = fs::path(dir) / (HashContent(identity).Hex() + kEntrySuffix);
+  const fs::path temporary = path.string() + ".tmp" + std::to_string(::getpid());
+  {
+    std::ofstream out(temporary);
+    out << j.dump(1) << "\n";
+    if (!out) throw InputError("--cache " + dir + ": cannot write " + temporary.string());
+  }
+  fs::rename(temporary, path, error);
+  if (error) {
+    fs::remove(temporary, error);
+    throw InputError("--cache " + dir + ": cannot write " + path.string());
+  }
+}
+
+std::vector<DrapeCacheEntry> ReadDrapeCache(const std::string& dir, const DrapeOptions& options) {
+  std::vector<DrapeCacheEntry> entries;
+  std::error_code error;
+  if (!fs::exists(dir, error)) return entries;
+  if (!fs::is_directory(dir, error)) throw InputError("--cache " + dir + ": not a folder");
+  const std::string key = DrapeSceneKey(options);
+  std::vector<fs::path> files;
+  for (const fs::directory_entry& f : fs::directory_iterator(dir, error)) {
+    const std::string name = f.path().filename().string();
+    if (name.size() > std::string(kEntrySuffix).size() && name.ends_with(kEntrySuffix))
+      files.push_back(f.path());
+  }
+  std::sort(files.begin(), files.end());  // the same order on every file system
+  for (const fs::path& path : files) {
+    std::ifstream in(path);
+    std::stringstream text;
+    text << in.rdbuf();
+    json j;
+    try {
+      j = json::parse(text.str());
+    } catch (const json::exception&) {
+      throw InputError(path.string() + ": not a drape cache entry (not JSON)");
+    }
+    DrapeCacheEntry e = EntryFromJson(j, path.string());
+    if (e.scene_key == key) entries.push_back(std::move(e));
+  }
+  return entries;
+}
+
+Material ApplyWhatIfEdits(const Material& material, const std::string& edits) {
+  if (edits.empty()) throw InputError("--what-if: no edits (NAME=VALUE,...)");
+  Material m = material;
+  std::vector<std::string> seen;
+  for (size_t from = 0; from <= edits.size();) {
+    const size_t comma = std::min(edits.find(',', from), edits.size());
+    const std::string edit = edits.substr(from, comma - from);
+    from = comma + 1;
+    const size_t eq = edit.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == edit.size())
+      throw InputError("--what-if: '" + edit + "' is not NAME=VALUE");
+    const std::string name = edit.substr(0, eq), text = edit.substr(eq + 1);
+    if (std::find(seen.begin(), seen.end(), name) != seen.end())
+      throw InputError("--what-if: " + name + " given twice");
+    seen.push_back(name);
+    const MaterialParameterValue old = GetMaterialParameter(m, name);  // an unknown name
+    if (const std::string why = ParameterWithoutEffect(m, name); !why.empty())
+      throw InputError("--what-if: " + why);
+    size_t used = 0;
+    double lab = 0.0;
+    try {
+      lab = std::stod(text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != text.size() || !std::isfinite(lab))
+      throw InputError("--what-if: " + name + " = '" + text + "' is not a number");
+    try {
+      m = WithMaterialParameter(m, name, LabToSi(old.unit, lab));
+    } catch (const InputError& e) {
+      throw InputError("--what-if: " + name + " = " + text + " " + old.unit +
+                       " is outside the material's valid range: " + e.what());
+    }
+  }
+  return m;
+}
+
+DrapeWhatIf PredictDrape(const Material& material, const std::vector<DrapeCacheEntry>& cache,
+                         const WhatIfOptions& options) {
+  DrapeWhatIf w;
+  std::vector<EntryView> views;
+  const EntryView* nearest = nullptr;
+  for (const DrapeCacheEntry& e : cache) {
+    std::vector<double> values;
+    for (const DrapeCacheEntry::Parameter& p : e.parameters) values.push_back(p.value);
+    json form;
+    try {
+      form = MaterialForm(WithParameterValues(material, Names(e), values));
+    } catch (const InputError&) {
+      continue;  // another kind of material (a parameter it does not have)
+    }
+    std::optional<EntryView> v = ViewFrom(e, material, form);
+    if (!v) continue;
+    ++w.entries_matching;
+    if (std::isnan(w.distance) || v->distance < w.distance) w.distance = v->distance;
+    if (v->distance <= options.reach) views.push_back(std::move(*v));
+  }
+  if (views.empty()) {
+    w.reason = w.entries_matching == 0
+                   ? "no cached drape of this scene and material form"
+                   : "the nearest of " + std::to_string(w.entries_matching) +
+                         " cached drapes is " + NumberText(100.0 * w.distance, 3) +
+                         " % away in a parameter, beyond the reach of " +
+                         NumberText(100.0 * options.reach, 3) + " %";
+    return w;
+  }
+  for (const EntryView& v : views)
+    if (!nearest || v.distance < nearest->distance) nearest = &v;
+  w.entries_used = static_cast<int>(views.size());
+  w.drape_coefficient = Gmls(views);
+  w.error_estimate = ErrorEstimate(*nearest, views, w.drape_coefficient);
+  const std::string how = "from " + std::to_string(w.entries_used) + " cached drape" +
+                          (w.entries_used > 1 ? "s" : "") + ", the nearest " +
+                          NumberText(100.0 * nearest->distance, 3) + " % away";
+  if (w.error_estimate > options.max_error) {
+    w.reason = "the estimated error " + NumberText(w.error_estimate, 2) + " (" + how +
+               ") is above " + NumberText(options.max_error, 2);
+    w.drape_coefficient = std::numeric_limits<double>::quiet_NaN();
+    return w;
+  }
+  w.predicted = true;
+  w.reason = "predicted " + how;
+  return w;
+}
+
+json DrapeWhatIfJson(const DrapeWhatIf& w) {
+  const auto number = [](double v) { return std::isfinite(v) ? json(v) : json(); };
+  return {{"predicted", w.predicted},
+          {"drape_coefficient", number(w.drape_coefficient)},
+          {"error_estimate", number(w.error_estimate)},
+          {"entries_used", w.entries_used},
+          {"entries_matching", w.entries_matching},
+          {"distance_percent", number(100.0 * w.distance)},
+          {"reason", w.reason}};
+}
+
+DrapeWhatIfPrediction PredictDrapeWhatIf(const Material& material, const std::string& edits,
+                                         const DrapeOptions& options, const std::string& cache_dir,
+                                         const WhatIfOptions& what_if) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!(what_if.reach > 0.0 && what_if.reach <= 1.0))
+    throw InputError("what-if reach: must be in (0, 100] %, got " + NumberText(100.0 * what_if.reach) + " %");
+  if (!(what_if.max_error > 0.0 && what_if.max_error < 1.0))
+    throw InputError("what-if max error: must be in (0, 1), got " + NumberText(what_if.max_error));
+  DrapeWhatIfPrediction p;
+  p.material = ApplyWhatIfEdits(material, edits);
+  p.what_if = PredictDrape(p.material, ReadDrapeCache(cache_dir, options), what_if);
+  p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return p;
+}
+
+DrapeResult SimulateDrapeCached(const Material& material, const DrapeOptions& options,
+                                const std::string& cache_dir) {
+  if (!options.sensitivity_parameters.empty())
+    throw InputError("--cache: a cached drape needs every parameter's sensitivity (leave out "
+                     "--sensitivity-params)");
+  ReadDrapeCache(cache_dir, options);  // a folder that is none, or a bad entry: before the solve
+  DrapeOptions o = options;
+  o.sensitivity = true;
+  DrapeResult r = SimulateDrape(material, o);
+  if (r.converged) WriteDrapeCacheEntry(cache_dir, MakeDrapeCacheEntry(material, o, r));
+  return r;
+}
+
+}  // namespace textile

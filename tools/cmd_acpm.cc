@@ -73,7 +73,7 @@ AcpmOptions Options(const AcpmArgs& a) {
   o.sensitivity = a.sensitivity.sensitivity;
   o.sensitivity_parameters = a.sensitivity.Parameters();
   o.monte_carlo_samples = a.sensitivity.monte_carlo;
-  o.monte_carlo_seed = a.sensitivity.monte_carlo_seed;
+  o.monte_carlo_seed = a.sensitivity.Seed();
   if (std::string why; !o.Check(&why)) throw InputError("acpm: " + why);
   // RunAcpm refuses this too; here it is the flags' fault, not the material's.
   if (o.model == AcpmModelKind::kElastica && o.seam.direction == AcpmSeamDirection::kAlong)
@@ -302,7 +302,9 @@ void RegisterAcpm(CLI::App& app) {
   sub->add_option(
       "--crossing-tol-mm", a->crossing_tol_mm,
       "Crossing refinement of stepping models [mm] (default 0.05; the elastica is exact)");
-  AddSensitivityFlags(sub, &a->sensitivity, "the crossing length L", "the elastica model only",
+  AddSensitivityFlags(sub, &a->sensitivity, "the crossing length L",
+                      "differences of exact elastica solves, or of whole shell runs (two a "
+                      "parameter) for a seam along the push",
                       "b1,b2,c1,beta,areal_density_gsm");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   sub->callback([a] { Run(*a); });

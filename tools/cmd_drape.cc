@@ -61,8 +61,7 @@ struct DrapeArgs {
   SensitivityArgs sensitivity;
   // --cache DIR keeps the drape with its sensitivities; --what-if EDITS predicts from it.
   std::string cache, what_if;
-  double what_if_reach_percent = 10.0;
-  double what_if_max_error = 0.01;
+  std::optional<double> what_if_reach_percent, what_if_max_error;
 };
 
 SeamProfile LoadSeamProfile(const DrapeArgs& a) {
@@ -158,7 +157,7 @@ DrapeOptions Options(const DrapeArgs& a) {
   o.sensitivity = a.sensitivity.sensitivity;
   o.sensitivity_parameters = a.sensitivity.Parameters();
   o.monte_carlo_samples = a.sensitivity.monte_carlo;
-  o.monte_carlo_seed = a.sensitivity.monte_carlo_seed;
+  o.monte_carlo_seed = a.sensitivity.Seed();
   o.first_seed = a.first_seed;
   if (a.resolution_mm) {
     const double h = finite(*a.resolution_mm, "--resolution-mm");
@@ -361,6 +360,37 @@ void PrintComparison(const DrapeComparison& c, const DrapeArgs& a, bool several_
   for (const Note& n : c.notes) std::cout << "  note: " << n.text << "\n";
 }
 
+// The scene as the options give it, in mm (the result's `scene` without the mesh's figures).
+nlohmann::json SceneJson(const DrapeOptions& o) {
+  nlohmann::json j = {
+      {"specimen_radius_mm", units::MToMm(o.specimen_radius)},
+      {"support_radius_mm", units::MToMm(o.support_radius)},
+      {"mount", DrapeMountName(o.mount)},
+      {"seams", DrapeSeamsName(o.seams)},
+      {"perturbation_mm", units::MToMm(o.perturbation)},
+      {"frame_deg", o.frame_angle / kDegree},
+      {"start_modes", {o.min_harmonic, o.max_harmonic}},
+      {"resolution_mm", units::MToMm(o.element_size)},
+      {"rim_mm", units::MToMm(o.rim_element_size)},
+      {"rim_band_mm",
+       o.rim_element_size > 0.0 ? nlohmann::json(units::MToMm(o.rim_band)) : nlohmann::json()},
+      {"seam_refine_mm", o.seams != DrapeSeams::kNone
+                             ? nlohmann::json(units::MToMm(o.seam_refinement_range))
+                             : nlohmann::json()},
+      {"contact_sink_mm", o.mount == DrapeMount::kResting
+                              ? nlohmann::json(units::MToMm(o.contact_sink))
+                              : nlohmann::json()},
+      {"coarse_to_fine", o.coarse_to_fine},
+      {"extrapolate", o.rim_extrapolation},
+      {"tolerance", o.solver.tolerance},
+      {"raster_cell_mm", units::MToMm(o.raster_cell)}};
+  if (o.seams != DrapeSeams::kNone) {
+    j["seam_profile"] = SeamProfileToJson(o.seam_profile);
+    if (o.seams == DrapeSeams::kShifted) j["shift_mm"] = units::MToMm(o.seam_shift);
+  }
+  return j;
+}
+
 nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Material& m,
                           const DrapeArgs& a) {
   nlohmann::json j;
@@ -408,39 +438,16 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
     }
     j["seeds"].push_back(js);
   }
-  j["scene"] = {{"specimen_radius_mm", units::MToMm(o.specimen_radius)},
-                {"support_radius_mm", units::MToMm(o.support_radius)},
-                {"mount", DrapeMountName(o.mount)},
-                {"seams", DrapeSeamsName(o.seams)},
-                {"perturbation_mm", units::MToMm(o.perturbation)},
-                {"frame_deg", o.frame_angle / kDegree},
-                {"start_modes", {o.min_harmonic, o.max_harmonic}},
-                {"resolution_mm", units::MToMm(o.element_size)},
-                {"rim_mm", units::MToMm(o.rim_element_size)},
-                {"rim_band_mm", o.rim_element_size > 0.0 ? nlohmann::json(units::MToMm(o.rim_band))
-                                                         : nlohmann::json()},
-                {"seam_refine_mm", o.seams != DrapeSeams::kNone
-                                       ? nlohmann::json(units::MToMm(o.seam_refinement_range))
-                                       : nlohmann::json()},
-                {"contact_sink_mm", o.mount == DrapeMount::kResting
-                                        ? nlohmann::json(units::MToMm(o.contact_sink))
-                                        : nlohmann::json()},
-                {"rim_turn_down_mm", units::MToMm(r.rim_turn_down)},
-                {"coarse_to_fine", o.coarse_to_fine},
-                {"extrapolate", o.rim_extrapolation},
-                {"base_vertices", r.base_vertices},
-                {"tolerance", o.solver.tolerance},
-                {"raster_cell_mm", units::MToMm(o.raster_cell)},
-                {"vertices", r.mesh.num_vertices()},
-                {"triangles", r.mesh.num_triangles()},
-                {"coarse_vertices", r.coarse_vertices},
-                {"specimen_area_mm2", r.specimen_area * 1e6},
-                {"support_area_mm2", r.support_area * 1e6},
-                {"mass_g", r.mass * 1e3}};
-  if (o.seams != DrapeSeams::kNone) {
-    j["scene"]["seam_profile"] = SeamProfileToJson(o.seam_profile);
-    if (o.seams == DrapeSeams::kShifted) j["scene"]["shift_mm"] = units::MToMm(o.seam_shift);
-  }
+  j["scene"] = SceneJson(o);
+  nlohmann::json& scene = j["scene"];
+  scene["rim_turn_down_mm"] = units::MToMm(r.rim_turn_down);
+  scene["base_vertices"] = r.base_vertices;
+  scene["vertices"] = r.mesh.num_vertices();
+  scene["triangles"] = r.mesh.num_triangles();
+  scene["coarse_vertices"] = r.coarse_vertices;
+  scene["specimen_area_mm2"] = r.specimen_area * 1e6;
+  scene["support_area_mm2"] = r.support_area * 1e6;
+  scene["mass_g"] = r.mass * 1e3;
   if (o.sensitivity || o.monte_carlo_samples > 0) {
     j["drape_coefficient_sigma"] = NumberOrNull(r.drape_coefficient_sigma);
     j["drape_coefficient_sigma_note"] = r.sigma_note;
@@ -533,17 +540,25 @@ void PrintText(const DrapeResult& r, const DrapeOptions& o, const Material& m, c
   if (!a.ply.empty()) std::cout << "mesh (PLY): " << a.ply << "\n";
 }
 
+// Where a what-if's scene comes from (docs/guide/drape.md, "What-if").
+constexpr const char* kSceneFrom =
+    "the --material file: --rim-mm auto sizes the rim before the edits, so a drape of the "
+    "edited file alone may mesh its rim otherwise";
+
 // --what-if answered from the cache: the result file holds the prediction, the edited material
 // and the scene; no outline, picture or mesh (there is no drape).
 void WritePrediction(const DrapeWhatIfPrediction& p, const DrapeOptions& o, const DrapeArgs& a) {
   nlohmann::json j = {{"what_if", DrapeWhatIfJson(p.what_if)},
                       {"drape_coefficient", p.what_if.drape_coefficient},
                       {"drape_coefficient_error_estimate", p.what_if.error_estimate},
-                      {"scene", DrapeSceneJson(o)},
+                      {"scene", SceneJson(o)},
                       {"material", MaterialToJson(p.material)},
                       {"seconds", p.seconds}};
   j["what_if"]["edits"] = a.what_if;
   j["what_if"]["cache"] = a.cache;
+  j["what_if"]["scene_from"] = kSceneFrom;
+  j["note"] = p.what_if.notes.empty() ? nlohmann::json()
+                                      : nlohmann::json(JoinNoteTexts(p.what_if.notes, "; "));
   j["material"]["file"] = a.material;
   AtomicFileSet outputs;
   outputs.Add(a.out).Write(j.dump(2) + "\n");
@@ -553,20 +568,39 @@ void WritePrediction(const DrapeWhatIfPrediction& p, const DrapeOptions& o, cons
     PrintJson(j);
     return;
   }
-  std::cout << "what-if " << a.what_if << ": DC " << Num(p.what_if.drape_coefficient, 4) << " ± "
-            << Num(p.what_if.error_estimate, 2) << " (" << p.what_if.reason << ") in "
-            << Num(1e3 * p.seconds, 3) << " ms\nresult: " << a.out << "\n";
+  std::cout << "what-if " << a.what_if << ": DC " << Num(p.what_if.drape_coefficient, 4)
+            << ", estimated error " << Num(p.what_if.error_estimate, 2) << " ("
+            << p.what_if.reason << "; a rule of thumb that does not foresee a change of the "
+            << "node count) in " << Num(1e3 * p.seconds, 3) << " ms\n";
+  for (const Note& n : p.what_if.notes) std::cout << "note: " << n.text << "\n";
+  std::cout << "result: " << a.out << "\n";
 }
 
-// The what-if flags' own checks: --what-if needs --cache, and answers with a DC only.
+// The what-if flags' own checks, with the flags' names: --what-if needs --cache and answers
+// with a DC only; its options need it; --cache needs every parameter's sensitivity.
 void CheckWhatIfArgs(const DrapeArgs& a) {
-  if (a.what_if.empty()) return;
-  if (a.cache.empty()) throw InputError("--what-if: needs --cache DIR (the solved drapes it predicts from)");
-  for (const auto& [flag, value] : {std::pair{"--png", a.png}, {"--obj", a.obj}, {"--ply", a.ply},
-                                    {"--compare", a.compare}})
-    if (!value.empty())
-      throw InputError(std::string("--what-if: predicts the DC only; ") + flag +
-                       " needs a drape (run without --what-if)");
+  if (a.what_if.empty()) {
+    if (a.what_if_reach_percent) throw InputError("--what-if-reach-pct: needs --what-if");
+    if (a.what_if_max_error) throw InputError("--what-if-max-error: needs --what-if");
+  } else {
+    if (a.cache.empty())
+      throw InputError("--what-if: needs --cache DIR (the solved drapes it predicts from)");
+    for (const auto& [flag, value] : {std::pair{"--png", a.png}, {"--obj", a.obj}, {"--ply", a.ply},
+                                      {"--compare", a.compare}})
+      if (!value.empty())
+        throw InputError(std::string("--what-if: predicts the DC only; ") + flag +
+                         " needs a drape (run without --what-if)");
+    if (a.sensitivity.sensitivity || a.sensitivity.monte_carlo > 0)
+      throw InputError("--what-if: predicts the DC only; --sensitivity and --monte-carlo need a "
+                       "drape (run without --what-if)");
+    if (const double r = a.what_if_reach_percent.value_or(10.0); !(r > 0.0 && r <= 100.0))
+      throw InputError("--what-if-reach-pct: must be in (0, 100], got " + Num(r));
+    if (const double e = a.what_if_max_error.value_or(0.01); !(e > 0.0 && e < 1.0))
+      throw InputError("--what-if-max-error: must be in (0, 1), got " + Num(e));
+  }
+  if (!a.cache.empty() && !a.sensitivity.params.empty())
+    throw InputError("--cache: a cached drape needs every parameter's sensitivity (leave out "
+                     "--sensitivity-params)");
 }
 
 void Run(const DrapeArgs& a) {
@@ -602,18 +636,18 @@ void Run(const DrapeArgs& a) {
   // --what-if: the scene is the file material's (its rim), the material the edited one.
   std::optional<DrapeWhatIf> what_if;
   if (!a.what_if.empty()) {
-    DrapeWhatIfPrediction p;
-    try {
-      p = PredictDrapeWhatIf(m, a.what_if, o, a.cache,
-                             {a.what_if_reach_percent / 100.0, a.what_if_max_error});
-    } catch (const InputError& e) {
-      throw InputError(a.material + ": " + e.what());
-    }
+    // The edits' and the cache's errors name their flag (no material-file prefix).
+    DrapeWhatIfPrediction p = PredictDrapeWhatIf(
+        m, a.what_if, o, a.cache,
+        {a.what_if_reach_percent.value_or(10.0) / 100.0, a.what_if_max_error.value_or(0.01)});
     if (p.what_if.predicted) return WritePrediction(p, o, a);
     Progress("drape: what-if: solving, " + p.what_if.reason, a.progress);
     m = std::move(p.material);
     what_if = std::move(p.what_if);
   }
+  if (!a.cache.empty() && o.mount != DrapeMount::kClamped)
+    throw InputError("--cache: clamped mount only (a cached drape carries sensitivities, which "
+                     "the resting mount has not)");
   if (!a.cache.empty()) o.sensitivity = true;  // a cached drape carries them
   AtomicFileSet outputs;
   AtomicFile& result_file = outputs.Add(a.out);
@@ -654,6 +688,7 @@ void Run(const DrapeArgs& a) {
   if (what_if) {
     j["what_if"] = DrapeWhatIfJson(*what_if);
     j["what_if"]["edits"] = a.what_if;
+    j["what_if"]["scene_from"] = kSceneFrom;
   }
   if (!a.cache.empty()) j["cache"] = a.cache;
   j["outline_csv"] = outline_file.path();

@@ -68,6 +68,13 @@ TEST(WhatIfEdits, TakeTheFilesNamesAndUnits) {
   refused("b1=nan", "is not a number");
   refused("b1=0.05", "outside the material's valid range");  // b1 < b2 with c1 < 0: κ0 < 0
   refused("stretch.compression_ratio=2", "outside the material's valid range");
+  refused("b1= 0.11", "is not a number");
+  refused("b1=0x1p-3", "is not a number");
+  // A law's constants move together: either order of a pair that is valid only together.
+  const Material both = ApplyWhatIfEdits(m, "b2=0.105,b1=0.108");
+  EXPECT_NEAR(both.bending.b1(), units::KesStiffnessToSi(0.108), 1e-15);
+  EXPECT_NEAR(both.bending.b2(), units::KesStiffnessToSi(0.105), 1e-15);
+  EXPECT_EQ(both.bending.b1(), ApplyWhatIfEdits(m, "b1=0.108,b2=0.105").bending.b1());
 }
 
 TEST(WhatIfScene, TheKeyFollowsWhatShapesTheDcOnly) {
@@ -150,6 +157,19 @@ TEST(WhatIfPrediction, GmlsBlendsEntriesAndOnlyTheSameMaterialFormAnswers) {
   const DrapeWhatIf other = PredictDrape(weft, cache, {});
   EXPECT_FALSE(other.predicted);
   EXPECT_EQ(other.entries_matching, 0);
+  // ... nor the other way round: a cached weft law does not answer for a material without one.
+  const DrapeWhatIf back = PredictDrape(
+      t, {MakeDrapeCacheEntry(weft, Coarse(), FakeDrape(weft, 0.4, {{"b1", g}}))}, {});
+  EXPECT_EQ(back.entries_matching, 0);
+  // An entry with other parameters (a linear law, c1 = 0: no b2) does not answer for a law that
+  // has them, and no parameter is taken for another.
+  Material linear = m;
+  linear.bending = BendingLaw::FromKes(0.1, 0.0892, 0.0);
+  std::vector<DrapeCacheEntry> mixed = cache;
+  mixed.push_back(MakeDrapeCacheEntry(linear, Coarse(), FakeDrape(linear, 0.9, {{"c1", 1e9}})));
+  const DrapeWhatIf w2 = PredictDrape(t, mixed, {});
+  EXPECT_EQ(w2.entries_matching, 2);
+  EXPECT_EQ(w2.drape_coefficient, w.drape_coefficient);
 }
 
 TEST(WhatIfCache, EntriesRoundTripAndOtherScenesAreLeftOut) {
@@ -166,8 +186,13 @@ TEST(WhatIfCache, EntriesRoundTripAndOtherScenesAreLeftOut) {
   EXPECT_EQ(read[0].drape_coefficient, 0.45);
   const DrapeWhatIf w = PredictDrape(ApplyWhatIfEdits(m, "b1=0.102"), read, {});
   EXPECT_TRUE(w.predicted) << w.reason;
+  // A broken file and another version are left out, each with its reason.
   std::ofstream(dir / "junk.drape-cache.json") << "{\"textile_drape_cache\": 1}";
-  EXPECT_THROW(ReadDrapeCache(dir.string(), Coarse()), InputError);
+  std::ofstream(dir / "future.drape-cache.json") << "{\"textile_drape_cache\": 2}";
+  std::vector<std::string> skipped;
+  EXPECT_EQ(ReadDrapeCache(dir.string(), Coarse(), &skipped).size(), 1u);
+  ASSERT_EQ(skipped.size(), 2u);
+  EXPECT_NE(skipped[0].find("version 2"), std::string::npos) << skipped[0];
   std::ofstream(dir.parent_path() / "plain-file") << "x";
   EXPECT_THROW(ReadDrapeCache((dir.parent_path() / "plain-file").string(), Coarse()), InputError);
   // A drape without sensitivities cannot be cached.

@@ -136,6 +136,14 @@ std::vector<std::string> SensitivityParameterList(bool sensitivity, const std::s
   return names;
 }
 
+std::vector<std::string> SensitivityArgs::Parameters() const {
+  if (monte_carlo < 0 || monte_carlo == 1)
+    throw InputError("--monte-carlo: must be at least 2 samples, got " + std::to_string(monte_carlo));
+  if (monte_carlo_seed && monte_carlo == 0)
+    throw InputError("--monte-carlo-seed: needs --monte-carlo");
+  return SensitivityParameterList(sensitivity || monte_carlo > 0, params);
+}
+
 void AddSensitivityFlags(CLI::App* sub, SensitivityArgs* a, const std::string& quantity,
                          const std::string& scope, const std::string& names) {
   sub->add_flag("--sensitivity", a->sensitivity,

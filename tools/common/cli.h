@@ -11,6 +11,7 @@
 
 #include "textile/sim/law/material_parameters.h"
 #include "textile/sim/law/monte_carlo.h"
+#include <optional>
 #include <string>
 
 namespace textile::cli {
@@ -45,11 +46,11 @@ struct SensitivityArgs {
   bool sensitivity = false;
   std::string params;
   int monte_carlo = 0;
-  unsigned monte_carlo_seed = 1;
+  std::optional<unsigned> monte_carlo_seed;
   // --sensitivity's parameters (SensitivityParameterList); --monte-carlo implies --sensitivity.
-  std::vector<std::string> Parameters() const {
-    return SensitivityParameterList(sensitivity || monte_carlo > 0, params);
-  }
+  // InputError, naming the flag, for --monte-carlo under 2 or --monte-carlo-seed without it.
+  std::vector<std::string> Parameters() const;
+  unsigned Seed() const { return monte_carlo_seed.value_or(1); }
 };
 void AddSensitivityFlags(CLI::App* sub, SensitivityArgs* a, const std::string& quantity,
                          const std::string& scope, const std::string& names);

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <numbers>
 #include <sstream>
 
@@ -260,8 +262,12 @@ std::string AcpmResult::BriefReport() const {
 
 namespace {
 
-// The relative step of the crossing length's differences.
-constexpr double kAcpmSensitivityStep = 1e-4;
+// The relative steps of the crossing length's differences: the elastica solves the crossing to
+// 1e-10 relative, so 1e-4 leaves a truncation error of ~1e-8; the shell's crossing is a
+// stepped, extrapolated solve good to ~1e-5 relative, so 1e-2 keeps its noise under 0.1 % of
+// the difference, with a truncation error of ~1e-4 (docs/methods/sensitivity.md, "ACPM").
+constexpr double kElasticaSensitivityStep = 1e-4;
+constexpr double kShellSensitivityStep = 1e-2;
 
 // The parameters the ACPM's elastica takes: a warp strip bent without stretch.
 bool ElasticaTakes(const std::string& name) {
@@ -269,25 +275,27 @@ bool ElasticaTakes(const std::string& name) {
          name == "areal_density_gsm";
 }
 
-// options.sensitivity's parameters, checked before any work (InputError).
-std::vector<std::string> AcpmSensitivityParameters(const Material& material,
-                                                   const AcpmOptions& o) {
+// options.sensitivity's parameters, checked before any work (InputError): the elastica takes the
+// `bending` law's constants, beta and the density; the shell every parameter of the material.
+std::vector<std::string> AcpmSensitivityParameters(const Material& material, const AcpmOptions& o,
+                                                   bool elastica) {
   if (!o.sensitivity) return {};
   MaterialFitCovariance(material);  // a malformed covariance is refused now
   std::vector<std::string> names;
   if (o.sensitivity_parameters.empty()) {
     for (const std::string& n : MaterialParameterNames(material))
-      if (ElasticaTakes(n)) names.push_back(n);
+      if (!elastica || ElasticaTakes(n)) names.push_back(n);
   } else {
     names = o.sensitivity_parameters;
     for (const std::string& n : names) {
       GetMaterialParameter(material, n);  // an unknown name, listing the material's
-      if (!ElasticaTakes(n))
+      if (elastica && !ElasticaTakes(n))
         throw InputError(n + ": does not enter the ACPM's elastica (a warp strip bent without "
                              "stretch takes b1, b2, c1, beta and areal_density_gsm)");
     }
   }
-  CheckSensitivityParameters(material, names, kAcpmSensitivityStep);
+  CheckSensitivityParameters(material, names,
+                             elastica ? kElasticaSensitivityStep : kShellSensitivityStep);
   return names;
 }
 
@@ -297,18 +305,19 @@ double MeanOverhang(const AcpmCrossings& c) {
   return sum / static_cast<double>(c.overhang.size());
 }
 
-// ∂L/∂p by central differences of the exact elastica (a millisecond a solve, to 1e-10
-// relative) at p ± 1e-4 of its scale (one-sided at the edge of its range); the influence
-// table and σ into *result.
-void AcpmSensitivities(const Material& material, const AcpmOptions& o,
-                       const std::vector<double>& z, const std::vector<std::string>& parameters,
-                       AcpmResult* result) {
+// The crossings of a material by the run's model (the elastica or the shell).
+using CrossingsOf = std::function<AcpmCrossings(const Material&)>;
+
+// ∂L/∂p by central differences of whole runs of the model at p ± `step` of its scale
+// (one-sided at the edge of its range); the influence table and σ into *result.
+void AcpmSensitivities(const Material& material, const CrossingsOf& model, double step_size,
+                       const std::vector<std::string>& parameters, AcpmResult* result) {
   std::vector<double> d;
   for (const std::string& name : parameters) {
-    const ParameterStep step = DifferenceStep(material, name, kAcpmSensitivityStep);
+    const ParameterStep step = DifferenceStep(material, name, step_size);
     double length[2];
     for (int side = 0; side < 2; ++side) {
-      const AcpmCrossings c = ElasticaModel(side ? step.down : step.up, o, z);
+      const AcpmCrossings c = model(side ? step.down : step.up);
       if (!c.converged) throw ComputeError("sensitivity of " + name + ": " + c.message);
       length[side] = MeanOverhang(c);
     }
@@ -321,13 +330,12 @@ void AcpmSensitivities(const Material& material, const AcpmOptions& o,
 }
 
 // The mean crossing length's spread over materials drawn from the fit's covariance, each
-// through the elastica, beside the linear σ; into result->monte_carlo.
-void AcpmMonteCarlo(const CovarianceSamples& draws, const AcpmOptions& o,
-                    const std::vector<double>& z, AcpmResult* result) {
+// through the model, beside the linear σ; into result->monte_carlo.
+void AcpmMonteCarlo(const CovarianceSamples& draws, const CrossingsOf& model, AcpmResult* result) {
   const auto start = std::chrono::steady_clock::now();
   std::vector<double> lengths;
   for (const Material& sample : draws.materials) {
-    const AcpmCrossings c = ElasticaModel(sample, o, z);
+    const AcpmCrossings c = model(sample);
     lengths.push_back(c.converged ? MeanOverhang(c) : std::numeric_limits<double>::quiet_NaN());
   }
   result->monte_carlo = SummariseMonteCarlo(lengths, draws.rejected, result->crossing_length_sigma);
@@ -381,24 +389,17 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
       break;
   }
 
-  const std::vector<std::string> parameters = AcpmSensitivityParameters(material, o);
-  if (o.sensitivity && !use_elastica)
-    throw InputError(
-        std::string(options.sensitivity ? "sensitivity" : "monte carlo") +
-        ": the elastica model only (plain samples and seams across the push); the shell's are "
-        "not built");
+  const std::vector<std::string> parameters =
+      AcpmSensitivityParameters(material, o, use_elastica);
   const CovarianceSamples draws =
       o.monte_carlo_samples > 0
           ? SampleFitCovariance(material, o.monte_carlo_samples, o.monte_carlo_seed)
           : CovarianceSamples{};
   const std::vector<double> z = o.RayPositions();
-  AcpmCrossings crossings;
+  CrossingsOf model;
   if (use_elastica) {
     result.model = AcpmModelKind::kElastica;
-    crossings = ElasticaModel(material, o, z);
-    if (o.sensitivity && crossings.converged)
-      AcpmSensitivities(material, o, z, parameters, &result);
-    if (o.monte_carlo_samples > 0 && crossings.converged) AcpmMonteCarlo(draws, o, z, &result);
+    model = [&o, &z](const Material& m) { return ElasticaModel(m, o, z); };
   } else {
     result.model = AcpmModelKind::kShell;
     const AcpmModel shell = o.shell_model ? o.shell_model : ShellAcpmModel();
@@ -408,7 +409,10 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
                                         : "; --model elastica answers plain samples and seams "
                                           "across the push direction exactly"));
     }
-    crossings = shell(material, o, z);
+    model = [shell, &o, &z](const Material& m) { return shell(m, o, z); };
+  }
+  AcpmCrossings crossings = model(material);
+  if (!use_elastica) {
     if (!crossings.converged) {
       // ShellAcpmCrossings' messages name the model already; a plugged-in one's may not.
       const bool named = crossings.message.rfind("shell model", 0) == 0;
@@ -418,6 +422,11 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
       throw ComputeError("shell model: returned " + std::to_string(crossings.overhang.size()) +
                          " crossings for " + std::to_string(z.size()) + " rays");
   }
+  if (o.sensitivity && crossings.converged)
+    AcpmSensitivities(material, model,
+                      use_elastica ? kElasticaSensitivityStep : kShellSensitivityStep, parameters,
+                      &result);
+  if (o.monte_carlo_samples > 0 && crossings.converged) AcpmMonteCarlo(draws, model, &result);
 
   // The same fabric without seams: the reference of the factor (Fig. 5). The model's own when
   // it gives one (a shell model's discretisation error then cancels in the ratio), else the

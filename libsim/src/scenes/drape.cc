@@ -375,10 +375,10 @@ bool DrapeOptions::Check(std::string* why) const {
     return Fail(why, "node_prominence_relative: must be in [0, 1)");
   if ((sensitivity || monte_carlo_samples > 0) && mount != DrapeMount::kClamped)
     return Fail(why,
-                "sensitivity: clamped mount only (the resting mount's friction state has no "
-                "derivative here)");
+                "sensitivity and Monte Carlo: clamped mount only (the resting mount's friction "
+                "state has no derivative here)");
   if (monte_carlo_samples < 0 || monte_carlo_samples == 1 || monte_carlo_samples > 10000)
-    return Fail(why, "monte_carlo_samples: must be 0 (none) or in 2..10000");
+    return Fail(why, "Monte Carlo samples: must be 0 (none) or in 2..10000");
   return true;
 }
 
@@ -849,8 +849,9 @@ void MonteCarloDc(const CovarianceSamples& draws, const DrapeOptions& options,
     bool changed = false;
     for (const SeedStart& s : starts) {
       size_t nodes = 0;
-      sum += SampleSeedDc(draws.materials[i], o, scene, *result, s, &nodes);
-      changed = changed || (std::isfinite(sum) && nodes != s.nodes);
+      const double dc = SampleSeedDc(draws.materials[i], o, scene, *result, s, &nodes);
+      sum += dc;  // NaN for the sample when a seed failed
+      changed = changed || (std::isfinite(dc) && nodes != s.nodes);
     }
     dcs.push_back(sum / static_cast<double>(starts.size()));
     if (changed) ++result->monte_carlo_node_changes;

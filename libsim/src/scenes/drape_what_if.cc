@@ -54,18 +54,23 @@ Material WithParameterValues(const Material& material, const std::vector<std::st
                              const std::vector<double>& values) {
   Material m = material;
   for (const std::string prefix : {"", "bending_weft.", "bending_bias."}) {
-    BendingLaw law = prefix.empty() ? m.bending : LawOf(&m, prefix)->value_or(m.bending);
-    if (law.is_spline()) continue;
+    std::vector<size_t> named;  // the names of this law's constants
+    for (size_t i = 0; i < names.size(); ++i)
+      if (const std::optional<std::string> p = LawPrefix(names[i]); p && *p == prefix)
+        named.push_back(i);
+    if (named.empty()) continue;
+    if (!prefix.empty() && !LawOf(&m, prefix)->has_value())
+      throw InputError("'" + names[named.front()] + "' is not a parameter of this material (it has no " +
+                       prefix.substr(0, prefix.size() - 1) + " law)");
+    const BendingLaw law = prefix.empty() ? m.bending : **LawOf(&m, prefix);
+    if (law.is_spline())
+      throw InputError("'" + names[named.front()] + "' is not a parameter of this material (a spline law)");
     double k[3] = {law.b1(), law.b2(), law.c1()};
-    bool any = false, b1_named = false;
-    for (size_t i = 0; i < names.size(); ++i) {
-      const std::optional<std::string> p = LawPrefix(names[i]);
-      if (!p || *p != prefix) continue;
+    bool b1_named = false;
+    for (size_t i : named) {
       k[ConstantIndex(names[i])] = values[i];
       b1_named = b1_named || names[i] == prefix + "b1";
-      any = true;
     }
-    if (!any) continue;
     if (law.kappa0() == 0.0 && !b1_named) k[0] = k[1];  // M = b2 κ: b2 is the line's slope
     if (const std::string why = BendingLaw::Invalidity(k[0], k[1], k[2]); !why.empty())
       throw InputError(why);
@@ -77,6 +82,7 @@ Material WithParameterValues(const Material& material, const std::vector<std::st
   for (size_t i = 0; i < names.size(); ++i)
     if (!LawPrefix(names[i])) m = WithMaterialParameter(m, names[i], values[i]);
   for (const std::string& name : names) std::erase(m.defaulted, name);
+  if (std::string why; !m.Check(&why)) throw InputError(why);
   return m;
 }
 
@@ -110,20 +116,17 @@ bool SameForm(const json& a, const json& b) {
   return a == b;
 }
 
-std::vector<std::string> Names(const DrapeCacheEntry& e) {
-  std::vector<std::string> names;
-  for (const DrapeCacheEntry::Parameter& p : e.parameters) names.push_back(p.name);
-  return names;
-}
-
 json EntryJson(const DrapeCacheEntry& e) {
   json parameters = json::array();
   for (const DrapeCacheEntry::Parameter& p : e.parameters)
     parameters.push_back(
         {{"name", p.name}, {"value_si", p.value}, {"scale_si", p.scale}, {"d_dc_d_p", p.d_dc_d_p}});
+  json notes = json::array();
+  for (const Note& n : e.notes) notes.push_back({{"code", n.code}, {"text", n.text}});
   return {{"textile_drape_cache", kEntryVersion}, {"scene_key", e.scene_key},
           {"material", e.material},               {"parameters", parameters},
-          {"drape_coefficient", e.drape_coefficient}, {"nodes", e.nodes}};
+          {"drape_coefficient", e.drape_coefficient}, {"nodes", e.nodes},
+          {"notes", notes}};
 }
 
 DrapeCacheEntry EntryFromJson(const json& j, const std::string& path) {
@@ -143,6 +146,8 @@ DrapeCacheEntry EntryFromJson(const json& j, const std::string& path) {
                               p.at("scale_si").get<double>(), p.at("d_dc_d_p").get<double>()});
     e.drape_coefficient = j.at("drape_coefficient").get<double>();
     e.nodes = j.at("nodes").get<double>();
+    for (const json& n : j.at("notes"))
+      e.notes.push_back({n.at("code").get<std::string>(), n.at("text").get<std::string>()});
     for (const DrapeCacheEntry::Parameter& p : e.parameters)
       if (!std::isfinite(p.value) || !(p.scale > 0.0) || !std::isfinite(p.d_dc_d_p))
         throw bad(p.name + ": a value, scale or derivative that is not a finite number");
@@ -167,23 +172,42 @@ struct EntryView {
   Eigen::VectorXd gradient;  // ∂DC/∂d [per relative change]
   double dc = 0.0;
   double distance = 0.0;     // max |offset|
+  std::vector<Note> notes;   // the cached drape's scene notes
 };
 
+// The entry's view of `target`, over the target's parameters (`names`, in their order): none
+// unless the entry has exactly these parameters and the same material form.
 std::optional<EntryView> ViewFrom(const DrapeCacheEntry& e, const Material& target,
-                                  const json& target_form_at_entry) {
-  if (!SameForm(e.material, target_form_at_entry)) return std::nullopt;
+                                  const std::vector<std::string>& names) {
+  if (e.parameters.size() != names.size()) return std::nullopt;
+  std::vector<const DrapeCacheEntry::Parameter*> by_name;
+  for (const std::string& name : names) {
+    const auto p = std::find_if(e.parameters.begin(), e.parameters.end(),
+                                [&](const DrapeCacheEntry::Parameter& q) { return q.name == name; });
+    if (p == e.parameters.end()) return std::nullopt;
+    by_name.push_back(&*p);
+  }
+  std::vector<double> values;
+  for (const DrapeCacheEntry::Parameter* p : by_name) values.push_back(p->value);
+  try {
+    if (!SameForm(e.material, MaterialForm(WithParameterValues(target, names, values))))
+      return std::nullopt;
+  } catch (const InputError&) {
+    return std::nullopt;  // the entry's values make no valid material of the target's form
+  }
   EntryView v;
-  const size_t n = e.parameters.size();
-  v.offset.resize(static_cast<long>(n));
-  v.gradient.resize(static_cast<long>(n));
-  for (size_t k = 0; k < n; ++k) {
-    const DrapeCacheEntry::Parameter& p = e.parameters[k];
+  const long n = static_cast<long>(names.size());
+  v.offset.resize(n);
+  v.gradient.resize(n);
+  for (long k = 0; k < n; ++k) {
+    const DrapeCacheEntry::Parameter& p = *by_name[static_cast<size_t>(k)];
     const double scale = MaterialParameterScale(target, p.name);
-    v.offset(static_cast<long>(k)) = (p.value - GetMaterialParameter(target, p.name).si) / scale;
-    v.gradient(static_cast<long>(k)) = p.d_dc_d_p * scale;
+    v.offset(k) = (p.value - GetMaterialParameter(target, p.name).si) / scale;
+    v.gradient(k) = p.d_dc_d_p * scale;
   }
   v.dc = e.drape_coefficient;
   v.distance = n ? v.offset.cwiseAbs().maxCoeff() : 0.0;
+  v.notes = e.notes;
   return v;
 }
 
@@ -230,8 +254,26 @@ double ErrorEstimate(const EntryView& nearest, const std::vector<EntryView>& vie
 
 json DrapeSceneJson(const DrapeOptions& o) {
   // Each field that shapes the DC. A field added to DrapeOptions must be added here or to the
-  // list of those that do not (progress, sensitivity, Monte Carlo): the size check says so.
-  static_assert(sizeof(void*) != 8 || sizeof(DrapeOptions) == 640, "DrapeOptions changed: update DrapeSceneJson");
+  // list of those that do not (progress, sensitivity, Monte Carlo; the solver's time cap and
+  // verbosity): the size check, on the 64-bit libstdc++ the project builds with, says so.
+#if defined(__GLIBCXX__) && defined(__LP64__)
+  static_assert(sizeof(DrapeOptions) == 640, "DrapeOptions changed: update DrapeSceneJson");
+  static_assert(sizeof(SolveOptions) == 112, "SolveOptions changed: update DrapeSceneJson");
+#endif
+  const SolveOptions& v = o.solver;
+  const json solver = {{"method", SolverMethodName(v.method)},
+                       {"linear", static_cast<int>(v.linear)},
+                       {"projection", static_cast<int>(v.projection)},
+                       {"exact_below", v.exact_below},
+                       {"expand_steps", v.expand_steps},
+                       {"tolerance", v.tolerance},
+                       {"max_iterations", v.max_iterations},
+                       {"max_step", v.max_step},
+                       {"time_step", v.time_step},
+                       {"cg_tolerance", v.cg_tolerance},
+                       {"cg_max_iterations", v.cg_max_iterations},
+                       {"anchor_tolerance", v.anchor_tolerance},
+                       {"fall_limit", v.fall_limit}};
   return {{"specimen_radius", o.specimen_radius},
           {"support_radius", o.support_radius},
           {"mount", DrapeMountName(o.mount)},
@@ -256,7 +298,7 @@ json DrapeSceneJson(const DrapeOptions& o) {
           {"seam_profile", o.seams == DrapeSeams::kNone ? json() : SeamProfileToJson(o.seam_profile)},
           {"seam_shift", o.seam_shift},
           {"seam_refinement_range", o.seam_refinement_range},
-          {"solver", {{"method", SolverMethodName(o.solver.method)}, {"tolerance", o.solver.tolerance}}},
+          {"solver", solver},
           {"raster_cell", o.raster_cell},
           {"outline_bins", o.outline_bins},
           {"smoothing_bins", o.smoothing_bins},
@@ -291,6 +333,14 @@ DrapeCacheEntry MakeDrapeCacheEntry(const Material& material, const DrapeOptions
   e.material = MaterialForm(WithParameterValues(material, names, values));
   e.drape_coefficient = result.drape_coefficient;
   e.nodes = result.nodes;
+  for (const DrapeCacheEntry::Parameter& p : e.parameters)
+    if (!std::isfinite(p.d_dc_d_p))
+      throw ComputeError("drape cache: the DC's derivative in " + p.name + " is not a number");
+  if (!std::isfinite(e.drape_coefficient)) throw ComputeError("drape cache: the DC is not a number");
+  // The scene's notes (a coarse rim, a bare support ...); the material's own defaults are the
+  // predicted material's to say.
+  for (const Note& n : result.notes)
+    if (n.code != "membrane_default") e.notes.push_back(n);
   return e;
 }
 
@@ -306,7 +356,11 @@ void WriteDrapeCacheEntry(const std::string& dir, const DrapeCacheEntry& entry) 
   {
     std::ofstream out(temporary);
     out << j.dump(1) << "\n";
-    if (!out) throw InputError("--cache " + dir + ": cannot write " + temporary.string());
+    out.close();
+    if (out.fail()) {
+      fs::remove(temporary, error);
+      throw InputError("--cache " + dir + ": cannot write " + temporary.string());
+    }
   }
   fs::rename(temporary, path, error);
   if (error) {
@@ -315,7 +369,8 @@ void WriteDrapeCacheEntry(const std::string& dir, const DrapeCacheEntry& entry) 
   }
 }
 
-std::vector<DrapeCacheEntry> ReadDrapeCache(const std::string& dir, const DrapeOptions& options) {
+std::vector<DrapeCacheEntry> ReadDrapeCache(const std::string& dir, const DrapeOptions& options,
+                                            std::vector<std::string>* skipped) {
   std::vector<DrapeCacheEntry> entries;
   std::error_code error;
   if (!fs::exists(dir, error)) return entries;
@@ -332,22 +387,42 @@ std::vector<DrapeCacheEntry> ReadDrapeCache(const std::string& dir, const DrapeO
     std::ifstream in(path);
     std::stringstream text;
     text << in.rdbuf();
-    json j;
     try {
-      j = json::parse(text.str());
-    } catch (const json::exception&) {
-      throw InputError(path.string() + ": not a drape cache entry (not JSON)");
+      json j;
+      try {
+        j = json::parse(text.str());
+      } catch (const json::exception&) {
+        throw InputError(path.string() + ": not a drape cache entry (not JSON)");
+      }
+      DrapeCacheEntry e = EntryFromJson(j, path.string());
+      if (e.scene_key == key) entries.push_back(std::move(e));
+    } catch (const InputError& e) {
+      if (skipped) skipped->push_back(e.what());  // another version, a broken file: not used
     }
-    DrapeCacheEntry e = EntryFromJson(j, path.string());
-    if (e.scene_key == key) entries.push_back(std::move(e));
   }
   return entries;
 }
 
+// A decimal number as a person types it: digits, a point, a sign, an exponent; no spaces, no
+// hexadecimal, nothing after it.
+std::optional<double> ParseDecimal(const std::string& text) {
+  if (text.empty() || text.find_first_not_of("0123456789+-.eE") != std::string::npos) return std::nullopt;
+  size_t used = 0;
+  double v = 0.0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (used != text.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
 Material ApplyWhatIfEdits(const Material& material, const std::string& edits) {
   if (edits.empty()) throw InputError("--what-if: no edits (NAME=VALUE,...)");
-  Material m = material;
-  std::vector<std::string> seen;
+  std::vector<std::string> names;
+  std::vector<double> values;  // [SI]
+  std::string shown;           // the edits in lab units, for messages
   for (size_t from = 0; from <= edits.size();) {
     const size_t comma = std::min(edits.find(',', from), edits.size());
     const std::string edit = edits.substr(from, comma - from);
@@ -356,29 +431,27 @@ Material ApplyWhatIfEdits(const Material& material, const std::string& edits) {
     if (eq == std::string::npos || eq == 0 || eq + 1 == edit.size())
       throw InputError("--what-if: '" + edit + "' is not NAME=VALUE");
     const std::string name = edit.substr(0, eq), text = edit.substr(eq + 1);
-    if (std::find(seen.begin(), seen.end(), name) != seen.end())
+    if (std::find(names.begin(), names.end(), name) != names.end())
       throw InputError("--what-if: " + name + " given twice");
-    seen.push_back(name);
-    const MaterialParameterValue old = GetMaterialParameter(m, name);  // an unknown name
-    if (const std::string why = ParameterWithoutEffect(m, name); !why.empty())
-      throw InputError("--what-if: " + why);
-    size_t used = 0;
-    double lab = 0.0;
+    MaterialParameterValue old;
     try {
-      lab = std::stod(text, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != text.size() || !std::isfinite(lab))
-      throw InputError("--what-if: " + name + " = '" + text + "' is not a number");
-    try {
-      m = WithMaterialParameter(m, name, LabToSi(old.unit, lab));
+      old = GetMaterialParameter(material, name);
+      if (const std::string why = ParameterWithoutEffect(material, name); !why.empty())
+        throw InputError(why);
     } catch (const InputError& e) {
-      throw InputError("--what-if: " + name + " = " + text + " " + old.unit +
-                       " is outside the material's valid range: " + e.what());
+      throw InputError(std::string("--what-if: ") + e.what());
     }
+    const std::optional<double> lab = ParseDecimal(text);
+    if (!lab) throw InputError("--what-if: " + name + " = '" + text + "' is not a number");
+    names.push_back(name);
+    values.push_back(LabToSi(old.unit, *lab));
+    shown += (shown.empty() ? "" : ", ") + name + " = " + text + " " + old.unit;
   }
-  return m;
+  try {
+    return WithParameterValues(material, names, values);  // a law's constants together
+  } catch (const InputError& e) {
+    throw InputError("--what-if: " + shown + " is outside the material's valid range: " + e.what());
+  }
 }
 
 DrapeWhatIf PredictDrape(const Material& material, const std::vector<DrapeCacheEntry>& cache,
@@ -386,16 +459,9 @@ DrapeWhatIf PredictDrape(const Material& material, const std::vector<DrapeCacheE
   DrapeWhatIf w;
   std::vector<EntryView> views;
   const EntryView* nearest = nullptr;
+  const std::vector<std::string> names = MaterialParameterNames(material);
   for (const DrapeCacheEntry& e : cache) {
-    std::vector<double> values;
-    for (const DrapeCacheEntry::Parameter& p : e.parameters) values.push_back(p.value);
-    json form;
-    try {
-      form = MaterialForm(WithParameterValues(material, Names(e), values));
-    } catch (const InputError&) {
-      continue;  // another kind of material (a parameter it does not have)
-    }
-    std::optional<EntryView> v = ViewFrom(e, material, form);
+    std::optional<EntryView> v = ViewFrom(e, material, names);
     if (!v) continue;
     ++w.entries_matching;
     if (std::isnan(w.distance) || v->distance < w.distance) w.distance = v->distance;
@@ -412,6 +478,7 @@ DrapeWhatIf PredictDrape(const Material& material, const std::vector<DrapeCacheE
   }
   for (const EntryView& v : views)
     if (!nearest || v.distance < nearest->distance) nearest = &v;
+  w.notes = nearest->notes;
   w.entries_used = static_cast<int>(views.size());
   w.drape_coefficient = Gmls(views);
   w.error_estimate = ErrorEstimate(*nearest, views, w.drape_coefficient);
@@ -450,7 +517,12 @@ DrapeWhatIfPrediction PredictDrapeWhatIf(const Material& material, const std::st
     throw InputError("what-if max error: must be in (0, 1), got " + NumberText(what_if.max_error));
   DrapeWhatIfPrediction p;
   p.material = ApplyWhatIfEdits(material, edits);
-  p.what_if = PredictDrape(p.material, ReadDrapeCache(cache_dir, options), what_if);
+  std::vector<std::string> skipped;
+  p.what_if = PredictDrape(p.material, ReadDrapeCache(cache_dir, options, &skipped), what_if);
+  for (const std::string& why : skipped)
+    p.what_if.notes.push_back({"cache_entry_skipped", "a cache file was not used: " + why});
+  if (p.what_if.predicted)
+    for (Note& n : MaterialDefaultNotes(p.material)) p.what_if.notes.push_back(std::move(n));
   p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return p;
 }
@@ -460,7 +532,7 @@ DrapeResult SimulateDrapeCached(const Material& material, const DrapeOptions& op
   if (!options.sensitivity_parameters.empty())
     throw InputError("--cache: a cached drape needs every parameter's sensitivity (leave out "
                      "--sensitivity-params)");
-  ReadDrapeCache(cache_dir, options);  // a folder that is none, or a bad entry: before the solve
+  ReadDrapeCache(cache_dir, options);  // a folder that is none: before the solve
   DrapeOptions o = options;
   o.sensitivity = true;
   DrapeResult r = SimulateDrape(material, o);

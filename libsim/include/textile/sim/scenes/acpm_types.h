@@ -88,12 +88,13 @@ struct AcpmOptions {
   AcpmSeam seam;
   AcpmModel shell_model;  // empty: ShellAcpmModel()
   // The crossing length's sensitivities (docs/methods/sensitivity.md, "ACPM"): for each of
-  // sensitivity_parameters (empty: every parameter the elastica takes: the `bending` law's
-  // constants, beta, areal_density_gsm). The elastica model only.
+  // sensitivity_parameters (empty: every parameter the model takes: the elastica the `bending`
+  // law's constants, beta and areal_density_gsm; the shell every parameter of the material),
+  // by central differences of whole runs.
   bool sensitivity = false;
   std::vector<std::string> sensitivity_parameters;
   // Monte Carlo check of the σ (law/monte_carlo.h): this many materials drawn from the fit's
-  // covariance of b1, b2, c1 (0: none; else 2..100000), each pushed through the elastica.
+  // covariance of b1, b2, c1 (0: none; else 2..100000), each pushed through the run's model.
   // Implies sensitivity (the linear σ beside it). Needs a material with a fit covariance.
   int monte_carlo_samples = 0;
   unsigned monte_carlo_seed = 1;

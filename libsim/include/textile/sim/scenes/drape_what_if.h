@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "textile/sim/core/note.h"
 #include "textile/sim/law/material.h"
 #include "textile/sim/scenes/drape.h"
 
@@ -46,18 +47,22 @@ struct DrapeCacheEntry {
   std::vector<Parameter> parameters;
   double drape_coefficient = 0.0;
   double nodes = 0.0;
+  std::vector<Note> notes;  // the drape's notes on its scene (the membrane defaults left out)
 };
 
 // The entry of a converged drape run with sensitivities (every parameter it differentiated).
-// InputError when the result has no sensitivities or did not converge.
+// InputError when the result has no sensitivities or did not converge, ComputeError when a
+// derivative is not a number.
 DrapeCacheEntry MakeDrapeCacheEntry(const Material& material, const DrapeOptions& options,
                                     const DrapeResult& result);
 // Writes the entry into `dir` (created if missing) as <hash>.drape-cache.json, atomically; the
 // same material and scene overwrite their entry. InputError when the folder cannot be written.
 void WriteDrapeCacheEntry(const std::string& dir, const DrapeCacheEntry& entry);
-// The entries of `dir` for this scene (none when the folder does not exist). InputError naming
-// a file that is not a cache entry.
-std::vector<DrapeCacheEntry> ReadDrapeCache(const std::string& dir, const DrapeOptions& options);
+// The entries of `dir` for this scene (none when the folder does not exist; InputError when it
+// is not a folder). A file that is no entry of this version is left out, its reason in
+// *skipped when given.
+std::vector<DrapeCacheEntry> ReadDrapeCache(const std::string& dir, const DrapeOptions& options,
+                                            std::vector<std::string>* skipped = nullptr);
 
 // The material with edits "NAME=VALUE,NAME=VALUE", names as the material file spells them
 // (MaterialParameterNames) and values in the file's units (gf·cm, gf·cm², g/m², N/m, N/m/rad,
@@ -82,6 +87,9 @@ struct DrapeWhatIf {
   // The nearest matching entry's largest relative parameter change (NaN without one).
   double distance = std::numeric_limits<double>::quiet_NaN();
   std::string reason;  // how it was predicted, or why not
+  // When predicted: the nearest cached drape's scene notes, and (PredictDrapeWhatIf) the edited
+  // material's membrane defaults; cache files left out.
+  std::vector<Note> notes;
 };
 
 // The DC of `material` from the cached drapes of its scene (docs/methods/sensitivity.md,

@@ -304,8 +304,8 @@ void RegisterAcpm(CLI::App& app) {
       "Crossing refinement of stepping models [mm] (default 0.05; the elastica is exact)");
   AddSensitivityFlags(sub, &a->sensitivity, "the crossing length L",
                       "differences of exact elastica solves, or of whole shell runs (two a "
-                      "parameter) for a seam along the push",
-                      "b1,b2,c1,beta,areal_density_gsm");
+                      "parameter, about 1.5 s a run with a seam along) when the shell answers",
+                      "b1,b2,c1,beta,areal_density_gsm; the shell also stretch.*");
   sub->add_flag("--json", a->json, "Print one JSON object instead of text");
   sub->callback([a] { Run(*a); });
 }

@@ -360,6 +360,13 @@ void PrintComparison(const DrapeComparison& c, const DrapeArgs& a, bool several_
   for (const Note& n : c.notes) std::cout << "  note: " << n.text << "\n";
 }
 
+// Where the membrane's compression ratio came from: --what-if, --compression-ratio over the
+// file, or the file.
+std::string CompressionRatioFrom(const DrapeArgs& a) {
+  if (a.what_if.find("stretch.compression_ratio=") != std::string::npos) return "--what-if";
+  return a.compression_ratio ? "--compression-ratio" : "material";
+}
+
 // The scene as the options give it, in mm (the result's `scene` without the mesh's figures).
 nlohmann::json SceneJson(const DrapeOptions& o) {
   nlohmann::json j = {
@@ -470,7 +477,7 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
   j["material"] = MaterialToJson(m);
   // Where the membrane's compression ratio came from: the file, or --compression-ratio over it.
   j["scene"]["compression_ratio"] = m.compression_ratio;
-  j["scene"]["compression_ratio_from"] = a.compression_ratio ? "--compression-ratio" : "material";
+  j["scene"]["compression_ratio_from"] = CompressionRatioFrom(a);
   j["material"]["file"] = a.material;
   j["seconds"] = r.seconds;
   return j;
@@ -557,6 +564,8 @@ void WritePrediction(const DrapeWhatIfPrediction& p, const DrapeOptions& o, cons
   j["what_if"]["edits"] = a.what_if;
   j["what_if"]["cache"] = a.cache;
   j["what_if"]["scene_from"] = kSceneFrom;
+  j["scene"]["compression_ratio"] = p.material.compression_ratio;
+  j["scene"]["compression_ratio_from"] = CompressionRatioFrom(a);
   j["note"] = p.what_if.notes.empty() ? nlohmann::json()
                                       : nlohmann::json(JoinNoteTexts(p.what_if.notes, "; "));
   j["material"]["file"] = a.material;
@@ -597,6 +606,12 @@ void CheckWhatIfArgs(const DrapeArgs& a) {
       throw InputError("--what-if-reach-pct: must be in (0, 100], got " + Num(r));
     if (const double e = a.what_if_max_error.value_or(0.01); !(e > 0.0 && e < 1.0))
       throw InputError("--what-if-max-error: must be in (0, 1), got " + Num(e));
+  }
+  if (!a.cache.empty()) {
+    const std::filesystem::path cache = std::filesystem::weakly_canonical(a.cache);
+    for (const std::string& out : {a.out, a.png, a.obj, a.ply})
+      if (!out.empty() && std::filesystem::weakly_canonical(out).parent_path() == cache)
+        throw InputError("--cache: " + out + " lies in the cache folder; write results elsewhere");
   }
   if (!a.cache.empty() && !a.sensitivity.params.empty())
     throw InputError("--cache: a cached drape needs every parameter's sensitivity (leave out "
@@ -665,8 +680,9 @@ void Run(const DrapeArgs& a) {
   DrapeResult r;
   try {
     r = a.cache.empty() ? SimulateDrape(m, o) : SimulateDrapeCached(m, o, a.cache);
-  } catch (const InputError& e) {
-    throw InputError(a.material + ": " + e.what());
+  } catch (const InputError& e) {  // a flag's own error names the flag, not the material file
+    const std::string what = e.what();
+    throw InputError(what.rfind("--", 0) == 0 ? what : a.material + ": " + what);
   }
   if (!r.converged)
     throw ComputeError("drape: not converged (" + r.message + "); no drape coefficient");

@@ -69,6 +69,7 @@ TEST(WhatIfEdits, TakeTheFilesNamesAndUnits) {
   refused("b1=0.05", "outside the material's valid range");  // b1 < b2 with c1 < 0: κ0 < 0
   refused("stretch.compression_ratio=2", "outside the material's valid range");
   refused("b1= 0.11", "is not a number");
+  refused("c1=0,b2=0.07", "the law is linear");  // b2 moves nothing once c1 = 0
   refused("b1=0x1p-3", "is not a number");
   // A law's constants move together: either order of a pair that is valid only together.
   const Material both = ApplyWhatIfEdits(m, "b2=0.105,b1=0.108");
@@ -187,12 +188,13 @@ TEST(WhatIfCache, EntriesRoundTripAndOtherScenesAreLeftOut) {
   const DrapeWhatIf w = PredictDrape(ApplyWhatIfEdits(m, "b1=0.102"), read, {});
   EXPECT_TRUE(w.predicted) << w.reason;
   // A broken file and another version are left out, each with its reason.
-  std::ofstream(dir / "junk.drape-cache.json") << "{\"textile_drape_cache\": 1}";
-  std::ofstream(dir / "future.drape-cache.json") << "{\"textile_drape_cache\": 2}";
+  std::ofstream(dir / "junk.drape-cache.json") << "{\"textile_drape_cache\": 2}";
+  std::ofstream(dir / "future.drape-cache.json") << "{\"textile_drape_cache\": 3}";
   std::vector<std::string> skipped;
   EXPECT_EQ(ReadDrapeCache(dir.string(), Coarse(), &skipped).size(), 1u);
   ASSERT_EQ(skipped.size(), 2u);
-  EXPECT_NE(skipped[0].find("version 2"), std::string::npos) << skipped[0];
+  EXPECT_NE(skipped[0].find("version 3"), std::string::npos) << skipped[0];  // future: sorted first
+  EXPECT_NE(skipped[1].find("not a drape cache entry"), std::string::npos) << skipped[1];
   std::ofstream(dir.parent_path() / "plain-file") << "x";
   EXPECT_THROW(ReadDrapeCache((dir.parent_path() / "plain-file").string(), Coarse()), InputError);
   // A drape without sensitivities cannot be cached.
@@ -216,6 +218,12 @@ TEST(WhatIfCache, APredictionFollowsTheSolvedDrape) {
   const DrapeResult solved = SimulateDrape(p.material, Coarse());
   ASSERT_TRUE(solved.converged);
   EXPECT_NEAR(p.what_if.drape_coefficient, solved.drape_coefficient, 0.004);
+  // The predicted material's membrane defaults are noted; a file that is no entry is too.
+  EXPECT_TRUE(HasNote(p.what_if.notes, "membrane_default"));
+  std::ofstream(dir / "old.drape-cache.json") << "{\"textile_drape_cache\": 1}";
+  const DrapeWhatIfPrediction q = PredictDrapeWhatIf(m, "b1=0.101", Coarse(), dir.string(), {});
+  EXPECT_TRUE(q.what_if.predicted);
+  EXPECT_TRUE(HasNote(q.what_if.notes, "cache_entry_skipped"));
   DrapeOptions partial = Coarse();
   partial.sensitivity_parameters = {"b1"};
   EXPECT_THROW(SimulateDrapeCached(m, partial, dir.string()), InputError);

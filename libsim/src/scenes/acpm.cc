@@ -291,7 +291,8 @@ std::vector<std::string> AcpmSensitivityParameters(const Material& material, con
       GetMaterialParameter(material, n);  // an unknown name, listing the material's
       if (elastica && !ElasticaTakes(n))
         throw InputError(n + ": does not enter the ACPM's elastica (a warp strip bent without "
-                             "stretch takes b1, b2, c1, beta and areal_density_gsm)");
+                             "stretch takes b1, b2, c1, beta and areal_density_gsm; --model "
+                             "shell takes the membrane too)");
     }
   }
   CheckSensitivityParameters(material, names,

@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 constexpr const char* kEntrySuffix = ".drape-cache.json";
-constexpr int kEntryVersion = 1;
+constexpr int kEntryVersion = 2;  // 2: the scene's notes, every solver option in the key
 // SC §4's weight 1/(|d − d_m|² + ε²), in relative parameter changes: ε = 0.1 %.
 constexpr double kWeightEpsilon2 = 1e-6;
 
@@ -146,7 +146,7 @@ DrapeCacheEntry EntryFromJson(const json& j, const std::string& path) {
                               p.at("scale_si").get<double>(), p.at("d_dc_d_p").get<double>()});
     e.drape_coefficient = j.at("drape_coefficient").get<double>();
     e.nodes = j.at("nodes").get<double>();
-    for (const json& n : j.at("notes"))
+    for (const json& n : j.value("notes", json::array()))
       e.notes.push_back({n.at("code").get<std::string>(), n.at("text").get<std::string>()});
     for (const DrapeCacheEntry::Parameter& p : e.parameters)
       if (!std::isfinite(p.value) || !(p.scale > 0.0) || !std::isfinite(p.d_dc_d_p))
@@ -248,6 +248,13 @@ double ErrorEstimate(const EntryView& nearest, const std::vector<EntryView>& vie
   const double half_change = 0.5 * std::abs(nearest.gradient.dot(nearest.offset));
   const double jitter = nearest.distance > 0.0 ? kJitter : 0.0;
   return std::max({spread, second_order, half_change, jitter});
+}
+
+// One note for the cache files that are no entry: how many, and the first one's reason.
+Note SkippedNote(const std::vector<std::string>& skipped) {
+  return {"cache_entry_skipped",
+          std::to_string(skipped.size()) + " cache file" + (skipped.size() > 1 ? "s were" : " was") +
+              " not used (" + skipped.front() + (skipped.size() > 1 ? "; ..." : "") + ")"};
 }
 
 }  // namespace
@@ -436,8 +443,6 @@ Material ApplyWhatIfEdits(const Material& material, const std::string& edits) {
     MaterialParameterValue old;
     try {
       old = GetMaterialParameter(material, name);
-      if (const std::string why = ParameterWithoutEffect(material, name); !why.empty())
-        throw InputError(why);
     } catch (const InputError& e) {
       throw InputError(std::string("--what-if: ") + e.what());
     }
@@ -447,11 +452,18 @@ Material ApplyWhatIfEdits(const Material& material, const std::string& edits) {
     values.push_back(LabToSi(old.unit, *lab));
     shown += (shown.empty() ? "" : ", ") + name + " = " + text + " " + old.unit;
   }
+  Material edited;
   try {
-    return WithParameterValues(material, names, values);  // a law's constants together
+    edited = WithParameterValues(material, names, values);  // a law's constants together
   } catch (const InputError& e) {
     throw InputError("--what-if: " + shown + " is outside the material's valid range: " + e.what());
   }
+  // An edit that moves nothing in the edited law (b2 of a law left with c1 = 0) is refused: the
+  // material would carry a value no drape sees.
+  for (const std::string& name : names)
+    if (const std::string why = ParameterWithoutEffect(edited, name); !why.empty())
+      throw InputError("--what-if: " + why);
+  return edited;
 }
 
 DrapeWhatIf PredictDrape(const Material& material, const std::vector<DrapeCacheEntry>& cache,
@@ -486,6 +498,7 @@ DrapeWhatIf PredictDrape(const Material& material, const std::vector<DrapeCacheE
                           (w.entries_used > 1 ? "s" : "") + ", the nearest " +
                           NumberText(100.0 * nearest->distance, 3) + " % away";
   if (w.error_estimate > options.max_error) {
+    w.notes.clear();  // the scene's notes are the solve's to give
     w.reason = "the estimated error " + NumberText(w.error_estimate, 2) + " (" + how +
                ") is above " + NumberText(options.max_error, 2);
     w.drape_coefficient = std::numeric_limits<double>::quiet_NaN();
@@ -519,8 +532,7 @@ DrapeWhatIfPrediction PredictDrapeWhatIf(const Material& material, const std::st
   p.material = ApplyWhatIfEdits(material, edits);
   std::vector<std::string> skipped;
   p.what_if = PredictDrape(p.material, ReadDrapeCache(cache_dir, options, &skipped), what_if);
-  for (const std::string& why : skipped)
-    p.what_if.notes.push_back({"cache_entry_skipped", "a cache file was not used: " + why});
+  if (!skipped.empty()) p.what_if.notes.push_back(SkippedNote(skipped));
   if (p.what_if.predicted)
     for (Note& n : MaterialDefaultNotes(p.material)) p.what_if.notes.push_back(std::move(n));
   p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -532,11 +544,18 @@ DrapeResult SimulateDrapeCached(const Material& material, const DrapeOptions& op
   if (!options.sensitivity_parameters.empty())
     throw InputError("--cache: a cached drape needs every parameter's sensitivity (leave out "
                      "--sensitivity-params)");
-  ReadDrapeCache(cache_dir, options);  // a folder that is none: before the solve
+  std::vector<std::string> skipped;
+  ReadDrapeCache(cache_dir, options, &skipped);  // a folder that is none: before the solve
   DrapeOptions o = options;
   o.sensitivity = true;
   DrapeResult r = SimulateDrape(material, o);
-  if (r.converged) WriteDrapeCacheEntry(cache_dir, MakeDrapeCacheEntry(material, o, r));
+  if (!skipped.empty()) r.notes.push_back(SkippedNote(skipped));
+  if (!r.converged) return r;
+  try {
+    WriteDrapeCacheEntry(cache_dir, MakeDrapeCacheEntry(material, o, r));
+  } catch (const ComputeError& e) {  // a derivative that is not a number: the DC stands
+    r.notes.push_back({"not_cached", std::string("the drape was not cached: ") + e.what()});
+  }
   return r;
 }
 

@@ -66,8 +66,9 @@ std::vector<DrapeCacheEntry> ReadDrapeCache(const std::string& dir, const DrapeO
 
 // The material with edits "NAME=VALUE,NAME=VALUE", names as the material file spells them
 // (MaterialParameterNames) and values in the file's units (gf·cm, gf·cm², g/m², N/m, N/m/rad,
-// -). InputError for a malformed edit, an unknown name, a name given twice, or a value that
-// leaves the material's valid range.
+// -), applied together (a law's constants at once). InputError for a malformed edit, an
+// unknown name, a name given twice, a value that leaves the material's valid range, or one
+// that moves nothing in the edited law (ParameterWithoutEffect).
 Material ApplyWhatIfEdits(const Material& material, const std::string& edits);
 
 struct WhatIfOptions {
@@ -120,7 +121,8 @@ DrapeWhatIfPrediction PredictDrapeWhatIf(const Material& material, const std::st
 
 // `textile drape --cache DIR`: the drape with every parameter's sensitivity
 // (options.sensitivity_parameters must be empty: InputError), added to the cache when it
-// converged.
+// converged (with a note instead when a derivative is not a number; another note names cache
+// files that are no entry).
 DrapeResult SimulateDrapeCached(const Material& material, const DrapeOptions& options,
                                 const std::string& cache_dir);
 

@@ -455,7 +455,7 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
   scene["specimen_area_mm2"] = r.specimen_area * 1e6;
   scene["support_area_mm2"] = r.support_area * 1e6;
   scene["mass_g"] = r.mass * 1e3;
-  if (o.sensitivity || o.monte_carlo_samples > 0) {
+  if (!r.sensitivities.empty()) {  // --sensitivity, --monte-carlo or --cache
     j["drape_coefficient_sigma"] = NumberOrNull(r.drape_coefficient_sigma);
     j["drape_coefficient_sigma_note"] = r.sigma_note;
     j["sensitivity_seconds"] = r.sensitivity_seconds;
@@ -536,7 +536,7 @@ void PrintText(const DrapeResult& r, const DrapeOptions& o, const Material& m, c
   }
   if (!note.empty()) std::cout << "\nnote: " << note;
   std::cout << "\n";
-  if (o.sensitivity || o.monte_carlo_samples > 0)
+  if (!r.sensitivities.empty())
     PrintInfluences("DC", "", 1.0, r.drape_coefficient_sigma, r.sigma_note, r.sensitivities);
   if (r.monte_carlo) PrintMonteCarlo("DC", "", 1.0, *r.monte_carlo);
   if (comparison) PrintComparison(*comparison, a, r.per_seed.size() > 1);
@@ -586,7 +586,7 @@ void WritePrediction(const DrapeWhatIfPrediction& p, const DrapeOptions& o, cons
 }
 
 // The what-if flags' own checks, with the flags' names: --what-if needs --cache and answers
-// with a DC only; its options need it; --cache needs every parameter's sensitivity.
+// with a DC only; its options need it; no output inside the cache folder.
 void CheckWhatIfArgs(const DrapeArgs& a) {
   if (a.what_if.empty()) {
     if (a.what_if_reach_percent) throw InputError("--what-if-reach-pct: needs --what-if");
@@ -613,9 +613,6 @@ void CheckWhatIfArgs(const DrapeArgs& a) {
       if (!out.empty() && std::filesystem::weakly_canonical(out).parent_path() == cache)
         throw InputError("--cache: " + out + " lies in the cache folder; write results elsewhere");
   }
-  if (!a.cache.empty() && !a.sensitivity.params.empty())
-    throw InputError("--cache: a cached drape needs every parameter's sensitivity (leave out "
-                     "--sensitivity-params)");
 }
 
 void Run(const DrapeArgs& a) {
@@ -660,10 +657,6 @@ void Run(const DrapeArgs& a) {
     m = std::move(p.material);
     what_if = std::move(p.what_if);
   }
-  if (!a.cache.empty() && o.mount != DrapeMount::kClamped)
-    throw InputError("--cache: clamped mount only (a cached drape carries sensitivities, which "
-                     "the resting mount has not)");
-  if (!a.cache.empty()) o.sensitivity = true;  // a cached drape carries them
   AtomicFileSet outputs;
   AtomicFile& result_file = outputs.Add(a.out);
   AtomicFile& outline_file = outputs.Add(outline_path);

@@ -209,7 +209,9 @@ TEST(BlendedLaw, DirectionWeightsAreAConvexCombinationPureAtTheMeasuredAngles) {
       EXPECT_GE(w.weft, 0.0) << i;
       EXPECT_GE(w.bias, 0.0) << i;
       EXPECT_NEAR(w.warp + w.weft + w.bias, 1.0, 1e-15) << i;
-      if (!with_bias) EXPECT_EQ(w.bias, 0.0);
+      if (!with_bias) {
+        EXPECT_EQ(w.bias, 0.0);
+      }
     }
   }
   const auto at = [](double phi) {

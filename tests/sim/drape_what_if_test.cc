@@ -227,6 +227,9 @@ TEST(WhatIfCache, APredictionFollowsTheSolvedDrape) {
   DrapeOptions partial = Coarse();
   partial.sensitivity_parameters = {"b1"};
   EXPECT_THROW(SimulateDrapeCached(m, partial, dir.string()), InputError);
+  DrapeOptions resting = Coarse();  // no sensitivities on the resting mount
+  resting.mount = DrapeMount::kResting;
+  EXPECT_THROW(SimulateDrapeCached(m, resting, dir.string()), InputError);
 }
 
 }  // namespace

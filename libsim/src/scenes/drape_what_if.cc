@@ -544,6 +544,9 @@ DrapeResult SimulateDrapeCached(const Material& material, const DrapeOptions& op
   if (!options.sensitivity_parameters.empty())
     throw InputError("--cache: a cached drape needs every parameter's sensitivity (leave out "
                      "--sensitivity-params)");
+  if (options.mount != DrapeMount::kClamped)
+    throw InputError("--cache: clamped mount only (a cached drape carries sensitivities, which "
+                     "the resting mount has not)");
   std::vector<std::string> skipped;
   ReadDrapeCache(cache_dir, options, &skipped);  // a folder that is none: before the solve
   DrapeOptions o = options;

@@ -1,6 +1,6 @@
 // drape-sensitivity: what the DC's sensitivities cost on a drape of about 10k vertices, per
-// parameter (one factorisation of the exact Hessian shared by all, two element gradients and a
-// back-substitution each; docs/methods/sensitivity.md), against the target of 30 ms a
+// parameter (one factorisation of the exact Hessian and one adjoint back-substitution shared by
+// all, two element gradients each; docs/methods/sensitivity.md), against the target of 30 ms a
 // parameter (Sensitive Couture Table 1: 145-640 ms), and how far the linear ∂DC/∂ln b1 is from
 // differences of whole drapes at b1 e^(±0.01) (full runs only).
 

@@ -46,6 +46,8 @@ TEST(ShadowOutline, TracesAStarShapedShadowsAreaAndItsExactDerivative) {
                      TraceShadowOutline(x - h * dx, sq.triangles, kBins, 0.05).area) /
                     (2.0 * h);
   EXPECT_NEAR(OutlineAreaDerivative(at, x, dx), fd, 1e-6 * std::abs(fd));
+  // Its gradient moves nothing vertical.
+  EXPECT_EQ(OutlineAreaGradient(at, x).col(2).norm(), 0.0);
   // The support's rim is the outline where the fabric lies inside it: fixed.
   const ShadowOutline inside = TraceShadowOutline(0.1 * sq.vertices, sq.triangles, kBins, 0.05);
   EXPECT_NEAR(inside.area, std::numbers::pi * 0.05 * 0.05, 1e-9);

@@ -80,6 +80,33 @@ TEST(EquilibriumSensitivity, MatchesDifferencesOfFullSolvesForEachParameter) {
   EXPECT_LT((sensitivity.Displacement("beta") - sum).norm(), 1e-6 * sum.norm());
 }
 
+// The adjoint form gives g · ∂x/∂p for a quantity's gradient g, every parameter, with one
+// back-substitution; a gradient on the held vertices counts for nothing (they do not move).
+TEST(EquilibriumSensitivity, TheAdjointFormIsTheDirectOne) {
+  const HangingStrip strip;
+  const Material m = Fig8();
+  Vertices start = strip.mesh.vertices;
+  for (int v = 0; v < start.rows(); ++v) start(v, 2) = -0.3 * start(v, 0);
+  const Vertices x = strip.Solve(m, start);
+  auto problem = strip.Problem(m);
+  const EquilibriumSensitivity sensitivity(problem.get(), x, m);
+  Vertices g(x.rows(), 3);
+  for (int v = 0; v < g.rows(); ++v)
+    g.row(v) << std::sin(1.0 + v), std::cos(2.0 * v), 0.5 + 0.01 * v;
+  const Vertices adjoint = sensitivity.Adjoint(g);
+  for (int v : strip.held) EXPECT_EQ(adjoint.row(v).norm(), 0.0);
+  for (const std::string& name : MaterialParameterNames(m)) {
+    const double direct = (g.array() * sensitivity.DisplacementPerUnit(name).array()).sum();
+    EXPECT_NEAR(sensitivity.QuantityDerivativePerUnit(adjoint, name), direct,
+                1e-8 * std::abs(direct) + 1e-300)
+        << name;
+  }
+  EXPECT_THROW(sensitivity.Adjoint(Vertices::Zero(3, 3)), InputError);
+  g(0, 0) = std::nan("");
+  EXPECT_THROW(sensitivity.Adjoint(g), InputError);
+  EXPECT_THROW(sensitivity.QuantityDerivativePerUnit(Vertices::Zero(3, 3), "b1"), InputError);
+}
+
 TEST(EquilibriumSensitivity, RefusesAStateThatIsNoEquilibriumAndUnknownParameters) {
   const HangingStrip strip;
   const Material m = Fig8();

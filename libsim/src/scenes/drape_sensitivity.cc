@@ -81,10 +81,10 @@ ShadowOutline TraceShadowOutline(const Vertices& x, const Triangles& triangles, 
   return o;
 }
 
-double OutlineAreaDerivative(const ShadowOutline& outline, const Vertices& x, const Vertices& dx) {
+Vertices OutlineAreaGradient(const ShadowOutline& outline, const Vertices& x) {
   const int bins = static_cast<int>(outline.radii.size());
   const double step = kTwoPi / bins;
-  double d_area = 0.0;
+  Vertices g = Vertices::Zero(x.rows(), 3);
   for (int b = 0; b < bins; ++b) {
     const auto [i, j] = outline.edge[b];
     if (i < 0) continue;  // the support's rim: fixed
@@ -93,10 +93,16 @@ double OutlineAreaDerivative(const ShadowOutline& outline, const Vertices& x, co
     const Eigen::Vector2d e = Projected(x, j) - Projected(x, i), n(-e.y(), e.x());
     const double un = u.dot(n);
     if (std::abs(un) <= 1e-12 * n.norm()) continue;  // grazing: no first-order change
-    const Eigen::Vector2d v = (1.0 - s) * Projected(dx, i) + s * Projected(dx, j);
-    d_area += outline.radii[b] * (v.dot(n) / un) * step;
+    // The ray's crossing moves by (v · n) / (u · n) along u, v the edge's displacement there.
+    const Eigen::Vector2d w = (outline.radii[b] * step / un) * n;
+    g.block<1, 2>(i, 0) += (1.0 - s) * w.transpose();
+    g.block<1, 2>(j, 0) += s * w.transpose();
   }
-  return d_area;
+  return g;
+}
+
+double OutlineAreaDerivative(const ShadowOutline& outline, const Vertices& x, const Vertices& dx) {
+  return (OutlineAreaGradient(outline, x).array() * dx.array()).sum();
 }
 
 namespace drape_internal {
@@ -127,9 +133,11 @@ std::vector<double> DcDerivatives(ClothProblem* problem, const Vertices& x,
                                            std::max(100.0 * o.solver.tolerance, 1e-6));
   const ShadowOutline outline = TraceShadowOutline(x, triangles, kSensitivityBins, o.support_radius);
   const double scale = result.specimen_area - result.support_area;
+  // The adjoint form: one back-substitution for all the parameters.
+  const Vertices adjoint = sensitivity.Adjoint(OutlineAreaGradient(outline, x));
   std::vector<double> d;
   for (const std::string& p : parameters)
-    d.push_back(OutlineAreaDerivative(outline, x, sensitivity.DisplacementPerUnit(p)) / scale);
+    d.push_back(sensitivity.QuantityDerivativePerUnit(adjoint, p) / scale);
   return d;
 }
 

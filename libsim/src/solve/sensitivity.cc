@@ -84,6 +84,20 @@ Vertices EquilibriumSensitivity::DisplacementPerUnit(const std::string& paramete
   return Solve(ResidualDerivative(parameter));
 }
 
+Vertices EquilibriumSensitivity::Adjoint(const Vertices& quantity_gradient) const {
+  if (quantity_gradient.rows() != x_.rows() || quantity_gradient.cols() != 3 ||
+      !quantity_gradient.allFinite())
+    throw InputError("sensitivity: the quantity's gradient must be finite, one row a vertex");
+  return Solve(quantity_gradient);  // -K⁻¹ g, zero on fixed vertices
+}
+
+double EquilibriumSensitivity::QuantityDerivativePerUnit(const Vertices& adjoint,
+                                                         const std::string& parameter) const {
+  if (adjoint.rows() != x_.rows() || adjoint.cols() != 3)
+    throw InputError("sensitivity: the adjoint must have one row a vertex");
+  return (adjoint.array() * ResidualDerivative(parameter).array()).sum();
+}
+
 Vertices EquilibriumSensitivity::Displacement(const std::string& parameter) const {
   const double p = GetMaterialParameter(material_, parameter).si;
   if (p == 0.0) return Vertices::Zero(x_.rows(), 3);

@@ -35,7 +35,10 @@ struct ShadowOutline {
 // Throws InputError for fewer than 8 bins, a non-finite state or bad triangles.
 ShadowOutline TraceShadowOutline(const Vertices& x, const Triangles& triangles, int bins,
                                  double support_radius);
-// dA for vertex displacements dx (#V×3 [m]) [m²], to first order.
+// ∂A/∂x (#V×3 [m]): the outline's area is linear, to first order, in the displacements of its
+// edges' vertices (nothing vertical, nothing where the support's rim is the outline).
+Vertices OutlineAreaGradient(const ShadowOutline& outline, const Vertices& x);
+// dA for vertex displacements dx (#V×3 [m]) [m²], to first order: ∂A/∂x · dx.
 double OutlineAreaDerivative(const ShadowOutline& outline, const Vertices& x, const Vertices& dx);
 
 }  // namespace textile

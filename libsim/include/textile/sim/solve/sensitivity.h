@@ -7,8 +7,8 @@
 //
 //   K dx = -(∂R/∂p) dp,   K = ∇ₓR = ∇²E(x), the exact (unprojected) Hessian,
 //
-// one back-substitution per parameter with one Cholesky factorisation of K
-// (docs/methods/sensitivity.md):
+// one back-substitution per parameter with one Cholesky factorisation of K, or one for all the
+// parameters for a single quantity of the state (the adjoint form; docs/methods/sensitivity.md):
 //
 //   textile::EquilibriumSensitivity s(&problem, x, material);   // factorises K once
 //   textile::Vertices dx = s.Displacement("b1");                // ∂x/∂ln b1 [m]
@@ -48,6 +48,13 @@ class EquilibriumSensitivity {
   Vertices DisplacementPerUnit(const std::string& parameter) const;
   // ∂x/∂ln p = p ∂x/∂p [m] (zero for a parameter that is 0, e.g. c1 of a linear law).
   Vertices Displacement(const std::string& parameter) const;
+
+  // The adjoint form, for a scalar quantity Q(x) of the equilibrium and many parameters: with
+  // g = ∂Q/∂x (#V×3), dQ/dp = g · ∂x/∂p = λ · ∂R/∂p, λ = -K⁻¹ g (K is symmetric). Adjoint(g)
+  // is λ, one back-substitution; QuantityDerivativePerUnit(λ, p) is dQ/dp [per unit of p, SI]
+  // without one.
+  Vertices Adjoint(const Vertices& quantity_gradient) const;
+  double QuantityDerivativePerUnit(const Vertices& adjoint, const std::string& parameter) const;
 
  private:
   struct Factor;

@@ -586,7 +586,8 @@ void WritePrediction(const DrapeWhatIfPrediction& p, const DrapeOptions& o, cons
 }
 
 // The what-if flags' own checks, with the flags' names: --what-if needs --cache and answers
-// with a DC only; its options need it; no output inside the cache folder.
+// with a DC only; its options need it; --cache needs every parameter's sensitivity, and no
+// output inside the cache folder.
 void CheckWhatIfArgs(const DrapeArgs& a) {
   if (a.what_if.empty()) {
     if (a.what_if_reach_percent) throw InputError("--what-if-reach-pct: needs --what-if");
@@ -607,6 +608,9 @@ void CheckWhatIfArgs(const DrapeArgs& a) {
     if (const double e = a.what_if_max_error.value_or(0.01); !(e > 0.0 && e < 1.0))
       throw InputError("--what-if-max-error: must be in (0, 1), got " + Num(e));
   }
+  if (!a.cache.empty() && !a.sensitivity.params.empty())  // before --sensitivity-params' own
+    throw InputError("--cache: a cached drape needs every parameter's sensitivity (leave out "
+                     "--sensitivity-params)");
   if (!a.cache.empty()) {
     const std::filesystem::path cache = std::filesystem::weakly_canonical(a.cache);
     for (const std::string& out : {a.out, a.png, a.obj, a.ply})

@@ -48,6 +48,7 @@ TEST(ShadowOutline, TracesAStarShapedShadowsAreaAndItsExactDerivative) {
   EXPECT_NEAR(OutlineAreaDerivative(at, x, dx), fd, 1e-6 * std::abs(fd));
   // Its gradient moves nothing vertical.
   EXPECT_EQ(OutlineAreaGradient(at, x).col(2).norm(), 0.0);
+  EXPECT_THROW(OutlineAreaDerivative(at, x, dx.topRows(3)), InputError);
   // The support's rim is the outline where the fabric lies inside it: fixed.
   const ShadowOutline inside = TraceShadowOutline(0.1 * sq.vertices, sq.triangles, kBins, 0.05);
   EXPECT_NEAR(inside.area, std::numbers::pi * 0.05 * 0.05, 1e-9);

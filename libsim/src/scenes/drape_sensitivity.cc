@@ -102,6 +102,8 @@ Vertices OutlineAreaGradient(const ShadowOutline& outline, const Vertices& x) {
 }
 
 double OutlineAreaDerivative(const ShadowOutline& outline, const Vertices& x, const Vertices& dx) {
+  if (dx.rows() != x.rows() || dx.cols() != 3)
+    throw InputError("outline area: the displacements must have one row a vertex");
   return (OutlineAreaGradient(outline, x).array() * dx.array()).sum();
 }
 

@@ -95,7 +95,10 @@ double EquilibriumSensitivity::QuantityDerivativePerUnit(const Vertices& adjoint
                                                          const std::string& parameter) const {
   if (adjoint.rows() != x_.rows() || adjoint.cols() != 3)
     throw InputError("sensitivity: the adjoint must have one row a vertex");
-  return (adjoint.array() * ResidualDerivative(parameter).array()).sum();
+  const double d = (adjoint.array() * ResidualDerivative(parameter).array()).sum();
+  if (!std::isfinite(d))
+    throw ComputeError("sensitivity: the derivative for '" + parameter + "' is not a number");
+  return d;
 }
 
 Vertices EquilibriumSensitivity::Displacement(const std::string& parameter) const {

@@ -38,7 +38,8 @@ ShadowOutline TraceShadowOutline(const Vertices& x, const Triangles& triangles, 
 // ∂A/∂x (#V×3 [m]): the outline's area is linear, to first order, in the displacements of its
 // edges' vertices (nothing vertical, nothing where the support's rim is the outline).
 Vertices OutlineAreaGradient(const ShadowOutline& outline, const Vertices& x);
-// dA for vertex displacements dx (#V×3 [m]) [m²], to first order: ∂A/∂x · dx.
+// dA for vertex displacements dx (#V×3 [m]) [m²], to first order: ∂A/∂x · dx (InputError for
+// another size).
 double OutlineAreaDerivative(const ShadowOutline& outline, const Vertices& x, const Vertices& dx);
 
 }  // namespace textile

@@ -55,7 +55,9 @@ Benchmark DrapeSensitivityBenchmark() {
             o.sensitivity = true;
             const DrapeResult r = SimulateDrape(m, o);
             if (!r.converged) throw ComputeError("drape-sensitivity: " + r.message);
-            const int parameters = static_cast<int>(r.sensitivities.size());
+            // The material's parameters and the scene's two radii.
+            const int parameters =
+                static_cast<int>(r.sensitivities.size() + r.scene_sensitivities.size());
             double d_b1 = std::nan("");
             for (const ParameterInfluence& s : r.sensitivities)
               if (s.parameter == "b1") d_b1 = s.d_q_d_ln_p;

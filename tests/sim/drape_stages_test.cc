@@ -49,6 +49,24 @@ TEST(DrapeNotes, QuietRunHasNone) {
   EXPECT_TRUE(DrapeNotes(QuietOptions(), QuietResult(), false).empty());
 }
 
+// Every parameter's sensitivity with shifted seams leaves the scene's radii out, and says so;
+// a list of parameters leaves them out by design, silently.
+TEST(DrapeNotes, SceneRadiiSkippedWithShiftedSeams) {
+  DrapeOptions o = QuietOptions();
+  o.sensitivity = true;
+  o.seams = DrapeSeams::kShifted;
+  DrapeResult r = QuietResult();
+  r.sensitivities.push_back(ParameterInfluence{});
+  EXPECT_FALSE(drape_internal::TakesSceneRadii(o));
+  EXPECT_TRUE(HasNote(DrapeNotes(o, r, false), "scene_radii_skipped"));
+  o.sensitivity_parameters = {"b1"};
+  EXPECT_FALSE(HasNote(DrapeNotes(o, r, false), "scene_radii_skipped"));
+  o.sensitivity_parameters.clear();
+  o.seams = DrapeSeams::kWeft;  // a diameter: the radial morph keeps it straight
+  EXPECT_TRUE(drape_internal::TakesSceneRadii(o));
+  EXPECT_FALSE(HasNote(DrapeNotes(o, r, false), "scene_radii_skipped"));
+}
+
 TEST(DrapeNotes, CoarseClampedRimWithoutExtrapolationIsAShortfall) {
   DrapeOptions o;  // 12 mm elements at the rim: 0.1 × 12 / 8.6 = 0.14 > 0.02
   const std::vector<Note> notes = DrapeNotes(o, QuietResult(), false);

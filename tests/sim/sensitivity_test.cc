@@ -38,6 +38,13 @@ struct HangingStrip {
     p->FixVertices(held, fixed);
     return p;
   }
+  // The rest state tilted down, far from equilibrium, and the equilibrium solved from it.
+  Vertices Tilted() const {
+    Vertices x = mesh.vertices;
+    for (int v = 0; v < x.rows(); ++v) x(v, 2) = -0.3 * x(v, 0);
+    return x;
+  }
+  Vertices Equilibrium(const Material& m) const { return Solve(m, Tilted()); }
   // The equilibrium from `start`, solved tight (the differences below need it).
   Vertices Solve(const Material& m, const Vertices& start) const {
     auto p = Problem(m);
@@ -51,16 +58,19 @@ struct HangingStrip {
   }
 };
 
-// ∂x/∂ln p by one back-substitution against central differences of full solves (started from
-// the equilibrium, so they stay on its branch): within 2 % for every parameter that moves it.
-TEST(EquilibriumSensitivity, MatchesDifferencesOfFullSolvesForEachParameter) {
+// The strip's equilibrium for the Fig. 8 fabric, its problem and their sensitivity.
+class StripSensitivity : public ::testing::Test {
+ protected:
   const HangingStrip strip;
   const Material m = Fig8();
-  Vertices start = strip.mesh.vertices;
-  for (int v = 0; v < start.rows(); ++v) start(v, 2) = -0.3 * start(v, 0);  // tilted down
-  const Vertices x = strip.Solve(m, start);
-  auto problem = strip.Problem(m);
-  const EquilibriumSensitivity sensitivity(problem.get(), x, m);
+  const Vertices x = strip.Equilibrium(m);
+  const std::unique_ptr<ClothProblem> problem = strip.Problem(m);
+  const EquilibriumSensitivity sensitivity{problem.get(), x, m};
+};
+
+// ∂x/∂ln p by one back-substitution against central differences of full solves (started from
+// the equilibrium, so they stay on its branch): within 2 % for every parameter that moves it.
+TEST_F(StripSensitivity, MatchesDifferencesOfFullSolvesForEachParameter) {
   constexpr double kStep = 1e-3;  // relative
   for (const std::string name :
        {"b1", "b2", "c1", "beta", "areal_density_gsm", "stretch.stiffness_N_per_m"}) {
@@ -82,14 +92,7 @@ TEST(EquilibriumSensitivity, MatchesDifferencesOfFullSolvesForEachParameter) {
 
 // The adjoint form gives g · ∂x/∂p for a quantity's gradient g, every parameter, with one
 // back-substitution; a gradient on the held vertices counts for nothing (they do not move).
-TEST(EquilibriumSensitivity, TheAdjointFormIsTheDirectOne) {
-  const HangingStrip strip;
-  const Material m = Fig8();
-  Vertices start = strip.mesh.vertices;
-  for (int v = 0; v < start.rows(); ++v) start(v, 2) = -0.3 * start(v, 0);
-  const Vertices x = strip.Solve(m, start);
-  auto problem = strip.Problem(m);
-  const EquilibriumSensitivity sensitivity(problem.get(), x, m);
+TEST_F(StripSensitivity, TheAdjointFormIsTheDirectOne) {
   Vertices g(x.rows(), 3);
   for (int v = 0; v < g.rows(); ++v)
     g.row(v) << std::sin(1.0 + v), std::cos(2.0 * v), 0.5 + 0.01 * v;
@@ -107,12 +110,45 @@ TEST(EquilibriumSensitivity, TheAdjointFormIsTheDirectOne) {
   EXPECT_THROW(sensitivity.QuantityDerivativePerUnit(Vertices::Zero(3, 3), "b1"), InputError);
 }
 
+// A rest-shape morph as a parameter: (1) the whole strip and its clamp moved sideways move the
+// equilibrium with them, exactly (no correction); (2) the overhang lengthened (the free part's rest stretched
+// along the strip, the clamp kept) against central differences of full solves of the morphed
+// strip, within 2 %.
+TEST_F(StripSensitivity, RestShapeMorphsMatchTranslationsAndFullSolves) {
+  Vertices sideways = Vertices::Zero(x.rows(), 3);
+  sideways.col(1).setOnes();
+  const Vertices moved =
+      sideways + sensitivity.Solve(sensitivity.RestShapeResidualChange(strip.mesh, sideways, 1e-9));
+  EXPECT_LT((moved - sideways).norm(), 1e-9 * sideways.norm());
+
+  const double edge = 0.08 / 12;
+  Vertices longer = Vertices::Zero(x.rows(), 3);
+  for (int v = 0; v < x.rows(); ++v)
+    longer(v, 0) = std::max(0.0, strip.mesh.vertices(v, 0) - edge) / (0.08 - edge);  // tip: 1 m/m
+  const Vertices got =
+      longer + sensitivity.Solve(sensitivity.RestShapeResidualChange(strip.mesh, longer, 1e-9));
+  const double h = 1e-4;  // 0.1 mm of overhang
+  const auto solved = [&](double t) {
+    HangingStrip morphed;
+    morphed.mesh.vertices += t * longer;
+    return morphed.Solve(m, x + t * longer);
+  };
+  const Vertices expected = (solved(h) - solved(-h)) / (2.0 * h);
+  ASSERT_GT(expected.norm(), 1e-6);
+  EXPECT_LT((got - expected).norm(), 0.02 * expected.norm())
+      << "|dx| " << got.norm() << " against " << expected.norm();
+  EXPECT_THROW(sensitivity.RestShapeResidualChange(strip.mesh, longer.topRows(3), 1e-9),
+               InputError);
+  EXPECT_THROW(sensitivity.RestShapeResidualChange(strip.mesh, longer, 0.0), InputError);
+  const TriangleMesh other = CrissCrossGridMesh(0.08, 0.04, 6, 3);  // another mesh
+  EXPECT_THROW(problem->MaterialGradient(x, m, ClothProblem::kAllParts, &other), InputError);
+}
+
 TEST(EquilibriumSensitivity, RefusesAStateThatIsNoEquilibriumAndUnknownParameters) {
   const HangingStrip strip;
   const Material m = Fig8();
   auto problem = strip.Problem(m);
-  Vertices bent = strip.mesh.vertices;
-  for (int v = 0; v < bent.rows(); ++v) bent(v, 2) = -0.3 * bent(v, 0);
+  const Vertices bent = strip.Tilted();
   try {
     EquilibriumSensitivity s(problem.get(), bent, m);
     FAIL() << "took a state far from equilibrium";

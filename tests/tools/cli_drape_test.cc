@@ -532,6 +532,14 @@ TEST(CliDrape, SensitivityReportsTheInfluenceTableAndSigma) {
       EXPECT_GT(row["d_dc_d_ln_p"].get<double>(), 0.0);
     }
   }
+  // The scene's radii, apart from the σ, in mm.
+  const auto& scene = j["scene_sensitivities"];
+  ASSERT_EQ(scene.size(), 2u);
+  EXPECT_EQ(scene[0]["parameter"], "specimen_radius");
+  EXPECT_EQ(scene[0]["unit"], "mm");
+  EXPECT_LT(scene[0]["d_dc_d_ln_p"].get<double>(), 0.0);
+  EXPECT_EQ(scene[1]["parameter"], "support_radius");
+  EXPECT_NE(r.out.find("scene (not in the sigma):"), std::string::npos) << r.out;
   // Without the flag the result has none of it.
   const auto plain = Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "p.json").string());
   ASSERT_EQ(plain.exit_code, 0) << plain.err;

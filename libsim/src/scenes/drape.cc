@@ -684,7 +684,8 @@ struct SeedState {
   // With a rim split: the base mesh's equilibrium and the split mesh's problem (sensitivities).
   Vertices base_positions;
   std::unique_ptr<ClothProblem> split_problem;
-  std::vector<double> d_dc_d_p;  // with options.sensitivity: ∂DC/∂p per parameter [per SI unit]
+  // With options.sensitivity: ∂DC/∂p per parameter [per SI unit], and ∂DC/∂R per scene radius.
+  drape_internal::DcDerivativeSet d_dc;
 };
 
 // What a Monte Carlo sample of a seed starts from: the seed's nominal equilibrium on the base
@@ -766,22 +767,29 @@ void SettleSplit(const Material& material, const DrapeOptions& o, const DrapeSce
 }
 
 // Stage 5 (sensitivity): ∂DC/∂p of a converged seed, through each equilibrium it was measured
-// on; with a split rim the extrapolation's DC_split + (DC_split - DC_base)/2.
+// on; with a split rim the extrapolation's DC_split + (DC_split - DC_base)/2. The scene's radii
+// too when the run takes them (TakesSceneRadii), through a morph of the rest mesh.
 void SeedSensitivities(const Material& material, const DrapeOptions& o, const DrapeScene& scene,
                        const DrapeResult& result, const std::vector<std::string>& parameters,
                        SeedState* st) {
   if (!o.sensitivity || !st->seed.converged) return;
+  const bool radii = drape_internal::TakesSceneRadii(o);
   const auto derivatives = [&](ClothProblem* problem, const Vertices& x, const Pattern& p) {
-    return drape_internal::DcDerivatives(problem, x, p.pm.mesh.triangles, material, o, result,
-                                         parameters);
+    return drape_internal::DcDerivatives(problem, x, p.pm.mesh, material, o, result, parameters,
+                                         radii);
   };
   if (!scene.split) {
-    st->d_dc_d_p = derivatives(st->fine_problem.get(), st->seed.positions, scene.fine);
+    st->d_dc = derivatives(st->fine_problem.get(), st->seed.positions, scene.fine);
     return;
   }
-  const std::vector<double> base = derivatives(st->fine_problem.get(), st->base_positions, scene.fine);
-  st->d_dc_d_p = derivatives(st->split_problem.get(), st->seed.positions, *scene.split);
-  for (size_t k = 0; k < base.size(); ++k) st->d_dc_d_p[k] = 1.5 * st->d_dc_d_p[k] - 0.5 * base[k];
+  const drape_internal::DcDerivativeSet base =
+      derivatives(st->fine_problem.get(), st->base_positions, scene.fine);
+  st->d_dc = derivatives(st->split_problem.get(), st->seed.positions, *scene.split);
+  const auto extrapolate = [](std::vector<double>* split, const std::vector<double>& base_d) {
+    for (size_t k = 0; k < base_d.size(); ++k) (*split)[k] = 1.5 * (*split)[k] - 0.5 * base_d[k];
+  };
+  extrapolate(&st->d_dc.material, base.material);
+  extrapolate(&st->d_dc.radii, base.radii);
 }
 
 // How deep the deepest node lies inside the resting mount's disk [m].
@@ -918,6 +926,26 @@ void SummariseSeeds(DrapeResult* result) {
   result->mean_radius_sd = SampleSd(means);
 }
 
+MorphedSeed SolveMorphedSeed(const Material& material, const DrapeOptions& options,
+                             SceneRadius which, double t, const Vertices& start) {
+  if (options.rim_extrapolation || options.coarse_to_fine || options.mount != DrapeMount::kClamped)
+    throw InputError("morphed seed: one clamped equilibrium only (no rim split, no cascade)");
+  DrapeResult nominal;
+  DrapeScene scene = BuildScene(options, &nominal);
+  const Vertices morph = RadiusMorph(scene.fine.pm.mesh, which, options);
+  if (start.rows() != morph.rows()) throw InputError("morphed seed: the start is of another mesh");
+  scene.fine.pm.mesh.vertices += t * morph;
+  DrapeOptions o = options;
+  (which == SceneRadius::kSpecimen ? o.specimen_radius : o.support_radius) += t;
+  MorphedSeed m;
+  m.mesh = scene.fine.pm.mesh;
+  m.support_radius = o.support_radius;
+  m.positions = start + t * morph;
+  const std::unique_ptr<ClothProblem> problem = MakeProblem(scene.fine, material, scene.seams, o);
+  m.summary = SolveStatic(problem.get(), &m.positions, o.solver);
+  return m;
+}
+
 }  // namespace drape_internal
 
 DrapeResult SimulateDrape(const Material& material, const DrapeOptions& options) {
@@ -938,19 +966,19 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& options)
   const DrapeScene scene = BuildScene(o, &result);
   Say(o, SceneReport(scene, result));
   std::string failure;  // the first failing seed's
-  std::vector<std::vector<double>> seed_derivatives;
+  std::vector<drape_internal::DcDerivativeSet> seed_derivatives;
   for (int k = 0; k < o.seeds; ++k) {
     SeedState st = SettleBase(material, o, scene, o.first_seed + static_cast<unsigned>(k), &result);
     SettleSplit(material, o, scene, result, &st);
     MeasureSeed(o, scene, result, &st.seed);
     const auto sensitivity_start = std::chrono::steady_clock::now();
     SeedSensitivities(material, o, scene, result, parameters, &st);
-    if (!st.d_dc_d_p.empty()) {
+    if (!st.d_dc.material.empty() || !st.d_dc.radii.empty()) {
       result.sensitivity_seconds +=
           std::chrono::duration<double>(std::chrono::steady_clock::now() - sensitivity_start).count();
       result.sensitivity_equilibria += scene.split ? 2 : 1;
+      seed_derivatives.push_back(std::move(st.d_dc));
     }
-    if (!st.d_dc_d_p.empty()) seed_derivatives.push_back(std::move(st.d_dc_d_p));
     if (o.monte_carlo_samples > 0 && st.seed.converged)
       starts.push_back({st.seed.seed, scene.split ? st.base_positions : st.seed.positions,
                         st.seed.nodes.angles.size()});
@@ -962,7 +990,7 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& options)
   drape_internal::SummariseSeeds(&result);
   if (!result.converged) result.message = failure;
   if (o.sensitivity && result.converged)
-    drape_internal::SummariseSensitivities(material, parameters, seed_derivatives, &result);
+    drape_internal::SummariseSensitivities(material, parameters, seed_derivatives, o, &result);
   if (o.monte_carlo_samples > 0 && result.converged) MonteCarloDc(draws, o, scene, starts, &result);
   bool rim_capped = false;
   if (o.rim_auto) AutoRimElementSize(material, o, o.rim_extrapolation, &rim_capped);

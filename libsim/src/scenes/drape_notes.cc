@@ -93,10 +93,21 @@ std::optional<Note> ReversedBracketNote(const DrapeResult& r) {
                   "--resolution-mm should agree before this DC is trusted"};
 }
 
+std::optional<Note> SceneRadiiSkippedNote(const DrapeOptions& o, const DrapeResult& r) {
+  if (!o.sensitivity || !o.sensitivity_parameters.empty() || o.seams != DrapeSeams::kShifted ||
+      r.sensitivities.empty())
+    return std::nullopt;
+  return Note{"scene_radii_skipped",
+              "no sensitivities in the scene's radii with shifted seams: the radial morph they "
+              "are taken through would bend the seams (docs/methods/sensitivity.md, \"Scene "
+              "radii\")"};
+}
+
 std::vector<Note> DrapeNotes(const DrapeOptions& o, const DrapeResult& r, bool rim_capped) {
   std::vector<Note> notes;
   for (std::optional<Note> note : {RimShortfallNote(o, r), RimAutoCappedNote(o, r, rim_capped),
-                                   BareSupportNote(r), SkirtSinkNote(o, r), ReversedBracketNote(r)})
+                                   BareSupportNote(r), SkirtSinkNote(o, r), ReversedBracketNote(r),
+                                   SceneRadiiSkippedNote(o, r)})
     if (note) notes.push_back(std::move(*note));
   return notes;
 }

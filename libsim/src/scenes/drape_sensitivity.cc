@@ -7,6 +7,8 @@
 
 #include "drape_stages.h"
 #include "textile/sim/core/error.h"
+#include "textile/sim/core/units.h"
+#include "textile/sim/mesh/mesh.h"
 #include "textile/sim/law/material_parameters.h"
 #include "textile/sim/solve/sensitivity.h"
 
@@ -126,34 +128,125 @@ std::vector<std::string> SensitivityParameters(const Material& material, const D
   return names;
 }
 
-std::vector<double> DcDerivatives(ClothProblem* problem, const Vertices& x,
-                                  const Triangles& triangles, const Material& material,
-                                  const DrapeOptions& o, const DrapeResult& result,
-                                  const std::vector<std::string>& parameters) {
+bool TakesSceneRadii(const DrapeOptions& o) {
+  return o.sensitivity && o.sensitivity_parameters.empty() && o.seams != DrapeSeams::kShifted;
+}
+
+Vertices RadiusMorph(const TriangleMesh& rest, SceneRadius which, const DrapeOptions& o) {
+  const double rs = o.support_radius, r_max = o.specimen_radius, overhang = r_max - rs;
+  Vertices d = Vertices::Zero(rest.num_vertices(), 3);
+  for (int v = 0; v < rest.num_vertices(); ++v) {
+    const Eigen::Vector2d p = rest.vertices.row(v).head<2>().transpose();
+    const double r = p.norm();
+    if (r == 0.0) continue;
+    const double u = which == SceneRadius::kSpecimen
+                         ? std::max(0.0, r - rs) / overhang
+                         : (r <= rs ? r / rs : std::max(0.0, r_max - r) / overhang);
+    d.block<1, 2>(v, 0) = (u / r) * p.transpose();
+  }
+  return d;
+}
+
+namespace {
+
+// The rest morph's central-difference step, relative to the specimen's radius (1.5 nm): below
+// the strains at which a membrane soft in compression switches (RestShapeResidualChange); at
+// 1e-4 the DC's derivatives came out 6-8 % low, from 1e-7 to 1e-9 within 0.2 % of morphed drapes.
+constexpr double kRadiusStep = 1e-8;
+
+// The radii's stated uncertainties (docs/methods/sensitivity.md, "Scene radii"): a specimen cut
+// to a template, a machined support disk.
+constexpr double kSpecimenRadiusUncertainty = 1e-3;  // [m]
+constexpr double kSupportRadiusUncertainty = 1e-4;   // [m]
+
+// ∂DC/∂R of one radius: the shadow's area through the adjoint (g · morph + λ · T,
+// RestShapeResidualChange) and the support's rim where it is the outline, the specimen's area through the morphed mesh,
+// the support's as π R_s².
+double RadiusDcDerivative(const EquilibriumSensitivity& sensitivity, const Vertices& adjoint,
+                          const Vertices& area_gradient, const ShadowOutline& outline,
+                          const TriangleMesh& rest, SceneRadius which,
+                          const DrapeOptions& o, const DrapeResult& result) {
+  const Vertices morph = RadiusMorph(rest, which, o);
+  const double h = kRadiusStep * o.specimen_radius;
+  const Vertices force = sensitivity.RestShapeResidualChange(rest, morph, h);
+  double d_shadow = (adjoint.array() * force.array()).sum() +
+                    (area_gradient.array() * morph.array()).sum();
+  double d_support = 0.0;
+  if (which == SceneRadius::kSupport) {
+    const double step = kTwoPi / static_cast<double>(outline.radii.size());
+    for (size_t b = 0; b < outline.radii.size(); ++b)
+      if (outline.edge[b][0] < 0) d_shadow += o.support_radius * step;
+    d_support = kTwoPi * o.support_radius;
+  }
+  TriangleMesh up = rest, down = rest;
+  up.vertices += h * morph;
+  down.vertices -= h * morph;
+  const double d_specimen = (TriangleAreas(up).sum() - TriangleAreas(down).sum()) / (2.0 * h);
+  const double span = result.specimen_area - result.support_area;
+  const double dc = (outline.area - result.support_area) / span;
+  return ((d_shadow - d_support) - dc * (d_specimen - d_support)) / span;
+}
+
+ParameterInfluence RadiusInfluence(SceneRadius which, const DrapeOptions& o, double d_dc_d_r) {
+  const bool specimen = which == SceneRadius::kSpecimen;
+  ParameterInfluence row;
+  row.parameter = specimen ? "specimen_radius" : "support_radius";
+  const double r = specimen ? o.specimen_radius : o.support_radius;
+  const double dr = specimen ? kSpecimenRadiusUncertainty : kSupportRadiusUncertainty;
+  row.value = units::MToMm(r);
+  row.unit = "mm";
+  row.d_q_d_p = d_dc_d_r;
+  row.d_q_d_ln_p = r * d_dc_d_r;
+  row.uncertainty_ln = dr / r;
+  row.uncertainty_source = specimen ? "default: a specimen cut to a template, ±1 mm"
+                                    : "default: a machined support disk, ±0.1 mm";
+  row.change = std::abs(d_dc_d_r) * dr;
+  return row;
+}
+
+}  // namespace
+
+DcDerivativeSet DcDerivatives(ClothProblem* problem, const Vertices& x, const TriangleMesh& rest,
+                              const Material& material, const DrapeOptions& o,
+                              const DrapeResult& result, const std::vector<std::string>& parameters,
+                              bool radii) {
   // The solve stops at o.solver.tolerance; a state 100 times further off is no equilibrium.
   const EquilibriumSensitivity sensitivity(problem, x, material,
                                            std::max(100.0 * o.solver.tolerance, 1e-6));
-  const ShadowOutline outline = TraceShadowOutline(x, triangles, kSensitivityBins, o.support_radius);
+  const ShadowOutline outline =
+      TraceShadowOutline(x, rest.triangles, kSensitivityBins, o.support_radius);
   const double scale = result.specimen_area - result.support_area;
   // The adjoint form: one back-substitution for all the parameters.
-  const Vertices adjoint = sensitivity.Adjoint(OutlineAreaGradient(outline, x));
-  std::vector<double> d;
+  const Vertices area_gradient = OutlineAreaGradient(outline, x);
+  const Vertices adjoint = sensitivity.Adjoint(area_gradient);
+  DcDerivativeSet d;
   for (const std::string& p : parameters)
-    d.push_back(sensitivity.QuantityDerivativePerUnit(adjoint, p) / scale);
+    d.material.push_back(sensitivity.QuantityDerivativePerUnit(adjoint, p) / scale);
+  if (radii)
+    for (SceneRadius which : {SceneRadius::kSpecimen, SceneRadius::kSupport})
+      d.radii.push_back(RadiusDcDerivative(sensitivity, adjoint, area_gradient, outline, rest,
+                                           which, o, result));
   return d;
 }
 
 void SummariseSensitivities(const Material& material, const std::vector<std::string>& parameters,
-                            const std::vector<std::vector<double>>& seed_derivatives,
-                            DrapeResult* result) {
+                            const std::vector<DcDerivativeSet>& seed_derivatives,
+                            const DrapeOptions& o, DrapeResult* result) {
   if (seed_derivatives.empty()) return;
+  const double seeds = static_cast<double>(seed_derivatives.size());
   std::vector<double> mean(parameters.size(), 0.0);
-  for (const std::vector<double>& d : seed_derivatives)
-    for (size_t k = 0; k < mean.size(); ++k) mean[k] += d[k] / static_cast<double>(seed_derivatives.size());
+  for (const DcDerivativeSet& d : seed_derivatives)
+    for (size_t k = 0; k < mean.size(); ++k) mean[k] += d.material[k] / seeds;
   InfluenceTable table = MakeInfluenceTable(material, parameters, mean);
   result->sensitivities = std::move(table.rows);
   result->drape_coefficient_sigma = table.sigma;
   result->sigma_note = std::move(table.sigma_note);
+  if (seed_derivatives.front().radii.size() != kSceneRadii) return;
+  for (int k = 0; k < kSceneRadii; ++k) {
+    double sum = 0.0;
+    for (const DcDerivativeSet& d : seed_derivatives) sum += d.radii[static_cast<size_t>(k)] / seeds;
+    result->scene_sensitivities.push_back(RadiusInfluence(static_cast<SceneRadius>(k), o, sum));
+  }
 }
 
 }  // namespace drape_internal

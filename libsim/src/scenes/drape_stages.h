@@ -11,6 +11,7 @@
 
 #include "textile/sim/scenes/drape.h"
 #include "textile/sim/solve/cloth_problem.h"
+#include "textile/sim/solve/static_solver.h"
 #include "textile/sim/core/note.h"
 
 namespace textile::drape_internal {
@@ -28,6 +29,10 @@ std::optional<Note> BareSupportNote(const DrapeResult& result);
 std::optional<Note> SkirtSinkNote(const DrapeOptions& options, const DrapeResult& result);
 // reversed_bracket: a seed's split rim gave a lower DC than its base mesh.
 std::optional<Note> ReversedBracketNote(const DrapeResult& result);
+
+// scene_radii_skipped: every parameter's sensitivity asked for with shifted seams, which leave
+// the scene's radii out (TakesSceneRadii).
+std::optional<Note> SceneRadiiSkippedNote(const DrapeOptions& options, const DrapeResult& result);
 
 // All of them, in the order above (DrapeResult::notes).
 std::vector<Note> DrapeNotes(const DrapeOptions& options, const DrapeResult& result,
@@ -52,17 +57,50 @@ void FillEmptyBins(Eigen::VectorXd* radii);
 // material's fit covariance checked: InputError before any work.
 std::vector<std::string> SensitivityParameters(const Material& material,
                                                const DrapeOptions& options);
-// ∂DC/∂p [per SI unit] of one equilibrium x of `problem` (on `triangles`) for each parameter:
-// the equilibrium's sensitivity (EquilibriumSensitivity) through the traced outline's area.
-std::vector<double> DcDerivatives(ClothProblem* problem, const Vertices& x,
-                                  const Triangles& triangles, const Material& material,
-                                  const DrapeOptions& options, const DrapeResult& result,
-                                  const std::vector<std::string>& parameters);
+// The scene's radii as parameters (docs/methods/sensitivity.md, "Scene radii"), in this order.
+enum class SceneRadius { kSpecimen, kSupport };
+constexpr int kSceneRadii = 2;
+// Whether the run takes them: sensitivity on, every parameter (no list), seams none or through
+// the centre (a radial morph would bend shifted ones).
+bool TakesSceneRadii(const DrapeOptions& options);
+// The rest disk's radial morph that moves one radius by a metre and keeps the other (#V×3
+// [m/m], z 0): u(r) r̂ with, R_s the support's radius and R the specimen's,
+//   specimen: u = 0 within R_s, (r − R_s)/(R − R_s) beyond;
+//   support:  u = r/R_s within R_s, (R − r)/(R − R_s) beyond.
+// Diameters stay straight; the clamp's vertices move with the support's radius only.
+Vertices RadiusMorph(const TriangleMesh& rest, SceneRadius which, const DrapeOptions& options);
+
+// For tests of the radii's derivatives: the equilibrium of `options`' scene (its first seed's
+// problem; one clamped equilibrium: InputError otherwise) with the fine mesh morphed by
+// t·RadiusMorph [m] instead of meshed anew, solved from `start` (an equilibrium of the nominal
+// mesh) carried along: the same branch. The morphed mesh and the moved support's radius too.
+struct MorphedSeed {
+  TriangleMesh mesh;
+  double support_radius = 0.0;
+  Vertices positions;
+  SolveSummary summary;
+};
+MorphedSeed SolveMorphedSeed(const Material& material, const DrapeOptions& options,
+                             SceneRadius which, double t, const Vertices& start);
+
+// ∂DC/∂p of one equilibrium x of `problem` (on the rest mesh `rest`): `material` for each
+// parameter [per SI unit], and with `radii` for each SceneRadius [per m] (else empty). Through the traced
+// outline's area and its adjoint (EquilibriumSensitivity), with the specimen's and the support's
+// areas' own changes in DC = (A_shadow − A_support) / (A_specimen − A_support).
+struct DcDerivativeSet {
+  std::vector<double> material;
+  std::vector<double> radii;
+};
+DcDerivativeSet DcDerivatives(ClothProblem* problem, const Vertices& x, const TriangleMesh& rest,
+                              const Material& material, const DrapeOptions& options,
+                              const DrapeResult& result, const std::vector<std::string>& parameters,
+                              bool radii);
 // result->sensitivities (means over the seeds' derivatives, with each parameter's uncertainty,
-// largest dc_change first), drape_coefficient_sigma and sigma_note.
+// largest dc_change first), drape_coefficient_sigma and sigma_note; result->scene_sensitivities
+// when the seeds carry radii.
 void SummariseSensitivities(const Material& material, const std::vector<std::string>& parameters,
-                            const std::vector<std::vector<double>>& seed_derivatives,
-                            DrapeResult* result);
+                            const std::vector<DcDerivativeSet>& seed_derivatives,
+                            const DrapeOptions& options, DrapeResult* result);
 
 }  // namespace textile::drape_internal
 

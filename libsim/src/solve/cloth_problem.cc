@@ -85,9 +85,9 @@ ClothProblem::ClothProblem(const TriangleMesh& rest, const Material& material,
   // Only the chosen discretisation is built; both take the hinges and their seam multipliers.
   multipliers_ = Multipliers(rest_, hinges_, seams);
   if (options_.discretization == BendingDiscretization::kTensor) {
-    tensor_.emplace(TensorElements(material));
+    tensor_.emplace(TensorElements(material, rest_, multipliers_));
   } else {
-    bending_.emplace(HingeElements(material));
+    bending_.emplace(HingeElements(material, rest_, multipliers_));
   }
   BuildPattern();
 }
@@ -99,11 +99,13 @@ DirectionLaws ClothProblem::BendingLaws(const Material& material) const {
           WeftLaw(material, options_.bending_scale), bias};
 }
 
-BendingElements ClothProblem::HingeElements(const Material& material) const {
-  return BendingElements(rest_, hinges_, BendingLaws(material), options_.bending, multipliers_);
+BendingElements ClothProblem::HingeElements(const Material& material, const TriangleMesh& rest,
+                                            const std::vector<double>& multipliers) const {
+  return BendingElements(rest, hinges_, BendingLaws(material), options_.bending, multipliers);
 }
 
-TensorBending ClothProblem::TensorElements(const Material& material) const {
+TensorBending ClothProblem::TensorElements(const Material& material, const TriangleMesh& rest,
+                                           const std::vector<double>& multipliers) const {
   // docs/methods/materials.md, "Warp, weft and bias": the twist term a bias law fixes can
   // make the tensor energy non-convex, so these elements take warp and weft only.
   if (material.bending_bias) {
@@ -112,17 +114,26 @@ TensorBending ClothProblem::TensorElements(const Material& material) const {
         "hinge discretisation for a material with a measured bias law");
   }
   const DirectionLaws laws = BendingLaws(material);
-  return TensorBending(rest_, hinges_, laws.warp, laws.weft, multipliers_);
+  return TensorBending(rest, hinges_, laws.warp, laws.weft, multipliers);
 }
 
-Vertices ClothProblem::MaterialGradient(const Vertices& x, const Material& other,
-                                        int parts) const {
+Vertices ClothProblem::MaterialGradient(const Vertices& x, const Material& other, int parts,
+                                        const TriangleMesh* rest) const {
+  if (rest && (rest->num_vertices() != rest_.num_vertices() ||
+               rest->triangles.rows() != rest_.triangles.rows() || rest->triangles != rest_.triangles))
+    throw InputError("material gradient: another rest mesh must have the problem's vertices and "
+                     "triangles");
+  const TriangleMesh& on = rest ? Checked(*rest) : rest_;
+  std::vector<double> moved_multipliers;  // the seams' bands found on the other rest mesh
+  if (rest && (parts & kBendingPart)) moved_multipliers = Multipliers(on, hinges_, seams_);
+  const std::vector<double>& multipliers = rest ? moved_multipliers : multipliers_;
   Vertices grad = Vertices::Zero(x.rows(), 3);
-  if (parts & kMembranePart) MembraneElements(rest_, other, options_.membrane).AddGradient(x, grad);
-  if ((parts & kBendingPart) && tensor_) TensorElements(other).EnergyGradient(x, grad);
-  if ((parts & kBendingPart) && !tensor_) HingeElements(other).AddGradient(x, grad);
+  if (parts & kMembranePart) MembraneElements(on, other, options_.membrane).AddGradient(x, grad);
+  if ((parts & kBendingPart) && tensor_)
+    TensorElements(other, on, multipliers).EnergyGradient(x, grad);
+  if ((parts & kBendingPart) && !tensor_) HingeElements(other, on, multipliers).AddGradient(x, grad);
   if (parts & kGravityPart) {
-    const Eigen::VectorXd masses = LumpedMasses(rest_, other.areal_density, seams_);
+    const Eigen::VectorXd masses = LumpedMasses(on, other.areal_density, seams_);
     for (int i = 0; i < num_vertices(); ++i)
       grad.row(i) -= masses(i) * options_.gravity.transpose();
   }

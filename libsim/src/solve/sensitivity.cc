@@ -101,6 +101,25 @@ double EquilibriumSensitivity::QuantityDerivativePerUnit(const Vertices& adjoint
   return d;
 }
 
+Vertices EquilibriumSensitivity::RestShapeResidualChange(const TriangleMesh& rest,
+                                                         const Vertices& d_rest,
+                                                         double step) const {
+  if (rest.num_vertices() != x_.rows() || d_rest.rows() != x_.rows() || d_rest.cols() != 3 ||
+      !d_rest.allFinite())
+    throw InputError("sensitivity: the rest morph must be finite, one row a vertex");
+  if (!(step > 0.0) || !std::isfinite(step))
+    throw InputError("sensitivity: the rest morph's step must be > 0");
+  const auto force_at = [&](double t) {
+    TriangleMesh morphed = rest;
+    morphed.vertices += t * d_rest;
+    return problem_->MaterialGradient(x_ + t * d_rest, material_, ClothProblem::kAllParts,
+                                      &morphed);
+  };
+  Vertices d = (force_at(step) - force_at(-step)) / (2.0 * step);
+  if (!d.allFinite()) throw ComputeError("sensitivity: the rest morph's force change is not a number");
+  return d;
+}
+
 Vertices EquilibriumSensitivity::Displacement(const std::string& parameter) const {
   const double p = GetMaterialParameter(material_, parameter).si;
   if (p == 0.0) return Vertices::Zero(x_.rows(), 3);

@@ -290,11 +290,17 @@ struct DrapeResult {
   //   bare_support       the fabric left over 2 % of the support's top bare
   //   skirt_sink         resting: the skirt sank over 0.3 mm into the support
   //   reversed_bracket   rim extrapolation: a seed's split rim gave a lower DC than its base
+  //   scene_radii_skipped  sensitivities with shifted seams: none in the scene's radii
   std::vector<Note> notes;
   // With options.sensitivity (and converged): each parameter's influence, the largest
   // dc_change first; the DC's 1-σ from the fit's covariance of the bending law's b1, b2, c1
   // (NaN when the material carries none, sigma_note saying so).
   std::vector<ParameterInfluence> sensitivities;  // Q = the DC
+  // With options.sensitivity and no sensitivity_parameters (and converged): the DC's
+  // derivatives in the scene's radii, "specimen_radius" then "support_radius" (value and
+  // uncertainty in mm; docs/methods/sensitivity.md, "Scene radii"). Not in the σ. Empty with
+  // shifted seams (a note says why).
+  std::vector<ParameterInfluence> scene_sensitivities;
   double drape_coefficient_sigma = std::numeric_limits<double>::quiet_NaN();
   std::string sigma_note;
   // Wall time of the sensitivities, all seeds and equilibria: factorisations, the parameters'

@@ -88,10 +88,12 @@ class ClothProblem {
   // vertices. Contact is left out. For design sensitivities (sensitivity.h): the difference of
   // two such gradients over a parameter step is ∂R/∂p, with the contact state frozen.
   // `parts` limits it to those (MaterialPart bits; a part the change does not touch adds nothing
-  // to a difference). Throws InputError as the constructor does for `other`.
+  // to a difference). With `rest`, on that rest mesh in place of the problem's (the same
+  // vertices and triangles; the seams' bands found on it): a rest-shape sensitivity's
+  // difference. Throws InputError as the constructor does for `other` or `rest`.
   enum MaterialPart { kMembranePart = 1, kBendingPart = 2, kGravityPart = 4, kAllParts = 7 };
-  Vertices MaterialGradient(const Vertices& x, const Material& other,
-                            int parts = kAllParts) const;
+  Vertices MaterialGradient(const Vertices& x, const Material& other, int parts = kAllParts,
+                            const TriangleMesh* rest = nullptr) const;
 
   // Total potential energy [J] at x (#V×3 [m]), with the current anchors.
   double Energy(const Vertices& x) const;
@@ -196,8 +198,11 @@ class ClothProblem {
   void DropFixedFromPattern();
   // A material's bending laws (β and bending_scale applied) and elements on this pattern.
   DirectionLaws BendingLaws(const Material& material) const;
-  BendingElements HingeElements(const Material& material) const;
-  TensorBending TensorElements(const Material& material) const;
+  // On `rest` with the hinges' seam multipliers `multipliers` (the problem's by default).
+  BendingElements HingeElements(const Material& material, const TriangleMesh& rest,
+                                const std::vector<double>& multipliers) const;
+  TensorBending TensorElements(const Material& material, const TriangleMesh& rest,
+                               const std::vector<double>& multipliers) const;
   // Bending Hessian elements [first, end) of the active discretisation into triplets_.
   int num_bending_elements() const;
   void BendingTriplets(const Vertices& x, HessianProjection projection, int first, int end);

@@ -124,8 +124,9 @@ TEST(DrapeSensitivity, RadiusMorphsMoveOneRadiusAndKeepTheOther) {
   DrapeOptions o = Coarse();
   o.seeds = 1;
   const TriangleMesh mesh = SimulateDrape(Fig8(), o).mesh;
-  const Vertices specimen = drape_internal::RadiusMorph(mesh, drape_internal::SceneRadius::kSpecimen, o);
-  const Vertices support = drape_internal::RadiusMorph(mesh, drape_internal::SceneRadius::kSupport, o);
+  using drape_internal::SceneRadius;
+  const Vertices specimen = drape_internal::RadiusMorph(mesh, SceneRadius::kSpecimen, o);
+  const Vertices support = drape_internal::RadiusMorph(mesh, SceneRadius::kSupport, o);
   int rim = 0, edge = 0;
   for (int v = 0; v < mesh.num_vertices(); ++v) {
     const Eigen::Vector2d p = mesh.vertices.row(v).head<2>().transpose();
@@ -151,21 +152,17 @@ TEST(DrapeSensitivity, RadiusMorphsMoveOneRadiusAndKeepTheOther) {
   EXPECT_GT(edge, 24);
 }
 
-// The DC's derivatives in the radii against central differences of the drape on meshes morphed
-// by ±0.2 mm of the radius (the same vertices, solved from the equilibrium: the same branch; a
-// mesh made anew would jitter by ~0.003 against a change of ~0.002), through the traced outline:
-// within 2 %.
-TEST(DrapeSensitivity, SceneRadiiMatchDifferencesOfMorphedDrapes) {
-  DrapeOptions o = Coarse();
-  o.sensitivity = true;
-  const Material m = Fig8();
+// The DC's derivatives in the radii of the drape `o` (sensitivity on) against central
+// differences of the drape on meshes morphed by ±0.2 mm of the radius (the same vertices, solved
+// from the equilibrium: the same branch; a mesh made anew would jitter by ~0.003 against a change
+// of ~0.002), through the traced outline: within 2 %. Returns the drape.
+DrapeResult ExpectRadiiMatchMorphedDrapes(const Material& m, const DrapeOptions& o) {
   const DrapeResult r = SimulateDrape(m, o);
-  ASSERT_TRUE(r.converged) << r.message;
-  ASSERT_EQ(r.scene_sensitivities.size(), 2u);
-  EXPECT_EQ(r.scene_sensitivities[0].parameter, "specimen_radius");
-  EXPECT_EQ(r.scene_sensitivities[1].parameter, "support_radius");
-  EXPECT_DOUBLE_EQ(r.scene_sensitivities[0].value, 150.0);
-  EXPECT_EQ(r.scene_sensitivities[0].unit, "mm");
+  EXPECT_TRUE(r.converged) << r.message;
+  if (r.scene_sensitivities.size() != 2u) {
+    ADD_FAILURE() << "no radii";
+    return r;
+  }
   constexpr double kStep = 2e-4;
   for (const drape_internal::SceneRadius which :
        {drape_internal::SceneRadius::kSpecimen, drape_internal::SceneRadius::kSupport}) {
@@ -182,16 +179,62 @@ TEST(DrapeSensitivity, SceneRadiiMatchDifferencesOfMorphedDrapes) {
     const ParameterInfluence& row = r.scene_sensitivities[static_cast<size_t>(which)];
     EXPECT_NEAR(row.d_q_d_p, fd, 0.02 * std::abs(fd)) << row.parameter;
   }
+  return r;
+}
+
+TEST(DrapeSensitivity, SceneRadiiMatchDifferencesOfMorphedDrapes) {
+  DrapeOptions o = Coarse();
+  o.sensitivity = true;
+  const Material m = Fig8();
+  const DrapeResult r = ExpectRadiiMatchMorphedDrapes(m, o);
+  ASSERT_EQ(r.scene_sensitivities.size(), 2u);
+  EXPECT_EQ(r.scene_sensitivities[0].parameter, "specimen_radius");
+  EXPECT_EQ(r.scene_sensitivities[1].parameter, "support_radius");
+  EXPECT_DOUBLE_EQ(r.scene_sensitivities[0].value, 150.0);
+  EXPECT_EQ(r.scene_sensitivities[0].unit, "mm");
   // A longer overhang hangs lower; a wider support holds more up.
   EXPECT_LT(r.scene_sensitivities[0].d_q_d_p, 0.0);
   EXPECT_GT(r.scene_sensitivities[1].d_q_d_p, 0.0);
-  // A list of parameters, or shifted seams (with a note), leave the radii out.
+  // A list of parameters leaves the radii out.
   o.sensitivity_parameters = {"b1"};
   EXPECT_TRUE(SimulateDrape(m, o).scene_sensitivities.empty());
   o.rim_extrapolation = true;
   EXPECT_THROW(drape_internal::SolveMorphedSeed(m, o, drape_internal::SceneRadius::kSpecimen, 0.0,
                                                 r.per_seed[0].positions),
                InputError);
+}
+
+// Seams through the centre (turned by the frame) move with the morph: their ends stay on the
+// rim, their bands on the fabric.
+TEST(DrapeSensitivity, SceneRadiiWithSeamsThroughTheCentre) {
+  DrapeOptions o = Coarse();
+  o.sensitivity = true;
+  o.seams = DrapeSeams::kWeftWarp;
+  o.frame_angle = 30.0 * std::numbers::pi / 180.0;
+  ExpectRadiiMatchMorphedDrapes(Fig8(), o);
+}
+
+// With the rim split (the CLI's default), the radii are extrapolated like the parameters; shifted
+// seams leave them out, with a note.
+TEST(DrapeSensitivity, SceneRadiiThroughTheRimSplitAndNotWithShiftedSeams) {
+  DrapeOptions o = Coarse();
+  o.sensitivity = true;
+  o.rim_element_size = 0.005;
+  o.rim_extrapolation = true;
+  const DrapeResult split = SimulateDrape(Fig8(), o);
+  ASSERT_TRUE(split.converged) << split.message;
+  ASSERT_EQ(split.scene_sensitivities.size(), 2u);
+  EXPECT_LT(split.scene_sensitivities[0].d_q_d_p, 0.0);
+  EXPECT_GT(split.scene_sensitivities[1].d_q_d_p, 0.0);
+  DrapeOptions shifted = Coarse();
+  shifted.sensitivity = true;
+  shifted.seams = DrapeSeams::kShifted;
+  shifted.seam_shift = 0.03;
+  const DrapeResult r = SimulateDrape(Fig8(), shifted);
+  ASSERT_TRUE(r.converged) << r.message;
+  EXPECT_FALSE(r.sensitivities.empty());
+  EXPECT_TRUE(r.scene_sensitivities.empty());
+  EXPECT_TRUE(HasNote(r.notes, "scene_radii_skipped"));
 }
 
 // σ² = gᵀ C g over b1, b2, c1; the table's changes over each parameter's uncertainty.
@@ -232,6 +275,7 @@ TEST(DrapeSensitivity, MonteCarloSamplesStartFromTheSeedsEquilibrium) {
   ASSERT_TRUE(r.converged) << r.message;
   ASSERT_TRUE(r.monte_carlo.has_value());
   EXPECT_FALSE(r.sensitivities.empty());  // implied
+  EXPECT_TRUE(r.scene_sensitivities.empty());  // not asked for
   EXPECT_EQ(r.monte_carlo->samples, 6);
   EXPECT_EQ(r.monte_carlo->failed, 0);
   EXPECT_EQ(r.monte_carlo_node_changes, 0);

@@ -769,22 +769,20 @@ void SettleSplit(const Material& material, const DrapeOptions& o, const DrapeSce
 // Stage 5 (sensitivity): ∂DC/∂p of a converged seed, through each equilibrium it was measured
 // on; with a split rim the extrapolation's DC_split + (DC_split - DC_base)/2. The scene's radii
 // too when the run takes them (TakesSceneRadii), through a morph of the rest mesh.
-void SeedSensitivities(const Material& material, const DrapeOptions& o, const DrapeScene& scene,
-                       const DrapeResult& result, const std::vector<std::string>& parameters,
-                       SeedState* st) {
+void SeedSensitivities(const Material& material, const DrapeOptions& o, bool radii,
+                       const DrapeScene& scene, const DrapeResult& result,
+                       const std::vector<std::string>& parameters, SeedState* st) {
   if (!o.sensitivity || !st->seed.converged) return;
-  const bool radii = drape_internal::TakesSceneRadii(o);
-  const auto derivatives = [&](ClothProblem* problem, const Vertices& x, const Pattern& p) {
-    return drape_internal::DcDerivatives(problem, x, p.pm.mesh, material, o, result, parameters,
-                                         radii);
+  const auto derivatives = [&](ClothProblem* problem, const Vertices& x) {
+    return drape_internal::DcDerivatives(problem, x, material, o, result, parameters, radii);
   };
   if (!scene.split) {
-    st->d_dc = derivatives(st->fine_problem.get(), st->seed.positions, scene.fine);
+    st->d_dc = derivatives(st->fine_problem.get(), st->seed.positions);
     return;
   }
   const drape_internal::DcDerivativeSet base =
-      derivatives(st->fine_problem.get(), st->base_positions, scene.fine);
-  st->d_dc = derivatives(st->split_problem.get(), st->seed.positions, *scene.split);
+      derivatives(st->fine_problem.get(), st->base_positions);
+  st->d_dc = derivatives(st->split_problem.get(), st->seed.positions);
   const auto extrapolate = [](std::vector<double>* split, const std::vector<double>& base_d) {
     for (size_t k = 0; k < base_d.size(); ++k) (*split)[k] = 1.5 * (*split)[k] - 0.5 * base_d[k];
   };
@@ -937,6 +935,8 @@ MorphedSeed SolveMorphedSeed(const Material& material, const DrapeOptions& optio
   scene.fine.pm.mesh.vertices += t * morph;
   DrapeOptions o = options;
   (which == SceneRadius::kSpecimen ? o.specimen_radius : o.support_radius) += t;
+  scene.seams.clear();  // diameters: moved with the rim (the support's morph keeps it)
+  for (const SeamLine& line : DrapeSeamLines(o)) scene.seams.push_back(Seam{o.seam_profile, line});
   MorphedSeed m;
   m.mesh = scene.fine.pm.mesh;
   m.support_radius = o.support_radius;
@@ -953,6 +953,7 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& options)
   if (std::string why; !options.Check(&why)) throw InputError("drape options: " + why);
   DrapeOptions o = options;
   if (o.monte_carlo_samples > 0) o.sensitivity = true;  // the linear σ beside the sampled one
+  const bool radii = drape_internal::TakesSceneRadii(options);  // asked for, not implied
   DrapeResult result;
   result.rim_turn_down = RimTurnDownLength(material, o);
   // Sensitivities and Monte Carlo draws: the names and the covariance checked before any work
@@ -972,7 +973,7 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& options)
     SettleSplit(material, o, scene, result, &st);
     MeasureSeed(o, scene, result, &st.seed);
     const auto sensitivity_start = std::chrono::steady_clock::now();
-    SeedSensitivities(material, o, scene, result, parameters, &st);
+    SeedSensitivities(material, o, radii, scene, result, parameters, &st);
     if (!st.d_dc.material.empty() || !st.d_dc.radii.empty()) {
       result.sensitivity_seconds +=
           std::chrono::duration<double>(std::chrono::steady_clock::now() - sensitivity_start).count();
@@ -994,7 +995,7 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& options)
   if (o.monte_carlo_samples > 0 && result.converged) MonteCarloDc(draws, o, scene, starts, &result);
   bool rim_capped = false;
   if (o.rim_auto) AutoRimElementSize(material, o, o.rim_extrapolation, &rim_capped);
-  result.notes = drape_internal::DrapeNotes(o, result, rim_capped);
+  result.notes = drape_internal::DrapeNotes(options, result, rim_capped);  // as asked
   // A membrane the file did not give is a guess the DC depends on: the run says which parts.
   for (Note& n : MaterialDefaultNotes(material)) result.notes.push_back(std::move(n));
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -159,16 +159,29 @@ constexpr double kRadiusStep = 1e-8;
 constexpr double kSpecimenRadiusUncertainty = 1e-3;  // [m]
 constexpr double kSupportRadiusUncertainty = 1e-4;   // [m]
 
+// The drape's seams at the specimen's radius R + t (the support's morph keeps the rim, and so
+// the seams' ends); none without seams. A diameter stays one under either morph.
+EquilibriumSensitivity::SeamsAt MorphedSeams(SceneRadius which, const DrapeOptions& o) {
+  if (o.seams == DrapeSeams::kNone) return {};
+  return [which, o](double t) {
+    DrapeOptions moved = o;
+    if (which == SceneRadius::kSpecimen) moved.specimen_radius += t;
+    std::vector<Seam> seams;
+    for (const SeamLine& line : DrapeSeamLines(moved)) seams.push_back(Seam{o.seam_profile, line});
+    return seams;
+  };
+}
+
 // ∂DC/∂R of one radius: the shadow's area through the adjoint (g · morph + λ · T,
-// RestShapeResidualChange) and the support's rim where it is the outline, the specimen's area through the morphed mesh,
-// the support's as π R_s².
+// RestShapeResidualChange) and the support's rim where it is the outline; the specimen's area
+// through the morphed mesh, the support's as π R_s².
 double RadiusDcDerivative(const EquilibriumSensitivity& sensitivity, const Vertices& adjoint,
                           const Vertices& area_gradient, const ShadowOutline& outline,
                           const TriangleMesh& rest, SceneRadius which,
                           const DrapeOptions& o, const DrapeResult& result) {
   const Vertices morph = RadiusMorph(rest, which, o);
   const double h = kRadiusStep * o.specimen_radius;
-  const Vertices force = sensitivity.RestShapeResidualChange(rest, morph, h);
+  const Vertices force = sensitivity.RestShapeResidualChange(morph, h, MorphedSeams(which, o));
   double d_shadow = (adjoint.array() * force.array()).sum() +
                     (area_gradient.array() * morph.array()).sum();
   double d_support = 0.0;
@@ -206,13 +219,14 @@ ParameterInfluence RadiusInfluence(SceneRadius which, const DrapeOptions& o, dou
 
 }  // namespace
 
-DcDerivativeSet DcDerivatives(ClothProblem* problem, const Vertices& x, const TriangleMesh& rest,
+DcDerivativeSet DcDerivatives(ClothProblem* problem, const Vertices& x,
                               const Material& material, const DrapeOptions& o,
                               const DrapeResult& result, const std::vector<std::string>& parameters,
                               bool radii) {
   // The solve stops at o.solver.tolerance; a state 100 times further off is no equilibrium.
   const EquilibriumSensitivity sensitivity(problem, x, material,
                                            std::max(100.0 * o.solver.tolerance, 1e-6));
+  const TriangleMesh& rest = problem->rest();
   const ShadowOutline outline =
       TraceShadowOutline(x, rest.triangles, kSensitivityBins, o.support_radius);
   const double scale = result.specimen_area - result.support_area;
@@ -244,7 +258,8 @@ void SummariseSensitivities(const Material& material, const std::vector<std::str
   if (seed_derivatives.front().radii.size() != kSceneRadii) return;
   for (int k = 0; k < kSceneRadii; ++k) {
     double sum = 0.0;
-    for (const DcDerivativeSet& d : seed_derivatives) sum += d.radii[static_cast<size_t>(k)] / seeds;
+    for (const DcDerivativeSet& d : seed_derivatives)
+      sum += d.radii[static_cast<size_t>(k)] / seeds;
     result->scene_sensitivities.push_back(RadiusInfluence(static_cast<SceneRadius>(k), o, sum));
   }
 }

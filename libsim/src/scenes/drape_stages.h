@@ -60,8 +60,8 @@ std::vector<std::string> SensitivityParameters(const Material& material,
 // The scene's radii as parameters (docs/methods/sensitivity.md, "Scene radii"), in this order.
 enum class SceneRadius { kSpecimen, kSupport };
 constexpr int kSceneRadii = 2;
-// Whether the run takes them: sensitivity on, every parameter (no list), seams none or through
-// the centre (a radial morph would bend shifted ones).
+// Whether the run takes them: sensitivity asked for (not implied by Monte Carlo), every
+// parameter (no list), seams none or through the centre (a radial morph would bend shifted ones).
 bool TakesSceneRadii(const DrapeOptions& options);
 // The rest disk's radial morph that moves one radius by a metre and keeps the other (#V×3
 // [m/m], z 0): u(r) r̂ with, R_s the support's radius and R the specimen's,
@@ -83,15 +83,15 @@ struct MorphedSeed {
 MorphedSeed SolveMorphedSeed(const Material& material, const DrapeOptions& options,
                              SceneRadius which, double t, const Vertices& start);
 
-// ∂DC/∂p of one equilibrium x of `problem` (on the rest mesh `rest`): `material` for each
-// parameter [per SI unit], and with `radii` for each SceneRadius [per m] (else empty). Through the traced
+// ∂DC/∂p of one equilibrium x of `problem`: `material` for each parameter [per SI unit], and
+// with `radii` for each SceneRadius [per m] (else empty). Through the traced
 // outline's area and its adjoint (EquilibriumSensitivity), with the specimen's and the support's
 // areas' own changes in DC = (A_shadow − A_support) / (A_specimen − A_support).
 struct DcDerivativeSet {
   std::vector<double> material;
   std::vector<double> radii;
 };
-DcDerivativeSet DcDerivatives(ClothProblem* problem, const Vertices& x, const TriangleMesh& rest,
+DcDerivativeSet DcDerivatives(ClothProblem* problem, const Vertices& x,
                               const Material& material, const DrapeOptions& options,
                               const DrapeResult& result, const std::vector<std::string>& parameters,
                               bool radii);

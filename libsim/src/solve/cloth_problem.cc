@@ -118,22 +118,29 @@ TensorBending ClothProblem::TensorElements(const Material& material, const Trian
 }
 
 Vertices ClothProblem::MaterialGradient(const Vertices& x, const Material& other, int parts,
-                                        const TriangleMesh* rest) const {
+                                        const TriangleMesh* rest,
+                                        const std::vector<Seam>* seams) const {
+  if (seams && seams->size() != seams_.size())
+    throw InputError("material gradient: other seams must be the problem's, moved");
   if (rest && (rest->num_vertices() != rest_.num_vertices() ||
-               rest->triangles.rows() != rest_.triangles.rows() || rest->triangles != rest_.triangles))
+               rest->triangles.rows() != rest_.triangles.rows() ||
+               rest->triangles != rest_.triangles))
     throw InputError("material gradient: another rest mesh must have the problem's vertices and "
                      "triangles");
   const TriangleMesh& on = rest ? Checked(*rest) : rest_;
+  const std::vector<Seam>& lines = seams ? *seams : seams_;
+  const bool moved = rest || seams;
   std::vector<double> moved_multipliers;  // the seams' bands found on the other rest mesh
-  if (rest && (parts & kBendingPart)) moved_multipliers = Multipliers(on, hinges_, seams_);
-  const std::vector<double>& multipliers = rest ? moved_multipliers : multipliers_;
+  if (moved && (parts & kBendingPart)) moved_multipliers = Multipliers(on, hinges_, lines);
+  const std::vector<double>& multipliers = moved ? moved_multipliers : multipliers_;
   Vertices grad = Vertices::Zero(x.rows(), 3);
   if (parts & kMembranePart) MembraneElements(on, other, options_.membrane).AddGradient(x, grad);
   if ((parts & kBendingPart) && tensor_)
     TensorElements(other, on, multipliers).EnergyGradient(x, grad);
-  if ((parts & kBendingPart) && !tensor_) HingeElements(other, on, multipliers).AddGradient(x, grad);
+  if ((parts & kBendingPart) && !tensor_)
+    HingeElements(other, on, multipliers).AddGradient(x, grad);
   if (parts & kGravityPart) {
-    const Eigen::VectorXd masses = LumpedMasses(on, other.areal_density, seams_);
+    const Eigen::VectorXd masses = LumpedMasses(on, other.areal_density, lines);
     for (int i = 0; i < num_vertices(); ++i)
       grad.row(i) -= masses(i) * options_.gravity.transpose();
   }

@@ -101,22 +101,23 @@ double EquilibriumSensitivity::QuantityDerivativePerUnit(const Vertices& adjoint
   return d;
 }
 
-Vertices EquilibriumSensitivity::RestShapeResidualChange(const TriangleMesh& rest,
-                                                         const Vertices& d_rest,
-                                                         double step) const {
-  if (rest.num_vertices() != x_.rows() || d_rest.rows() != x_.rows() || d_rest.cols() != 3 ||
-      !d_rest.allFinite())
+Vertices EquilibriumSensitivity::RestShapeResidualChange(const Vertices& d_rest, double step,
+                                                         const SeamsAt& seams_at) const {
+  if (d_rest.rows() != x_.rows() || d_rest.cols() != 3 || !d_rest.allFinite())
     throw InputError("sensitivity: the rest morph must be finite, one row a vertex");
   if (!(step > 0.0) || !std::isfinite(step))
     throw InputError("sensitivity: the rest morph's step must be > 0");
   const auto force_at = [&](double t) {
-    TriangleMesh morphed = rest;
+    TriangleMesh morphed = problem_->rest();
     morphed.vertices += t * d_rest;
+    std::vector<Seam> seams;
+    if (seams_at) seams = seams_at(t);
     return problem_->MaterialGradient(x_ + t * d_rest, material_, ClothProblem::kAllParts,
-                                      &morphed);
+                                      &morphed, seams_at ? &seams : nullptr);
   };
   Vertices d = (force_at(step) - force_at(-step)) / (2.0 * step);
-  if (!d.allFinite()) throw ComputeError("sensitivity: the rest morph's force change is not a number");
+  if (!d.allFinite())
+    throw ComputeError("sensitivity: the rest morph's force change is not a number");
   return d;
 }
 

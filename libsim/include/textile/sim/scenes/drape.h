@@ -296,10 +296,11 @@ struct DrapeResult {
   // dc_change first; the DC's 1-σ from the fit's covariance of the bending law's b1, b2, c1
   // (NaN when the material carries none, sigma_note saying so).
   std::vector<ParameterInfluence> sensitivities;  // Q = the DC
-  // With options.sensitivity and no sensitivity_parameters (and converged): the DC's
-  // derivatives in the scene's radii, "specimen_radius" then "support_radius" (value and
-  // uncertainty in mm; docs/methods/sensitivity.md, "Scene radii"). Not in the σ. Empty with
-  // shifted seams (a note says why).
+  // With options.sensitivity (not only implied by monte_carlo_samples) and no
+  // sensitivity_parameters (and converged): the DC's derivatives in the scene's radii,
+  // "specimen_radius" then "support_radius" (value and uncertainty in mm;
+  // docs/methods/sensitivity.md, "Scene radii"). Not in the σ. Empty with shifted seams (a note
+  // says why).
   std::vector<ParameterInfluence> scene_sensitivities;
   double drape_coefficient_sigma = std::numeric_limits<double>::quiet_NaN();
   std::string sigma_note;

@@ -120,7 +120,8 @@ DrapeWhatIfPrediction PredictDrapeWhatIf(const Material& material, const std::st
                                          const WhatIfOptions& what_if);
 
 // `textile drape --cache DIR`: the drape with every parameter's sensitivity
-// (options.sensitivity_parameters must be empty and the mount clamped: InputError), added to the cache when it
+// (options.sensitivity_parameters must be empty and the mount clamped: InputError), added to
+// the cache when it
 // converged (with a note instead when a derivative is not a number; another note names cache
 // files that are no entry).
 DrapeResult SimulateDrapeCached(const Material& material, const DrapeOptions& options,

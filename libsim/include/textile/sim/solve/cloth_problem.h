@@ -89,11 +89,13 @@ class ClothProblem {
   // two such gradients over a parameter step is ∂R/∂p, with the contact state frozen.
   // `parts` limits it to those (MaterialPart bits; a part the change does not touch adds nothing
   // to a difference). With `rest`, on that rest mesh in place of the problem's (the same
-  // vertices and triangles; the seams' bands found on it): a rest-shape sensitivity's
-  // difference. Throws InputError as the constructor does for `other` or `rest`.
+  // vertices and triangles), and with `seams`, those seam lines (the same profiles, moved with
+  // the rest) in place of the problem's: a rest-shape sensitivity's difference. Throws
+  // InputError as the constructor does for `other`, `rest` or `seams`.
   enum MaterialPart { kMembranePart = 1, kBendingPart = 2, kGravityPart = 4, kAllParts = 7 };
   Vertices MaterialGradient(const Vertices& x, const Material& other, int parts = kAllParts,
-                            const TriangleMesh* rest = nullptr) const;
+                            const TriangleMesh* rest = nullptr,
+                            const std::vector<Seam>* seams = nullptr) const;
 
   // Total potential energy [J] at x (#V×3 [m]), with the current anchors.
   double Energy(const Vertices& x) const;

@@ -18,7 +18,9 @@
 // differentiated by hand; the truncation error is ~1e-8 relative, 1e-4 one-sided). Contact and
 // friction anchors stay as they are: the contact set is frozen.
 
+#include <functional>
 #include <memory>
+#include <vector>
 #include <string>
 
 #include "textile/sim/law/material.h"
@@ -56,17 +58,19 @@ class EquilibriumSensitivity {
   Vertices Adjoint(const Vertices& quantity_gradient) const;
   double QuantityDerivativePerUnit(const Vertices& adjoint, const std::string& parameter) const;
 
-  // A scene's lengths (a radius, an overhang) as parameters: a morph of the rest mesh,
-  // rest + t·d_rest (#V×3 [m per unit of t]; rest is the problem's), the held vertices moved
-  // along. The state is carried with the same field, x + t·d_rest (smooth, so the difference
-  // is), and the equilibrium's change is that plus a correction: dx/dt = d_rest + Solve(T),
-  // T = ∂R/∂t along the carried state, which this returns (#V×3, zero on the held vertices; by
-  // central differences at t = ±step of ClothProblem::MaterialGradient on the morphed rest mesh,
-  // contact left out). For a quantity: dQ/dt = g · d_rest + λ · T. Take the step small (1e-8 of
-  // the scene's size): a membrane soft in compression has a kink at zero strain, which a larger
-  // step straddles (docs/methods/sensitivity.md, "Scene radii").
-  Vertices RestShapeResidualChange(const TriangleMesh& rest, const Vertices& d_rest,
-                                   double step) const;
+  // A scene's lengths (a radius, an overhang) as parameters: a morph of the problem's rest
+  // mesh, rest + t·d_rest (#V×3 [m per unit of t]), the held vertices moved along, and the seam
+  // lines as seams_at(t) gives them (the problem's when empty). The state is carried with the
+  // same field, x + t·d_rest (smooth, so the difference is), and the equilibrium's change is
+  // that plus a correction: dx/dt = d_rest + Solve(T), T = ∂R/∂t along the carried state, which
+  // this returns (#V×3, zero on the held vertices; central differences at t = ±step of
+  // ClothProblem::MaterialGradient on the morphed rest, contact left out). For a quantity:
+  // dQ/dt = g · d_rest + λ · T. Take the step small (1e-8 of the scene's size): a membrane soft
+  // in compression has a kink at zero strain, which a larger step straddles
+  // (docs/methods/sensitivity.md, "Scene radii").
+  using SeamsAt = std::function<std::vector<Seam>(double t)>;
+  Vertices RestShapeResidualChange(const Vertices& d_rest, double step,
+                                   const SeamsAt& seams_at = {}) const;
 
  private:
   struct Factor;

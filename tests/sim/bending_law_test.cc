@@ -473,8 +473,8 @@ TEST(SplineLaw, BreakpointsAreTheKnotsAndPabstsKappa0) {
   EXPECT_EQ(fig8.MinStiffness(), fig8.b2());
 }
 
-void ExpectSplineRefused(std::vector<double> kappa, std::vector<double> moment,
-                         const std::string& fragment, std::vector<double> sd = {}) {
+void ExpectSplineRefused(const std::vector<double>& kappa, const std::vector<double>& moment,
+                         const std::string& fragment, const std::vector<double>& sd = {}) {
   try {
     BendingLaw::FromSpline(kappa, moment, sd);
     FAIL() << "accepted; expected: " << fragment;

@@ -157,7 +157,7 @@ TEST(DrapeSensitivity, RadiusMorphsMoveOneRadiusAndKeepTheOther) {
 // from the equilibrium: the same branch; a mesh made anew would jitter by ~0.003 against a change
 // of ~0.002), through the traced outline: within 2 %. Returns the drape.
 DrapeResult ExpectRadiiMatchMorphedDrapes(const Material& m, const DrapeOptions& o) {
-  const DrapeResult r = SimulateDrape(m, o);
+  DrapeResult r = SimulateDrape(m, o);
   EXPECT_TRUE(r.converged) << r.message;
   if (r.scene_sensitivities.size() != 2u) {
     ADD_FAILURE() << "no radii";

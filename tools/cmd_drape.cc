@@ -459,6 +459,7 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
     j["drape_coefficient_sigma"] = NumberOrNull(r.drape_coefficient_sigma);
     j["drape_coefficient_sigma_note"] = r.sigma_note;
     j["sensitivity_seconds"] = r.sensitivity_seconds;
+    j["scene_sensitivity_seconds"] = r.scene_sensitivity_seconds;
     const auto rows = [](const std::vector<ParameterInfluence>& influences) {
       nlohmann::json list = nlohmann::json::array();
       for (const ParameterInfluence& s : influences)
@@ -473,10 +474,13 @@ nlohmann::json ResultJson(const DrapeResult& r, const DrapeOptions& o, const Mat
       return list;
     };
     j["sensitivities"] = rows(r.sensitivities);
-    // The scene's radii (not in the σ), null when the run did not take them.
-    j["scene_sensitivities"] = r.scene_sensitivities.empty()
-                                   ? nlohmann::json()
-                                   : rows(r.scene_sensitivities);
+    // The scene's radii and the seam's coefficients (not in the σ), null when the run did not
+    // take them.
+    const auto rows_or_null = [&rows](const std::vector<ParameterInfluence>& influences) {
+      return influences.empty() ? nlohmann::json() : rows(influences);
+    };
+    j["scene_sensitivities"] = rows_or_null(r.scene_sensitivities);
+    j["seam_sensitivities"] = rows_or_null(r.seam_sensitivities);
   }
   if (r.monte_carlo) {
     j["monte_carlo"] = MonteCarloJson(*r.monte_carlo, 1.0, "-");
@@ -546,13 +550,8 @@ void PrintText(const DrapeResult& r, const DrapeOptions& o, const Material& m, c
   std::cout << "\n";
   if (!r.sensitivities.empty())
     PrintInfluences("DC", "", 1.0, r.drape_coefficient_sigma, r.sigma_note, r.sensitivities);
-  if (!r.scene_sensitivities.empty()) {
-    std::cout << "scene (not in the sigma):\n";
-    for (const ParameterInfluence& s : r.scene_sensitivities)
-      std::cout << "  " << s.parameter << " = " << Num(s.value, 4) << " " << s.unit << ": "
-                << Num(s.d_q_d_ln_p, 3) << "; " << Num(s.change, 2) << " over "
-                << s.uncertainty_source << "\n";
-  }
+  PrintInfluencesBesideSigma("scene", r.scene_sensitivities);
+  PrintInfluencesBesideSigma("seam", r.seam_sensitivities);
   if (r.monte_carlo) PrintMonteCarlo("DC", "", 1.0, *r.monte_carlo);
   if (comparison) PrintComparison(*comparison, a, r.per_seed.size() > 1);
   std::cout << "time: " << Num(r.seconds, 3) << " s\nresult: " << a.out

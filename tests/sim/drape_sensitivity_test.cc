@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -221,11 +222,25 @@ TEST(DrapeSensitivity, SceneRadiiThroughTheRimSplitAndNotWithShiftedSeams) {
   o.sensitivity = true;
   o.rim_element_size = 0.005;
   o.rim_extrapolation = true;
+  o.seams = DrapeSeams::kWeft;
   const DrapeResult split = SimulateDrape(Fig8(), o);
   ASSERT_TRUE(split.converged) << split.message;
+  EXPECT_EQ(split.sensitivity_equilibria, 2);
   ASSERT_EQ(split.scene_sensitivities.size(), 2u);
-  EXPECT_LT(split.scene_sensitivities[0].d_q_d_p, 0.0);
-  EXPECT_GT(split.scene_sensitivities[1].d_q_d_p, 0.0);
+  ASSERT_EQ(split.seam_sensitivities.size(), 4u);
+  // The extrapolation 1.5 D_split − 0.5 D_base stays near the base mesh's own derivatives.
+  o.rim_extrapolation = false;
+  const DrapeResult base = SimulateDrape(Fig8(), o);
+  ASSERT_TRUE(base.converged) << base.message;
+  EXPECT_EQ(base.sensitivity_equilibria, 1);
+  for (size_t k = 0; k < 2; ++k) {
+    const double d = split.scene_sensitivities[k].d_q_d_p;
+    const double b = base.scene_sensitivities[k].d_q_d_p;
+    EXPECT_GT(d * b, 0.0) << k;  // the same sign
+    EXPECT_NEAR(d, b, 0.1 * std::abs(b)) << split.scene_sensitivities[k].parameter;
+  }
+  EXPECT_NEAR(split.seam_sensitivities[3].d_q_d_ln_p, base.seam_sensitivities[3].d_q_d_ln_p,
+              0.1 * std::abs(base.seam_sensitivities[3].d_q_d_ln_p));
   DrapeOptions shifted = Coarse();
   shifted.sensitivity = true;
   shifted.seams = DrapeSeams::kShifted;
@@ -237,6 +252,102 @@ TEST(DrapeSensitivity, SceneRadiiThroughTheRimSplitAndNotWithShiftedSeams) {
   EXPECT_TRUE(HasNote(r.notes, "scene_radii_skipped"));
 }
 
+// dDC/dln p of seam rows `names` against central differences of drapes with the seams'
+// coefficients scaled by e^(±step) (the same mesh, solved from the equilibrium: the same
+// branch), through the traced outline: within 2 %.
+void ExpectSeamRowsMatchDrapes(const Material& m, const DrapeOptions& o, const DrapeResult& r,
+                               const std::vector<std::string>& names, double step) {
+  const auto dc = [&](const std::string& name, double s) {
+    SeamProfile p = o.seam_profile;
+    p.type = "fitted";
+    for (size_t k = 0; k < p.coefficients_mm.size(); ++k)
+      if (name == "seam.scale" || name == std::string("seam.a") + "210"[k])
+        p.coefficients_mm[k] *= std::exp(s);
+    const drape_internal::MorphedSeed seed = drape_internal::SolveMorphedSeed(
+        m, o, drape_internal::SceneRadius::kSpecimen, 0.0, r.per_seed[0].positions, &p);
+    EXPECT_TRUE(seed.summary.converged) << seed.summary.message;
+    const ShadowOutline outline =
+        TraceShadowOutline(seed.positions, seed.mesh.triangles, kBins, o.support_radius);
+    return DrapeCoefficient(outline.area, r.specimen_area, r.support_area);
+  };
+  for (const std::string& name : names) {
+    const auto row = std::find_if(r.seam_sensitivities.begin(), r.seam_sensitivities.end(),
+                                  [&](const ParameterInfluence& s) { return s.parameter == name; });
+    ASSERT_NE(row, r.seam_sensitivities.end()) << name;
+    const double fd = (dc(name, step) - dc(name, -step)) / (2.0 * step);
+    ASSERT_GT(std::abs(fd), 1e-4) << name << " does not move the drape";
+    EXPECT_NEAR(row->d_q_d_ln_p, fd, 0.02 * std::abs(fd)) << name;
+  }
+}
+
+// The seam's coefficients as parameters: a2, a1, a0 and B_f as a whole, against drapes with
+// stepped coefficients; a stiffer seam holds the drape up. Shifted seams take them too (no
+// morph), but not the radii.
+TEST(DrapeSensitivity, SeamCoefficientsMatchDifferencesOfDrapes) {
+  DrapeOptions o = Coarse();
+  o.sensitivity = true;
+  o.seams = DrapeSeams::kWeft;
+  const Material m = Fig8();
+  const DrapeResult r = SimulateDrape(m, o);
+  ASSERT_TRUE(r.converged) << r.message;
+  ASSERT_EQ(r.seam_sensitivities.size(), 4u);
+  EXPECT_EQ(r.seam_sensitivities[0].parameter, "seam.a2");
+  EXPECT_EQ(r.seam_sensitivities[2].unit, "-");
+  EXPECT_DOUBLE_EQ(r.seam_sensitivities[2].value, 9.07);  // C-plain's a0
+  EXPECT_EQ(r.scene_sensitivities.size(), 2u);
+  EXPECT_GT(r.seam_sensitivities[3].d_q_d_ln_p, 0.0);
+  EXPECT_GT(r.scene_sensitivity_seconds, 0.0);
+  EXPECT_LT(r.scene_sensitivity_seconds, r.sensitivity_seconds);
+  ExpectSeamRowsMatchDrapes(m, o, r, {"seam.scale", "seam.a2"}, 0.02);
+
+  o.seams = DrapeSeams::kShifted;
+  o.seam_shift = 0.03;
+  const DrapeResult shifted = SimulateDrape(m, o);
+  ASSERT_TRUE(shifted.converged) << shifted.message;
+  EXPECT_TRUE(shifted.scene_sensitivities.empty());
+  ExpectSeamRowsMatchDrapes(m, o, shifted, {"seam.a0"}, 0.02);
+  EXPECT_THROW(drape_internal::SolveMorphedSeed(m, o, drape_internal::SceneRadius::kSpecimen,
+                                                0.001, shifted.per_seed[0].positions),
+               InputError);  // a morph would bend shifted seams
+  // A list of parameters: no seam rows.
+  o.seams = DrapeSeams::kWeft;
+  o.sensitivity_parameters = {"b1"};
+  EXPECT_TRUE(SimulateDrape(m, o).seam_sensitivities.empty());
+}
+
+// The seam rows' uncertainties: the seam file's covariance where it has one, else ±10 %;
+// B_f as a whole is the coefficients' sum, a_k ∂DC/∂a_k.
+TEST(DrapeSensitivity, SeamRowsTakeTheSeamFilesCovariance) {
+  DrapeOptions o;
+  o.seams = DrapeSeams::kWeft;
+  const std::vector<double> g = {100.0, -2.0, 0.01};  // ∂DC/∂a_k [per 1/mm², 1/mm, 1]
+  drape_internal::DcDerivativeSet seed;
+  seed.seam = g;
+  DrapeResult plain;
+  drape_internal::SummariseSensitivities(Fig8(), {}, {seed}, o, &plain);
+  ASSERT_EQ(plain.seam_sensitivities.size(), 4u);
+  const std::array<double, 3>& a = o.seam_profile.coefficients_mm;
+  double sum = 0.0;
+  for (size_t k = 0; k < 3; ++k) {
+    const ParameterInfluence& row = plain.seam_sensitivities[k];
+    EXPECT_FALSE(row.defaulted);  // a measured seam; its uncertainty is the default
+    EXPECT_NE(row.uncertainty_source.find("default: ±10 %"), std::string::npos);
+    EXPECT_NEAR(row.change, 0.1 * std::abs(a[k] * g[k]), 1e-15);
+    EXPECT_NEAR(row.d_q_d_ln_p, a[k] * g[k], 1e-15);
+    sum += a[k] * g[k];
+  }
+  EXPECT_NEAR(plain.seam_sensitivities[3].d_q_d_ln_p, sum, 1e-15);
+  EXPECT_NEAR(plain.seam_sensitivities[3].change, 0.1 * std::abs(sum), 1e-15);
+  o.seam_profile.covariance = Eigen::Vector3d(1e-10, 4e-6, 0.25).asDiagonal();
+  DrapeResult fitted;
+  drape_internal::SummariseSensitivities(Fig8(), {}, {seed}, o, &fitted);
+  ASSERT_EQ(fitted.seam_sensitivities.size(), 4u);
+  EXPECT_NEAR(fitted.seam_sensitivities[1].change, 2.0 * 2e-3, 1e-15);
+  EXPECT_NEAR(fitted.seam_sensitivities[2].change, 0.01 * 0.5, 1e-15);
+  EXPECT_NE(fitted.seam_sensitivities[0].uncertainty_source.find("covariance"), std::string::npos);
+  EXPECT_TRUE(fitted.scene_sensitivities.empty());
+}
+
 // σ² = gᵀ C g over b1, b2, c1; the table's changes over each parameter's uncertainty.
 TEST(DrapeSensitivity, SigmaPropagatesTheFitCovarianceAndDefaultsAreNamed) {
   Material m = Fig8();
@@ -246,8 +357,9 @@ TEST(DrapeSensitivity, SigmaPropagatesTheFitCovarianceAndDefaultsAreNamed) {
   const std::vector<std::string> names = {"b1", "b2", "c1", "stretch.stiffness_N_per_m"};
   const std::vector<double> g = {1000.0, -500.0, 2e4, 1e-5};  // ∂DC/∂p [per SI unit]
   m.defaulted = {"stretch.stiffness_N_per_m"};
-  drape_internal::SummariseSensitivities(m, names, {drape_internal::DcDerivativeSet{g, {}}},
-                                         DrapeOptions{}, &r);
+  drape_internal::DcDerivativeSet seed;
+  seed.material = g;
+  drape_internal::SummariseSensitivities(m, names, {seed}, DrapeOptions{}, &r);
   EXPECT_TRUE(r.scene_sensitivities.empty());  // no radii in the seeds' derivatives
   const Eigen::Matrix3d c = *MaterialFitCovariance(m);
   const Eigen::Vector3d v(g[0], g[1], g[2]);

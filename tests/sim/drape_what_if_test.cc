@@ -212,6 +212,10 @@ TEST(WhatIfCache, APredictionFollowsTheSolvedDrape) {
   const Material m = Fig8();
   const DrapeResult base = SimulateDrapeCached(m, Coarse(), dir.string());
   ASSERT_TRUE(base.converged) << base.message;
+  // The cache needs the material's derivatives only: without sensitivity asked for, no radii.
+  EXPECT_EQ(base.sensitivities.size(), MaterialParameterNames(m).size());
+  EXPECT_TRUE(base.scene_sensitivities.empty());
+  EXPECT_EQ(base.scene_sensitivity_seconds, 0.0);
   const DrapeWhatIfPrediction p =
       PredictDrapeWhatIf(m, "b1=0.101,areal_density_gsm=199", Coarse(), dir.string(), {});
   ASSERT_TRUE(p.what_if.predicted) << p.what_if.reason;

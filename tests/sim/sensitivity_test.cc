@@ -7,6 +7,7 @@
 
 #include "textile/sim/core/error.h"
 #include "textile/sim/law/material_parameters.h"
+#include "textile/sim/law/seam.h"
 #include "textile/sim/mesh/mesh.h"
 #include "textile/sim/solve/static_solver.h"
 
@@ -31,8 +32,9 @@ struct HangingStrip {
     for (int v = 0; v < mesh.num_vertices(); ++v)
       if (mesh.vertices(v, 0) < 0.08 / 12 + 1e-12) held.push_back(v);
   }
-  std::unique_ptr<ClothProblem> Problem(const Material& m) const {
-    auto p = std::make_unique<ClothProblem>(mesh, m, std::vector<Seam>{}, ClothOptions{});
+  std::unique_ptr<ClothProblem> Problem(const Material& m,
+                                        const std::vector<Seam>& seams = {}) const {
+    auto p = std::make_unique<ClothProblem>(mesh, m, seams, ClothOptions{});
     Vertices fixed(static_cast<long>(held.size()), 3);
     for (size_t k = 0; k < held.size(); ++k) fixed.row(static_cast<long>(k)) = mesh.vertices.row(held[k]);
     p->FixVertices(held, fixed);
@@ -142,6 +144,23 @@ TEST_F(StripSensitivity, RestShapeMorphsMatchTranslationsAndFullSolves) {
   EXPECT_THROW(sensitivity.RestShapeResidualChange(longer, 0.0), InputError);
   const TriangleMesh other = CrissCrossGridMesh(0.08, 0.04, 6, 3);  // another mesh
   EXPECT_THROW(problem->MaterialGradient(x, m, ClothProblem::kAllParts, &other), InputError);
+}
+
+// Other seams in MaterialGradient (a seam sensitivity's stepped profile) give the gradient of a
+// problem built with them: their bands' multipliers and their masses; as many as the problem's.
+TEST_F(StripSensitivity, MaterialGradientWithOtherSeamsIsTheirProblems) {
+  SeamLine line(2, 2);
+  line << 0.04, 0.0, 0.04, 0.04;  // across the strip, in the overhang
+  const auto problem_a = strip.Problem(m, {Seam{SeamPreset("A-plain"), line}});
+  const std::vector<Seam> c{Seam{SeamPreset("C-plain"), line}};
+  Vertices expected;
+  strip.Problem(m, c)->EnergyGradient(x, &expected);
+  const Vertices got = problem_a->MaterialGradient(x, m, ClothProblem::kAllParts, nullptr, &c);
+  EXPECT_LT((got - expected).norm(), 1e-12 * expected.norm());
+  EXPECT_GT((got - problem_a->MaterialGradient(x, m)).norm(), 1e-3 * expected.norm());
+  const std::vector<Seam> two{c[0], c[0]};
+  EXPECT_THROW(problem_a->MaterialGradient(x, m, ClothProblem::kAllParts, nullptr, &two),
+               InputError);
 }
 
 TEST(EquilibriumSensitivity, RefusesAStateThatIsNoEquilibriumAndUnknownParameters) {

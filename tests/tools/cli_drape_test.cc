@@ -86,7 +86,8 @@ TEST(CliDrape, SeamFromPresetOrFileRaisesDc) {
   const auto plain = Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "plain.json").string() + " --json");
   const auto preset = Textile("drape " + kFig8 + kCoarse + " --seams weft --seam-type C-plain -o " +
                               (dir / "preset.json").string() + " --json");
-  const auto file = Textile("drape " + kFig8 + kCoarse + " --seams weft --seam-file samples/seams/C-plain.json -o " +
+  const auto file = Textile("drape " + kFig8 + kCoarse +
+                            " --seams weft --seam-file samples/seams/C-plain.json --sensitivity -o " +
                             (dir / "file.json").string() + " --json");
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
   ASSERT_EQ(preset.exit_code, 0) << preset.err;
@@ -98,6 +99,15 @@ TEST(CliDrape, SeamFromPresetOrFileRaisesDc) {
   EXPECT_NEAR(f["drape_coefficient"].get<double>(), s["drape_coefficient"].get<double>(), 1e-9);
   EXPECT_EQ(s["scene"]["seams"], "weft");
   EXPECT_EQ(s["scene"]["seam_profile"]["type"], "C-plain");
+  // --sensitivity with seams: the seam's coefficients as the file has them, then B_f as a
+  // whole; a stiffer seam holds the drape up.
+  const auto& seam = f["seam_sensitivities"];
+  ASSERT_EQ(seam.size(), 4u) << f.dump();
+  EXPECT_EQ(seam[2]["parameter"], "seam.a0");
+  EXPECT_DOUBLE_EQ(seam[2]["value"].get<double>(), 9.07);
+  EXPECT_EQ(seam[3]["parameter"], "seam.scale");
+  EXPECT_GT(seam[3]["d_dc_d_ln_p"].get<double>(), 0.0);
+  EXPECT_FALSE(s.contains("seam_sensitivities"));
 }
 
 // A PLY's header properties of its vertex element and its vertex rows (ASCII, as PlyText writes).
@@ -540,6 +550,7 @@ TEST(CliDrape, SensitivityReportsTheInfluenceTableAndSigma) {
   EXPECT_LT(scene[0]["d_dc_d_ln_p"].get<double>(), 0.0);
   EXPECT_EQ(scene[1]["parameter"], "support_radius");
   EXPECT_NE(r.out.find("scene (not in the sigma):"), std::string::npos) << r.out;
+  EXPECT_TRUE(j["seam_sensitivities"].is_null());  // no seams
   // Without the flag the result has none of it.
   const auto plain = Textile("drape " + kFig8 + kCoarse + " -o " + (dir / "p.json").string());
   ASSERT_EQ(plain.exit_code, 0) << plain.err;

@@ -171,6 +171,19 @@ void PrintMonteCarlo(const std::string& quantity, const std::string& unit, doubl
             << Num(s.seconds, 3) << " s (" << s.note << ")\n";
 }
 
+namespace {
+
+// "  name = value unit (default): dQ/dln p; change over source", Q's values times `scale` with
+// their unit `in` (" mm" or empty).
+void PrintInfluenceRow(const ParameterInfluence& s, double scale, const std::string& in) {
+  std::cout << "  " << s.parameter << " = " << Num(s.value, 4)
+            << (s.unit == "-" ? std::string() : " " + s.unit)
+            << (s.defaulted ? " (default)" : "") << ": " << Num(scale * s.d_q_d_ln_p, 3) << in
+            << "; " << Num(scale * s.change, 2) << in << " over " << s.uncertainty_source << "\n";
+}
+
+}  // namespace
+
 void PrintInfluences(const std::string& quantity, const std::string& unit, double scale,
                      double sigma, const std::string& sigma_note,
                      const std::vector<ParameterInfluence>& rows) {
@@ -180,11 +193,14 @@ void PrintInfluences(const std::string& quantity, const std::string& unit, doubl
             << sigma_note << ")\n"
             << "influence (d" << quantity << "/dln p" << in
             << "; change over the uncertainty):\n";
-  for (const ParameterInfluence& s : rows)
-    std::cout << "  " << s.parameter << " = " << Num(s.value, 4)
-              << (s.unit == "-" ? std::string() : " " + s.unit)
-              << (s.defaulted ? " (default)" : "") << ": " << Num(scale * s.d_q_d_ln_p, 3) << in
-              << "; " << Num(scale * s.change, 2) << in << " over " << s.uncertainty_source << "\n";
+  for (const ParameterInfluence& s : rows) PrintInfluenceRow(s, scale, in);
+}
+
+void PrintInfluencesBesideSigma(const std::string& title,
+                                const std::vector<ParameterInfluence>& rows) {
+  if (rows.empty()) return;
+  std::cout << title << " (not in the sigma):\n";
+  for (const ParameterInfluence& s : rows) PrintInfluenceRow(s, 1.0, "");
 }
 
 }  // namespace textile::cli

@@ -582,6 +582,16 @@ std::vector<SeamLine> DrapeSeamLines(const DrapeOptions& o) {
   return {};
 }
 
+namespace drape_internal {
+
+std::vector<Seam> DrapeSeamList(const DrapeOptions& o) {
+  std::vector<Seam> seams;
+  for (const SeamLine& line : DrapeSeamLines(o)) seams.push_back(Seam{o.seam_profile, line});
+  return seams;
+}
+
+}  // namespace drape_internal
+
 double RimTurnDownLength(const Material& material, const DrapeOptions& o) {
   const double overhang = o.specimen_radius - o.support_radius;
   if (!(material.areal_density > 0.0) || !Finite(material.areal_density))
@@ -646,8 +656,7 @@ struct DrapeScene {
 DrapeScene BuildScene(const DrapeOptions& o, DrapeResult* result) {
   DrapeScene scene;
   result->seam_lines = DrapeSeamLines(o);
-  for (const SeamLine& line : result->seam_lines)
-    scene.seams.push_back(Seam{o.seam_profile, line});
+  scene.seams = drape_internal::DrapeSeamList(o);
   scene.fine = MeshPattern(o, scene.seams, 1.0);
   if (o.coarse_to_fine) {
     scene.coarse = std::make_unique<Pattern>(MeshPattern(o, scene.seams, o.coarse_factor));
@@ -768,13 +777,15 @@ void SettleSplit(const Material& material, const DrapeOptions& o, const DrapeSce
 
 // Stage 5 (sensitivity): ∂DC/∂p of a converged seed, through each equilibrium it was measured
 // on; with a split rim the extrapolation's DC_split + (DC_split - DC_base)/2. The scene's radii
-// too when the run takes them (TakesSceneRadii), through a morph of the rest mesh.
-void SeedSensitivities(const Material& material, const DrapeOptions& o, bool radii,
+// and the seam's coefficients too when the run takes them (TakesSceneParameters): the radii
+// through a morph of the rest mesh, the coefficients through the seams' own change.
+void SeedSensitivities(const Material& material, const DrapeOptions& o, bool scene_parameters,
                        const DrapeScene& scene, const DrapeResult& result,
                        const std::vector<std::string>& parameters, SeedState* st) {
   if (!o.sensitivity || !st->seed.converged) return;
   const auto derivatives = [&](ClothProblem* problem, const Vertices& x) {
-    return drape_internal::DcDerivatives(problem, x, material, o, result, parameters, radii);
+    return drape_internal::DcDerivatives(problem, x, material, o, result, parameters,
+                                         scene_parameters);
   };
   if (!scene.split) {
     st->d_dc = derivatives(st->fine_problem.get(), st->seed.positions);
@@ -788,6 +799,8 @@ void SeedSensitivities(const Material& material, const DrapeOptions& o, bool rad
   };
   extrapolate(&st->d_dc.material, base.material);
   extrapolate(&st->d_dc.radii, base.radii);
+  extrapolate(&st->d_dc.seam, base.seam);
+  st->d_dc.scene_seconds += base.scene_seconds;
 }
 
 // How deep the deepest node lies inside the resting mount's disk [m].
@@ -925,9 +938,12 @@ void SummariseSeeds(DrapeResult* result) {
 }
 
 MorphedSeed SolveMorphedSeed(const Material& material, const DrapeOptions& options,
-                             SceneRadius which, double t, const Vertices& start) {
+                             SceneRadius which, double t, const Vertices& start,
+                             const SeamProfile* seam_profile) {
   if (options.rim_extrapolation || options.coarse_to_fine || options.mount != DrapeMount::kClamped)
     throw InputError("morphed seed: one clamped equilibrium only (no rim split, no cascade)");
+  if (options.seams == DrapeSeams::kShifted && t != 0.0)
+    throw InputError("morphed seed: no shifted seams (the radial morph would bend them)");
   DrapeResult nominal;
   DrapeScene scene = BuildScene(options, &nominal);
   const Vertices morph = RadiusMorph(scene.fine.pm.mesh, which, options);
@@ -935,8 +951,8 @@ MorphedSeed SolveMorphedSeed(const Material& material, const DrapeOptions& optio
   scene.fine.pm.mesh.vertices += t * morph;
   DrapeOptions o = options;
   (which == SceneRadius::kSpecimen ? o.specimen_radius : o.support_radius) += t;
-  scene.seams.clear();  // diameters: moved with the rim (the support's morph keeps it)
-  for (const SeamLine& line : DrapeSeamLines(o)) scene.seams.push_back(Seam{o.seam_profile, line});
+  if (seam_profile) o.seam_profile = *seam_profile;  // on the mesh refined for options'
+  scene.seams = DrapeSeamList(o);  // diameters: moved with the rim (the support's morph keeps it)
   MorphedSeed m;
   m.mesh = scene.fine.pm.mesh;
   m.support_radius = o.support_radius;
@@ -953,7 +969,8 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& options)
   if (std::string why; !options.Check(&why)) throw InputError("drape options: " + why);
   DrapeOptions o = options;
   if (o.monte_carlo_samples > 0) o.sensitivity = true;  // the linear σ beside the sampled one
-  const bool radii = drape_internal::TakesSceneRadii(options);  // asked for, not implied
+  // The radii and the seam's coefficients: asked for, not implied by Monte Carlo.
+  const bool scene_parameters = drape_internal::TakesSceneParameters(options);
   DrapeResult result;
   result.rim_turn_down = RimTurnDownLength(material, o);
   // Sensitivities and Monte Carlo draws: the names and the covariance checked before any work
@@ -973,10 +990,11 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& options)
     SettleSplit(material, o, scene, result, &st);
     MeasureSeed(o, scene, result, &st.seed);
     const auto sensitivity_start = std::chrono::steady_clock::now();
-    SeedSensitivities(material, o, radii, scene, result, parameters, &st);
-    if (!st.d_dc.material.empty() || !st.d_dc.radii.empty()) {
+    SeedSensitivities(material, o, scene_parameters, scene, result, parameters, &st);
+    if (!st.d_dc.material.empty() || !st.d_dc.radii.empty() || !st.d_dc.seam.empty()) {
       result.sensitivity_seconds +=
           std::chrono::duration<double>(std::chrono::steady_clock::now() - sensitivity_start).count();
+      result.scene_sensitivity_seconds += st.d_dc.scene_seconds;
       result.sensitivity_equilibria += scene.split ? 2 : 1;
       seed_derivatives.push_back(std::move(st.d_dc));
     }

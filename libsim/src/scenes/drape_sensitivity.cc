@@ -1,7 +1,10 @@
 #include "textile/sim/scenes/drape_sensitivity.h"
 
 #include <algorithm>
+#include <array>
+#include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <utility>
 
@@ -128,8 +131,16 @@ std::vector<std::string> SensitivityParameters(const Material& material, const D
   return names;
 }
 
+bool TakesSceneParameters(const DrapeOptions& o) {
+  return o.sensitivity && o.sensitivity_parameters.empty();
+}
+
 bool TakesSceneRadii(const DrapeOptions& o) {
-  return o.sensitivity && o.sensitivity_parameters.empty() && o.seams != DrapeSeams::kShifted;
+  return TakesSceneParameters(o) && o.seams != DrapeSeams::kShifted;
+}
+
+bool TakesSeamCoefficients(const DrapeOptions& o) {
+  return TakesSceneParameters(o) && o.seams != DrapeSeams::kNone;
 }
 
 Vertices RadiusMorph(const TriangleMesh& rest, SceneRadius which, const DrapeOptions& o) {
@@ -166,9 +177,7 @@ EquilibriumSensitivity::SeamsAt MorphedSeams(SceneRadius which, const DrapeOptio
   return [which, o](double t) {
     DrapeOptions moved = o;
     if (which == SceneRadius::kSpecimen) moved.specimen_radius += t;
-    std::vector<Seam> seams;
-    for (const SeamLine& line : DrapeSeamLines(moved)) seams.push_back(Seam{o.seam_profile, line});
-    return seams;
+    return DrapeSeamList(moved);
   };
 }
 
@@ -196,8 +205,91 @@ double RadiusDcDerivative(const EquilibriumSensitivity& sensitivity, const Verti
   down.vertices -= h * morph;
   const double d_specimen = (TriangleAreas(up).sum() - TriangleAreas(down).sum()) / (2.0 * h);
   const double span = result.specimen_area - result.support_area;
-  const double dc = (outline.area - result.support_area) / span;
+  const double dc = DrapeCoefficient(outline.area, result.specimen_area, result.support_area);
   return ((d_shadow - d_support) - dc * (d_specimen - d_support)) / span;
+}
+
+// The seam coefficient k's (0: a2, 1: a1, 2: a0) central-difference step [1/mm^(2-k)]: a
+// change of B_f by 1e-6 of B_f(0) at the influence distance d_max, where the term is largest.
+// B_f is linear in its coefficients, and S follows it but for its kink at 1 (SeamProfile).
+double SeamCoefficientStep(const SeamProfile& profile, int k) {
+  return 1e-6 * std::max(1.0, std::abs(profile.StiffnessFactor(0.0))) /
+         std::pow(profile.influence_mm, 2 - k);
+}
+
+// The drape's seams with coefficient k of their profile moved by t (a "fitted" profile then: a
+// preset's coefficients are Table 2's).
+EquilibriumSensitivity::SeamsAt SteppedSeams(int k, const DrapeOptions& o) {
+  return [k, o](double t) {
+    DrapeOptions stepped = o;
+    stepped.seam_profile.type = "fitted";
+    stepped.seam_profile.coefficients_mm[static_cast<size_t>(k)] += t;
+    return DrapeSeamList(stepped);
+  };
+}
+
+// ∂DC/∂a_k: the seams' change of the bending forces (the only ones a profile moves: the
+// membrane and the seams' masses do not see it) at the fixed rest and state, through the
+// adjoint. The areas do not move.
+double SeamCoefficientDcDerivative(const EquilibriumSensitivity& sensitivity,
+                                   const Vertices& adjoint, int k, const DrapeOptions& o,
+                                   const DrapeResult& result) {
+  const Vertices still = Vertices::Zero(adjoint.rows(), 3);
+  const Vertices force =
+      sensitivity.RestShapeResidualChange(still, SeamCoefficientStep(o.seam_profile, k),
+                                          SteppedSeams(k, o), ClothProblem::kBendingPart);
+  return (adjoint.array() * force.array()).sum() / (result.specimen_area - result.support_area);
+}
+
+// The seam's uncertainty when its file carries no covariance (Table 2 gives none) [relative].
+constexpr double kSeamDefaultUncertainty = 0.1;
+
+// The seam rows: a2, a1, a0 as the seam file has them (mm units), then B_f scaled as a whole.
+std::vector<ParameterInfluence> SeamInfluences(const SeamProfile& profile,
+                                               const std::vector<double>& d_dc_d_a) {
+  static const std::array<const char*, kSeamCoefficients> kNames{"seam.a2", "seam.a1", "seam.a0"};
+  static const std::array<const char*, kSeamCoefficients> kUnits{"1/mm²", "1/mm", "-"};
+  std::vector<ParameterInfluence> rows;
+  double d_scale = 0.0;
+  for (int k = 0; k < kSeamCoefficients; ++k) {
+    const size_t i = static_cast<size_t>(k);
+    const double a = profile.coefficients_mm[i];
+    const bool fitted = profile.covariance.has_value();
+    const double sd = fitted ? std::sqrt(std::max(0.0, (*profile.covariance)(k, k)))
+                             : kSeamDefaultUncertainty * std::abs(a);
+    ParameterInfluence row;  // a measured seam (Table 2's, or the file's): not defaulted
+    row.parameter = kNames[i];
+    row.value = a;
+    row.unit = kUnits[i];
+    row.d_q_d_p = d_dc_d_a[i];
+    row.d_q_d_ln_p = a * d_dc_d_a[i];
+    row.uncertainty_ln = a != 0.0 ? sd / std::abs(a) : std::numeric_limits<double>::quiet_NaN();
+    row.uncertainty_source = fitted ? "the seam file's fit covariance"
+                                    : "default: ±10 % (the seam file carries no covariance)";
+    row.change = std::abs(d_dc_d_a[i]) * sd;
+    rows.push_back(std::move(row));
+    d_scale += a * d_dc_d_a[i];
+  }
+  ParameterInfluence scale;
+  scale.parameter = "seam.scale";
+  scale.value = 1.0;
+  scale.unit = "-";
+  scale.d_q_d_p = scale.d_q_d_ln_p = d_scale;
+  scale.uncertainty_ln = kSeamDefaultUncertainty;
+  scale.uncertainty_source = "default: B_f ±10 % as a whole";
+  scale.change = std::abs(d_scale) * kSeamDefaultUncertainty;
+  rows.push_back(std::move(scale));
+  return rows;
+}
+
+// The mean over the seeds of one of their derivative lists (each as long as the first seed's).
+std::vector<double> SeedMean(const std::vector<DcDerivativeSet>& seeds,
+                             std::vector<double> DcDerivativeSet::*list) {
+  std::vector<double> mean((seeds.front().*list).size(), 0.0);
+  for (const DcDerivativeSet& d : seeds)
+    for (size_t k = 0; k < mean.size(); ++k)
+      mean[k] += (d.*list)[k] / static_cast<double>(seeds.size());
+  return mean;
 }
 
 ParameterInfluence RadiusInfluence(SceneRadius which, const DrapeOptions& o, double d_dc_d_r) {
@@ -222,7 +314,7 @@ ParameterInfluence RadiusInfluence(SceneRadius which, const DrapeOptions& o, dou
 DcDerivativeSet DcDerivatives(ClothProblem* problem, const Vertices& x,
                               const Material& material, const DrapeOptions& o,
                               const DrapeResult& result, const std::vector<std::string>& parameters,
-                              bool radii) {
+                              bool scene) {
   // The solve stops at o.solver.tolerance; a state 100 times further off is no equilibrium.
   const EquilibriumSensitivity sensitivity(problem, x, material,
                                            std::max(100.0 * o.solver.tolerance, 1e-6));
@@ -236,10 +328,17 @@ DcDerivativeSet DcDerivatives(ClothProblem* problem, const Vertices& x,
   DcDerivativeSet d;
   for (const std::string& p : parameters)
     d.material.push_back(sensitivity.QuantityDerivativePerUnit(adjoint, p) / scale);
-  if (radii)
+  if (!scene) return d;
+  const auto start = std::chrono::steady_clock::now();
+  if (o.seams != DrapeSeams::kShifted)
     for (SceneRadius which : {SceneRadius::kSpecimen, SceneRadius::kSupport})
       d.radii.push_back(RadiusDcDerivative(sensitivity, adjoint, area_gradient, outline, rest,
                                            which, o, result));
+  if (o.seams != DrapeSeams::kNone)
+    for (int k = 0; k < kSeamCoefficients; ++k)
+      d.seam.push_back(SeamCoefficientDcDerivative(sensitivity, adjoint, k, o, result));
+  d.scene_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return d;
 }
 
@@ -247,21 +346,18 @@ void SummariseSensitivities(const Material& material, const std::vector<std::str
                             const std::vector<DcDerivativeSet>& seed_derivatives,
                             const DrapeOptions& o, DrapeResult* result) {
   if (seed_derivatives.empty()) return;
-  const double seeds = static_cast<double>(seed_derivatives.size());
-  std::vector<double> mean(parameters.size(), 0.0);
-  for (const DcDerivativeSet& d : seed_derivatives)
-    for (size_t k = 0; k < mean.size(); ++k) mean[k] += d.material[k] / seeds;
-  InfluenceTable table = MakeInfluenceTable(material, parameters, mean);
+  InfluenceTable table =
+      MakeInfluenceTable(material, parameters, SeedMean(seed_derivatives, &DcDerivativeSet::material));
   result->sensitivities = std::move(table.rows);
   result->drape_coefficient_sigma = table.sigma;
   result->sigma_note = std::move(table.sigma_note);
-  if (seed_derivatives.front().radii.size() != kSceneRadii) return;
-  for (int k = 0; k < kSceneRadii; ++k) {
-    double sum = 0.0;
-    for (const DcDerivativeSet& d : seed_derivatives)
-      sum += d.radii[static_cast<size_t>(k)] / seeds;
-    result->scene_sensitivities.push_back(RadiusInfluence(static_cast<SceneRadius>(k), o, sum));
-  }
+  const std::vector<double> radii = SeedMean(seed_derivatives, &DcDerivativeSet::radii);
+  if (radii.size() == kSceneRadii)
+    for (int k = 0; k < kSceneRadii; ++k)
+      result->scene_sensitivities.push_back(
+          RadiusInfluence(static_cast<SceneRadius>(k), o, radii[static_cast<size_t>(k)]));
+  const std::vector<double> seam = SeedMean(seed_derivatives, &DcDerivativeSet::seam);
+  if (seam.size() == kSeamCoefficients) result->seam_sensitivities = SeamInfluences(o.seam_profile, seam);
 }
 
 }  // namespace drape_internal

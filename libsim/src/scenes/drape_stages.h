@@ -57,12 +57,23 @@ void FillEmptyBins(Eigen::VectorXd* radii);
 // material's fit covariance checked: InputError before any work.
 std::vector<std::string> SensitivityParameters(const Material& material,
                                                const DrapeOptions& options);
+// The seams of `options`' scene: DrapeSeamLines, each with options.seam_profile.
+std::vector<Seam> DrapeSeamList(const DrapeOptions& options);
+
+// Whether the run takes the scene's own inputs (the radii, the seam's coefficients) as
+// parameters too: sensitivity asked for (not implied by Monte Carlo) for every parameter (no
+// list).
+bool TakesSceneParameters(const DrapeOptions& options);
 // The scene's radii as parameters (docs/methods/sensitivity.md, "Scene radii"), in this order.
 enum class SceneRadius { kSpecimen, kSupport };
 constexpr int kSceneRadii = 2;
-// Whether the run takes them: sensitivity asked for (not implied by Monte Carlo), every
-// parameter (no list), seams none or through the centre (a radial morph would bend shifted ones).
+// Whether the run takes them: TakesSceneParameters, seams none or through the centre (a radial
+// morph would bend shifted ones).
 bool TakesSceneRadii(const DrapeOptions& options);
+// The seam profile's coefficients a2, a1, a0 as parameters (docs/methods/sensitivity.md, "Seam
+// coefficients"): TakesSceneParameters, with seams.
+constexpr int kSeamCoefficients = 3;
+bool TakesSeamCoefficients(const DrapeOptions& options);
 // The rest disk's radial morph that moves one radius by a metre and keeps the other (#V×3
 // [m/m], z 0): u(r) r̂ with, R_s the support's radius and R the specimen's,
 //   specimen: u = 0 within R_s, (r − R_s)/(R − R_s) beyond;
@@ -70,9 +81,11 @@ bool TakesSceneRadii(const DrapeOptions& options);
 // Diameters stay straight; the clamp's vertices move with the support's radius only.
 Vertices RadiusMorph(const TriangleMesh& rest, SceneRadius which, const DrapeOptions& options);
 
-// For tests of the radii's derivatives: the equilibrium of `options`' scene (its first seed's
-// problem; one clamped equilibrium: InputError otherwise) with the fine mesh morphed by
-// t·RadiusMorph [m] instead of meshed anew, solved from `start` (an equilibrium of the nominal
+// For tests of the radii's and the seam coefficients' derivatives: the equilibrium of
+// `options`' scene (its first seed's problem; one clamped equilibrium: InputError otherwise)
+// with the fine mesh morphed by t·RadiusMorph [m] instead of meshed anew (shifted seams, which
+// the morph would bend: t = 0 only), and with the seams of `seam_profile` when given (on the
+// mesh refined for options.seam_profile), solved from `start` (an equilibrium of the nominal
 // mesh) carried along: the same branch. The morphed mesh and the moved support's radius too.
 struct MorphedSeed {
   TriangleMesh mesh;
@@ -81,23 +94,28 @@ struct MorphedSeed {
   SolveSummary summary;
 };
 MorphedSeed SolveMorphedSeed(const Material& material, const DrapeOptions& options,
-                             SceneRadius which, double t, const Vertices& start);
+                             SceneRadius which, double t, const Vertices& start,
+                             const SeamProfile* seam_profile = nullptr);
 
-// ∂DC/∂p of one equilibrium x of `problem`: `material` for each parameter [per SI unit], and
-// with `radii` for each SceneRadius [per m] (else empty). Through the traced
-// outline's area and its adjoint (EquilibriumSensitivity), with the specimen's and the support's
-// areas' own changes in DC = (A_shadow − A_support) / (A_specimen − A_support).
+// ∂DC/∂p of one equilibrium x of `problem`: `material` for each parameter [per SI unit]; with
+// `scene`, for each SceneRadius [per m] unless the seams are shifted, and for each seam
+// coefficient a2, a1, a0 [per 1/mm², 1/mm, 1] when there are seams (else empty). Through the
+// traced outline's area and its adjoint (EquilibriumSensitivity), with the specimen's and the
+// support's areas' own changes in DC = (A_shadow − A_support) / (A_specimen − A_support).
+// scene_seconds: the wall time of the radii and the coefficients [s].
 struct DcDerivativeSet {
   std::vector<double> material;
   std::vector<double> radii;
+  std::vector<double> seam;
+  double scene_seconds = 0.0;
 };
 DcDerivativeSet DcDerivatives(ClothProblem* problem, const Vertices& x,
                               const Material& material, const DrapeOptions& options,
                               const DrapeResult& result, const std::vector<std::string>& parameters,
-                              bool radii);
+                              bool scene);
 // result->sensitivities (means over the seeds' derivatives, with each parameter's uncertainty,
 // largest dc_change first), drape_coefficient_sigma and sigma_note; result->scene_sensitivities
-// when the seeds carry radii.
+// when the seeds carry radii, result->seam_sensitivities when they carry seam coefficients.
 void SummariseSensitivities(const Material& material, const std::vector<std::string>& parameters,
                             const std::vector<DcDerivativeSet>& seed_derivatives,
                             const DrapeOptions& options, DrapeResult* result);

@@ -550,6 +550,9 @@ DrapeResult SimulateDrapeCached(const Material& material, const DrapeOptions& op
   std::vector<std::string> skipped;
   ReadDrapeCache(cache_dir, options, &skipped);  // a folder that is none: before the solve
   DrapeOptions o = options;
+  // The cache keeps the material's derivatives: without --sensitivity, named so that the run
+  // spends nothing on the scene's (TakesSceneParameters).
+  if (!o.sensitivity) o.sensitivity_parameters = MaterialParameterNames(material);
   o.sensitivity = true;
   DrapeResult r = SimulateDrape(material, o);
   if (!skipped.empty()) r.notes.push_back(SkippedNote(skipped));

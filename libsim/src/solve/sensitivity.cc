@@ -102,7 +102,8 @@ double EquilibriumSensitivity::QuantityDerivativePerUnit(const Vertices& adjoint
 }
 
 Vertices EquilibriumSensitivity::RestShapeResidualChange(const Vertices& d_rest, double step,
-                                                         const SeamsAt& seams_at) const {
+                                                         const SeamsAt& seams_at,
+                                                         int parts) const {
   if (d_rest.rows() != x_.rows() || d_rest.cols() != 3 || !d_rest.allFinite())
     throw InputError("sensitivity: the rest morph must be finite, one row a vertex");
   if (!(step > 0.0) || !std::isfinite(step))
@@ -112,8 +113,8 @@ Vertices EquilibriumSensitivity::RestShapeResidualChange(const Vertices& d_rest,
     morphed.vertices += t * d_rest;
     std::vector<Seam> seams;
     if (seams_at) seams = seams_at(t);
-    return problem_->MaterialGradient(x_ + t * d_rest, material_, ClothProblem::kAllParts,
-                                      &morphed, seams_at ? &seams : nullptr);
+    return problem_->MaterialGradient(x_ + t * d_rest, material_, parts, &morphed,
+                                      seams_at ? &seams : nullptr);
   };
   Vertices d = (force_at(step) - force_at(-step)) / (2.0 * step);
   if (!d.allFinite())

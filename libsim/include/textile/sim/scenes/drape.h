@@ -302,12 +302,22 @@ struct DrapeResult {
   // docs/methods/sensitivity.md, "Scene radii"). Not in the σ. Empty with shifted seams (a note
   // says why).
   std::vector<ParameterInfluence> scene_sensitivities;
+  // With options.sensitivity (not only implied), no sensitivity_parameters and seams (and
+  // converged): the DC's derivatives in the seam profile's coefficients of B_f(d) =
+  // a2 d² + a1 d + a0 (d in mm), "seam.a2", "seam.a1", "seam.a0" (value and unit as the seam
+  // file has them, 1/mm², 1/mm, -), then "seam.scale", B_f scaled as a whole (value 1), with
+  // the seam file's covariance or a default ±10 % (docs/methods/sensitivity.md, "Seam
+  // coefficients"). Not in the σ.
+  std::vector<ParameterInfluence> seam_sensitivities;
   double drape_coefficient_sigma = std::numeric_limits<double>::quiet_NaN();
   std::string sigma_note;
   // Wall time of the sensitivities, all seeds and equilibria: factorisations, the parameters'
   // differences and back-substitutions, the outlines [s].
   double sensitivity_seconds = 0.0;
   int sensitivity_equilibria = 0;  // equilibria differentiated (two a seed with a split rim)
+  // The part of sensitivity_seconds spent on the scene's radii and the seam's coefficients
+  // (their rest and seam changes, one force difference each) [s].
+  double scene_sensitivity_seconds = 0.0;
   // With options.monte_carlo_samples (and converged): the DC's spread over the samples (each
   // the mean over the seeds), beside the linear σ; monte_carlo_node_changes samples whose node
   // count differed from the nominal drape's for some seed (another branch).

@@ -89,8 +89,9 @@ class ClothProblem {
   // two such gradients over a parameter step is ∂R/∂p, with the contact state frozen.
   // `parts` limits it to those (MaterialPart bits; a part the change does not touch adds nothing
   // to a difference). With `rest`, on that rest mesh in place of the problem's (the same
-  // vertices and triangles), and with `seams`, those seam lines (the same profiles, moved with
-  // the rest) in place of the problem's: a rest-shape sensitivity's difference. Throws
+  // vertices and triangles), and with `seams`, those seams (as many: lines moved with the rest,
+  // or profiles stepped) in place of the problem's: a rest-shape or seam sensitivity's
+  // difference (the seams' masses come from them too). Throws
   // InputError as the constructor does for `other`, `rest` or `seams`.
   enum MaterialPart { kMembranePart = 1, kBendingPart = 2, kGravityPart = 4, kAllParts = 7 };
   Vertices MaterialGradient(const Vertices& x, const Material& other, int parts = kAllParts,

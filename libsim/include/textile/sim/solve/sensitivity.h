@@ -67,10 +67,13 @@ class EquilibriumSensitivity {
   // ClothProblem::MaterialGradient on the morphed rest, contact left out). For a quantity:
   // dQ/dt = g · d_rest + λ · T. Take the step small (1e-8 of the scene's size): a membrane soft
   // in compression has a kink at zero strain, which a larger step straddles
-  // (docs/methods/sensitivity.md, "Scene radii").
+  // (docs/methods/sensitivity.md, "Scene radii"). `parts` (ClothProblem::MaterialPart bits)
+  // limits the forces to those the change moves: a seam profile's step with no morph moves the
+  // bending only.
   using SeamsAt = std::function<std::vector<Seam>(double t)>;
   Vertices RestShapeResidualChange(const Vertices& d_rest, double step,
-                                   const SeamsAt& seams_at = {}) const;
+                                   const SeamsAt& seams_at = {},
+                                   int parts = ClothProblem::kAllParts) const;
 
  private:
   struct Factor;

@@ -253,6 +253,8 @@ void Run(const AcpmArgs& a) {
   for (const Note& n : r.membrane_defaults) std::cout << "note: " << n.text << "\n";
   if (o.sensitivity || o.monte_carlo_samples > 0)
     PrintInfluences("L", "mm", 1e3, r.crossing_length_sigma, r.sigma_note, r.sensitivities);
+  PrintInfluencesBesideSigma("scene", "mm", 1e3, r.scene_sensitivities);
+  PrintInfluencesBesideSigma("seam", "mm", 1e3, r.seam_sensitivities);
   if (r.monte_carlo) PrintMonteCarlo("L", "mm", 1e3, *r.monte_carlo);
   std::cout << "wrote " << a.out << (a.png.empty() ? "" : ", " + a.png)
             << (a.obj.empty() ? "" : ", " + a.obj) << "\n";

@@ -550,8 +550,8 @@ void PrintText(const DrapeResult& r, const DrapeOptions& o, const Material& m, c
   std::cout << "\n";
   if (!r.sensitivities.empty())
     PrintInfluences("DC", "", 1.0, r.drape_coefficient_sigma, r.sigma_note, r.sensitivities);
-  PrintInfluencesBesideSigma("scene", r.scene_sensitivities);
-  PrintInfluencesBesideSigma("seam", r.seam_sensitivities);
+  PrintInfluencesBesideSigma("scene", "", 1.0, r.scene_sensitivities);
+  PrintInfluencesBesideSigma("seam", "", 1.0, r.seam_sensitivities);
   if (r.monte_carlo) PrintMonteCarlo("DC", "", 1.0, *r.monte_carlo);
   if (comparison) PrintComparison(*comparison, a, r.per_seed.size() > 1);
   std::cout << "time: " << Num(r.seconds, 3) << " s\nresult: " << a.out

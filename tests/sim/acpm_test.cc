@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <numbers>
 
 #include "textile/sim/elastica/elastica.h"
 #include "textile/sim/core/error.h"
@@ -399,6 +401,111 @@ TEST(Acpm, ShellSensitivitiesMatchTheElasticasOnAPlainStrip) {
       }
   o.sensitivity_parameters = {"stretch.stiffness_N_per_m"};
   EXPECT_TRUE(std::isfinite(RunAcpm(Fig8(), o).sensitivities.at(0).d_q_d_ln_p));
+}
+
+constexpr double kOneDegree = std::numbers::pi / 180.0;  // [rad]
+
+// The mean crossing length of a run of `o` (no sensitivities).
+double MeanLength(const Material& m, AcpmOptions o) {
+  o.sensitivity = false;
+  const AcpmResult r = RunAcpm(m, o);
+  double sum = 0.0;
+  for (const AcpmRay& ray : r.rays) sum += ray.overhang;
+  return sum / static_cast<double>(r.rays.size());
+}
+
+// The scene's and the seam's rows of the elastica (a seam across) against central differences
+// of whole runs at steps 20-100 times the rows' own: the barrier ±0.2°, the seam ±0.5 mm, B_f
+// scaled by e^(±0.005); within 1 %. A list of parameters, or Monte Carlo alone, leaves them out.
+TEST(Acpm, SceneAndSeamRowsMatchDifferencesOfWholeRuns) {
+  AcpmOptions o;
+  o.num_rays = 1;
+  o.seam.direction = AcpmSeamDirection::kAcross;
+  o.seam.profile = SeamPreset("C-plain");
+  o.seam.position = 0.02;
+  o.sensitivity = true;
+  const Material m = Fig8();
+  const AcpmResult r = RunAcpm(m, o);
+  ASSERT_EQ(r.scene_sensitivities.size(), 2u);
+  ASSERT_EQ(r.seam_sensitivities.size(), 4u);
+  EXPECT_EQ(r.scene_sensitivities[0].parameter, "barrier_angle");
+  EXPECT_NEAR(r.scene_sensitivities[0].value, 41.5, 1e-9);
+  EXPECT_EQ(r.scene_sensitivities[1].parameter, "seam_position");
+  EXPECT_NEAR(r.scene_sensitivities[1].value, 20.0, 1e-9);
+  const auto fd = [&](const std::function<void(AcpmOptions*, double)>& set, double h) {
+    AcpmOptions up = o, down = o;
+    set(&up, h);
+    set(&down, -h);
+    return (MeanLength(m, up) - MeanLength(m, down)) / (2.0 * h);
+  };
+  const double angle = fd([](AcpmOptions* s, double t) { s->barrier_angle += t; }, 0.2 * kOneDegree);
+  const double at = fd([](AcpmOptions* s, double t) { s->seam.position += t; }, 5e-4);
+  const double scale = fd(
+      [](AcpmOptions* s, double t) {
+        s->seam.profile.type = "fitted";
+        for (double& a : s->seam.profile.coefficients_mm) a *= std::exp(t);
+      },
+      0.005);
+  EXPECT_GT(angle, 0.0);  // a steeper barrier wants a longer overhang
+  EXPECT_NEAR(r.scene_sensitivities[0].d_q_d_p, angle, 0.01 * std::abs(angle));
+  EXPECT_NEAR(r.scene_sensitivities[1].d_q_d_p, at, 0.01 * std::abs(at));
+  EXPECT_NEAR(r.seam_sensitivities[3].d_q_d_ln_p, scale, 0.01 * std::abs(scale));
+  EXPECT_NEAR(r.scene_sensitivities[0].change, std::abs(angle) * 0.5 * kOneDegree,
+              0.01 * std::abs(angle) * 0.5 * kOneDegree);
+  const nlohmann::json j = AcpmResultToJson(r, m, o);
+  EXPECT_EQ(j["seam_sensitivities"].size(), 4u);
+  EXPECT_EQ(j["scene_sensitivities"][1]["parameter"], "seam_position");
+  o.sensitivity_parameters = {"b1"};
+  EXPECT_TRUE(RunAcpm(m, o).scene_sensitivities.empty());
+  o.sensitivity_parameters.clear();
+  o.sensitivity = false;
+  o.monte_carlo_samples = 4;
+  Material fitted = m;
+  fitted.fit["covariance_kes"] = {{1e-8, 0.0, 0.0}, {0.0, 1e-8, 0.0}, {0.0, 0.0, 1e-9}};
+  const AcpmResult mc = RunAcpm(fitted, o);
+  EXPECT_FALSE(mc.sensitivities.empty());
+  EXPECT_TRUE(mc.scene_sensitivities.empty());
+  EXPECT_TRUE(mc.seam_sensitivities.empty());
+}
+
+// Through a stand-in shell (a seam along): each ray's crossing L(z) = L0 (1 + 0.1 sin θ)
+// (1 + 0.01 |z − z_s| / mm) B_f(0)^(1/3); the rows are its derivatives, differences of runs
+// at ±1 % (one-sided where the seam's position leaves the sample).
+TEST(Acpm, SceneRowsThroughTheShellModel) {
+  AcpmOptions o;
+  o.num_rays = 3;
+  o.seam.direction = AcpmSeamDirection::kAlong;
+  o.seam.profile = SeamPreset("B-plain");
+  o.seam.position = 0.2;  // at the right edge: the position's difference is one-sided
+  o.sensitivity = true;
+  constexpr double kL0 = 0.05;
+  o.shell_model = [](const Material&, const AcpmOptions& scene, const std::vector<double>& z) {
+    AcpmCrossings c;
+    c.converged = true;
+    for (double zi : z)
+      c.overhang.push_back(kL0 * (1.0 + 0.1 * std::sin(scene.barrier_angle)) *
+                           (1.0 + 10.0 * std::abs(zi - scene.seam.position)) *
+                           std::cbrt(scene.seam.profile.StiffnessFactor(0.0)));
+    return c;
+  };
+  const AcpmResult r = RunAcpm(Fig8(), o);
+  ASSERT_EQ(r.model, AcpmModelKind::kShell);
+  ASSERT_EQ(r.scene_sensitivities.size(), 2u);
+  const std::vector<double> z = o.RayPositions();
+  double mean_factor = 0.0;  // the mean over the rays of (1 + 10 |z − z_s|)
+  for (double zi : z) mean_factor += (1.0 + 10.0 * std::abs(zi - 0.2)) / 3.0;
+  const double a0 = o.seam.profile.coefficients_mm[2], theta = o.barrier_angle;
+  const double common = kL0 * std::cbrt(a0);
+  EXPECT_NEAR(r.scene_sensitivities[0].d_q_d_p, common * 0.1 * std::cos(theta) * mean_factor,
+              1e-3 * common);
+  // Every ray lies left of the seam: dL/dz_s = 10 L0 (1 + 0.1 sin θ) a0^(1/3), exact.
+  EXPECT_NEAR(r.scene_sensitivities[1].d_q_d_p, 10.0 * common * (1.0 + 0.1 * std::sin(theta)),
+              1e-6 * common);
+  // Only a0 moves B_f(0): dL/dln a0 = L/3; a2 and a1 nothing.
+  const double length = common * (1.0 + 0.1 * std::sin(theta)) * mean_factor;
+  EXPECT_NEAR(r.seam_sensitivities[2].d_q_d_ln_p, length / 3.0, 1e-3 * length);
+  EXPECT_NEAR(r.seam_sensitivities[0].d_q_d_p, 0.0, 1e-9);
+  EXPECT_NEAR(r.seam_sensitivities[3].d_q_d_ln_p, length / 3.0, 1e-3 * length);
 }
 
 // --monte-carlo: where the covariance is small the law is linear over it and the sampled σ is

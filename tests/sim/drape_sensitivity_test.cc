@@ -298,7 +298,7 @@ TEST(DrapeSensitivity, SeamCoefficientsMatchDifferencesOfDrapes) {
   EXPECT_GT(r.seam_sensitivities[3].d_q_d_ln_p, 0.0);
   EXPECT_GT(r.scene_sensitivity_seconds, 0.0);
   EXPECT_LT(r.scene_sensitivity_seconds, r.sensitivity_seconds);
-  ExpectSeamRowsMatchDrapes(m, o, r, {"seam.scale", "seam.a2"}, 0.02);
+  ExpectSeamRowsMatchDrapes(m, o, r, {"seam.scale", "seam.a2", "seam.a1"}, 0.02);
 
   o.seams = DrapeSeams::kShifted;
   o.seam_shift = 0.03;
@@ -315,8 +315,10 @@ TEST(DrapeSensitivity, SeamCoefficientsMatchDifferencesOfDrapes) {
   EXPECT_TRUE(SimulateDrape(m, o).seam_sensitivities.empty());
 }
 
-// The seam rows' uncertainties: the seam file's covariance where it has one, else ±10 %;
-// B_f as a whole is the coefficients' sum, a_k ∂DC/∂a_k.
+// The drape's seam rows come from the seeds' mean derivatives and the options' profile:
+// ±10 % without a covariance, its sds with one (SeamInfluences' own cases: input_influence_test);
+// B_f as a whole is the coefficients' sum, a_k ∂DC/∂a_k. A profile a step from its bounds is
+// refused before any solve.
 TEST(DrapeSensitivity, SeamRowsTakeTheSeamFilesCovariance) {
   DrapeOptions o;
   o.seams = DrapeSeams::kWeft;
@@ -346,6 +348,15 @@ TEST(DrapeSensitivity, SeamRowsTakeTheSeamFilesCovariance) {
   EXPECT_NEAR(fitted.seam_sensitivities[2].change, 0.01 * 0.5, 1e-15);
   EXPECT_NE(fitted.seam_sensitivities[0].uncertainty_source.find("covariance"), std::string::npos);
   EXPECT_TRUE(fitted.scene_sensitivities.empty());
+  DrapeOptions edge = Coarse();
+  edge.sensitivity = true;
+  edge.seams = DrapeSeams::kWeft;
+  edge.seam_profile.type = "fitted";
+  edge.seam_profile.coefficients_mm = {0.0, -0.09, 9.0 + 1e-9};  // B_f(100 mm) = 1e-9
+  EXPECT_THROW(drape_internal::TakenSceneInputs(edge), InputError);
+  EXPECT_THROW(SimulateDrape(Fig8(), edge), InputError);
+  edge.sensitivity_parameters = {"b1"};  // the seam left out
+  EXPECT_FALSE(drape_internal::TakenSceneInputs(edge).seam);
 }
 
 // σ² = gᵀ C g over b1, b2, c1; the table's changes over each parameter's uncertainty.

@@ -70,9 +70,26 @@ TEST(CliAcpm, SensitivityReportsTheLengthsInfluenceTable) {
       EXPECT_NEAR(row["length_change_mm"].get<double>(), 0.1 * length / 3.0, 1e-4 * length);
     }
   }
+  EXPECT_EQ(j["scene_sensitivities"].size(), 1u);  // the barrier's angle
+  EXPECT_TRUE(j["seam_sensitivities"].is_null());  // no seam
   const auto plain = Textile("acpm " + kFig8 + " -o " + (dir / "p.json").string());
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
   EXPECT_FALSE(nlohmann::json::parse(ReadAll(dir / "p.json")).contains("sensitivities"));
+  // A seam across: its position and coefficients too, apart from the σ, in the text and the
+  // JSON; a stiffer seam holds the strip out further.
+  const auto seam = Textile(
+      "acpm " + kFig8 + " --seam C-plain --seam-dir across --seam-at 20 --sensitivity -o " +
+      (dir / "s.json").string());
+  ASSERT_EQ(seam.exit_code, 0) << seam.err;
+  EXPECT_NE(seam.out.find("scene (not in the sigma):\n  barrier_angle = 41.5 deg: "),
+            std::string::npos) << seam.out;
+  EXPECT_NE(seam.out.find("seam (not in the sigma):"), std::string::npos) << seam.out;
+  const auto s = nlohmann::json::parse(ReadAll(dir / "s.json"));
+  ASSERT_EQ(s["scene_sensitivities"].size(), 2u);
+  EXPECT_EQ(s["scene_sensitivities"][1]["parameter"], "seam_position");
+  EXPECT_EQ(s["scene_sensitivities"][1]["unit"], "mm");
+  ASSERT_EQ(s["seam_sensitivities"].size(), 4u);
+  EXPECT_GT(s["seam_sensitivities"][3]["d_length_mm_d_ln_p"].get<double>(), 0.0);
 }
 
 // --monte-carlo N: the sampled σ beside the linear one in acpm.json and the text, the same draws

@@ -196,11 +196,12 @@ void PrintInfluences(const std::string& quantity, const std::string& unit, doubl
   for (const ParameterInfluence& s : rows) PrintInfluenceRow(s, scale, in);
 }
 
-void PrintInfluencesBesideSigma(const std::string& title,
+void PrintInfluencesBesideSigma(const std::string& title, const std::string& unit, double scale,
                                 const std::vector<ParameterInfluence>& rows) {
   if (rows.empty()) return;
   std::cout << title << " (not in the sigma):\n";
-  for (const ParameterInfluence& s : rows) PrintInfluenceRow(s, 1.0, "");
+  for (const ParameterInfluence& s : rows)
+    PrintInfluenceRow(s, scale, unit.empty() ? "" : " " + unit);
 }
 
 }  // namespace textile::cli

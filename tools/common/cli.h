@@ -63,9 +63,9 @@ void PrintMonteCarlo(const std::string& quantity, const std::string& unit, doubl
 void PrintInfluences(const std::string& quantity, const std::string& unit, double scale,
                      double sigma, const std::string& sigma_note,
                      const std::vector<ParameterInfluence>& rows);
-// "<title> (not in the sigma):" and `rows` as PrintInfluences prints them (a dimensionless
-// quantity); nothing when there are none.
-void PrintInfluencesBesideSigma(const std::string& title,
+// "<title> (not in the sigma):" and `rows` as PrintInfluences prints them (the quantity's
+// values times `scale`, in `unit`); nothing when there are none.
+void PrintInfluencesBesideSigma(const std::string& title, const std::string& unit, double scale,
                                 const std::vector<ParameterInfluence>& rows);
 
 // Progress/info line on stderr (never on stdout, which may carry JSON).

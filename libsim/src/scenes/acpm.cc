@@ -12,6 +12,7 @@
 #include "textile/sim/elastica/elastica.h"
 #include "textile/sim/core/error.h"
 #include "textile/sim/io/json_text.h"
+#include "textile/sim/law/input_influence.h"
 #include "textile/sim/law/material.h"
 #include "textile/sim/core/units.h"
 
@@ -330,6 +331,65 @@ void AcpmSensitivities(const Material& material, const CrossingsOf& model, doubl
   result->sigma_note = std::move(table.sigma_note);
 }
 
+// The crossings of the material in a scene by the run's model, for the scene's own inputs.
+using CrossingsIn = std::function<AcpmCrossings(const AcpmOptions&)>;
+
+// The stated uncertainties of the ACPM's scene (docs/methods/sensitivity.md, "ACPM"): the
+// barrier's alignment, a seam sewn along a marked line.
+constexpr double kBarrierAngleUncertainty = 0.5 * kDegree;  // [rad]
+constexpr double kSeamPositionUncertainty = 1e-3;          // [m]
+
+// ∂L/∂t by a central difference of whole runs in the scenes set(t ± h), one-sided where t ± h
+// leaves [lo, hi].
+double SceneDerivative(const CrossingsIn& model, const AcpmOptions& o, double t, double h,
+                       double lo, double hi, const std::function<void(AcpmOptions*, double)>& set,
+                       const std::string& name) {
+  const double up = std::min(t + h, hi), down = std::max(t - h, lo);
+  double length[2];
+  for (int side = 0; side < 2; ++side) {
+    AcpmOptions stepped = o;
+    set(&stepped, side ? down : up);
+    const AcpmCrossings c = model(stepped);
+    if (!c.converged) throw ComputeError("sensitivity of " + name + ": " + c.message);
+    length[side] = MeanOverhang(c);
+  }
+  return (length[0] - length[1]) / (up - down);
+}
+
+// The scene's rows (the barrier's angle; with a seam its position) and the seam's (its
+// coefficients, SeamInfluences) into *result, at the same relative step as the material's.
+void AcpmSceneSensitivities(const CrossingsIn& model, const AcpmOptions& o, double step_size,
+                            AcpmResult* result) {
+  const double angle = o.barrier_angle;
+  const double d_angle = SceneDerivative(
+      model, o, angle, step_size * angle, 0.0, std::nextafter(std::numbers::pi / 2.0, 0.0),
+      [](AcpmOptions* s, double t) { s->barrier_angle = t; }, "barrier_angle");
+  result->scene_sensitivities.push_back(
+      SceneInfluence("barrier_angle", angle, 1.0 / kDegree, "deg", d_angle,
+                     kBarrierAngleUncertainty, "default: the barrier's alignment, ±0.5°"));
+  if (o.seam.direction == AcpmSeamDirection::kNone) return;
+  const bool along = o.seam.direction == AcpmSeamDirection::kAlong;
+  const double span = along ? o.width : o.length, at = o.seam.position;
+  const double d_at = SceneDerivative(
+      model, o, at, step_size * span, 0.0, span,
+      [](AcpmOptions* s, double t) { s->seam.position = t; }, "seam_position");
+  result->scene_sensitivities.push_back(
+      SceneInfluence("seam_position", at, 1e3, "mm", d_at, kSeamPositionUncertainty,
+                     "default: a seam sewn along a marked line, ±1 mm"));
+  std::vector<double> d_a;
+  for (int k = 0; k < kSeamCoefficients; ++k) {
+    const SeamProfile& profile = o.seam.profile;
+    d_a.push_back(SceneDerivative(
+        model, o, 0.0, SeamCoefficientStep(profile, k, step_size),
+        -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+        [k, &profile](AcpmOptions* s, double t) {
+          s->seam.profile = SteppedSeamProfile(profile, k, t);
+        },
+        "the seam's coefficients"));
+  }
+  result->seam_sensitivities = SeamInfluences(o.seam.profile, d_a);
+}
+
 // The mean crossing length's spread over materials drawn from the fit's covariance, each
 // through the model, beside the linear σ; into result->monte_carlo.
 void AcpmMonteCarlo(const CovarianceSamples& draws, const CrossingsOf& model, AcpmResult* result) {
@@ -392,15 +452,22 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
 
   const std::vector<std::string> parameters =
       AcpmSensitivityParameters(material, o, use_elastica);
+  const double step = use_elastica ? kElasticaSensitivityStep : kShellSensitivityStep;
+  // The scene's and the seam's inputs: asked for (not implied by Monte Carlo), no list.
+  const bool scene_inputs = options.sensitivity && options.sensitivity_parameters.empty();
+  if (scene_inputs && o.seam.direction != AcpmSeamDirection::kNone)
+    CheckSeamCoefficientSteps(o.seam.profile, step);
   const CovarianceSamples draws =
       o.monte_carlo_samples > 0
           ? SampleFitCovariance(material, o.monte_carlo_samples, o.monte_carlo_seed)
           : CovarianceSamples{};
   const std::vector<double> z = o.RayPositions();
   CrossingsOf model;
+  CrossingsIn scene_model;  // the material's crossings in another scene
   if (use_elastica) {
     result.model = AcpmModelKind::kElastica;
     model = [&o, &z](const Material& m) { return ElasticaModel(m, o, z); };
+    scene_model = [&material, &z](const AcpmOptions& in) { return ElasticaModel(material, in, z); };
   } else {
     result.model = AcpmModelKind::kShell;
     const AcpmModel shell = o.shell_model ? o.shell_model : ShellAcpmModel();
@@ -411,6 +478,7 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
                                           "across the push direction exactly"));
     }
     model = [shell, &o, &z](const Material& m) { return shell(m, o, z); };
+    scene_model = [shell, &material, &z](const AcpmOptions& in) { return shell(material, in, z); };
   }
   AcpmCrossings crossings = model(material);
   if (!use_elastica) {
@@ -424,9 +492,8 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
                          " crossings for " + std::to_string(z.size()) + " rays");
   }
   if (o.sensitivity && crossings.converged)
-    AcpmSensitivities(material, model,
-                      use_elastica ? kElasticaSensitivityStep : kShellSensitivityStep, parameters,
-                      &result);
+    AcpmSensitivities(material, model, step, parameters, &result);
+  if (scene_inputs && crossings.converged) AcpmSceneSensitivities(scene_model, o, step, &result);
   if (o.monte_carlo_samples > 0 && crossings.converged) AcpmMonteCarlo(draws, model, &result);
 
   // The same fabric without seams: the reference of the factor (Fig. 5). The model's own when
@@ -540,18 +607,24 @@ nlohmann::json AcpmResultToJson(const AcpmResult& r, const Material& material,
     j["crossing_length_sigma_mm"] =
         std::isfinite(r.crossing_length_sigma) ? json(units::MToMm(r.crossing_length_sigma)) : json();
     j["crossing_length_sigma_note"] = r.sigma_note;
-    json rows = json::array();
-    for (const ParameterInfluence& s : r.sensitivities)
-      rows.push_back({{"parameter", s.parameter},
-                      {"value", s.value},
-                      {"unit", s.unit},
-                      {"defaulted", s.defaulted},
-                      {"d_length_mm_d_ln_p", units::MToMm(s.d_q_d_ln_p)},
-                      {"uncertainty_ln",
-                       std::isfinite(s.uncertainty_ln) ? json(s.uncertainty_ln) : json()},
-                      {"uncertainty_source", s.uncertainty_source},
-                      {"length_change_mm", units::MToMm(s.change)}});
-    j["sensitivities"] = rows;
+    const auto rows = [](const std::vector<ParameterInfluence>& influences) {
+      json list = json::array();
+      for (const ParameterInfluence& s : influences)
+        list.push_back({{"parameter", s.parameter},
+                        {"value", s.value},
+                        {"unit", s.unit},
+                        {"defaulted", s.defaulted},
+                        {"d_length_mm_d_ln_p", units::MToMm(s.d_q_d_ln_p)},
+                        {"uncertainty_ln",
+                         std::isfinite(s.uncertainty_ln) ? json(s.uncertainty_ln) : json()},
+                        {"uncertainty_source", s.uncertainty_source},
+                        {"length_change_mm", units::MToMm(s.change)}});
+      return list;
+    };
+    j["sensitivities"] = rows(r.sensitivities);
+    // The scene's and the seam's (not in the σ), null when the run did not take them.
+    j["scene_sensitivities"] = r.scene_sensitivities.empty() ? json() : rows(r.scene_sensitivities);
+    j["seam_sensitivities"] = r.seam_sensitivities.empty() ? json() : rows(r.seam_sensitivities);
   }
   if (r.monte_carlo) j["monte_carlo"] = MonteCarloJson(*r.monte_carlo, 1e3, "mm");
   return j;

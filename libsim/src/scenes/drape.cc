@@ -693,7 +693,8 @@ struct SeedState {
   // With a rim split: the base mesh's equilibrium and the split mesh's problem (sensitivities).
   Vertices base_positions;
   std::unique_ptr<ClothProblem> split_problem;
-  // With options.sensitivity: ∂DC/∂p per parameter [per SI unit], and ∂DC/∂R per scene radius.
+  // With options.sensitivity: ∂DC/∂p per parameter [per SI unit], per scene radius [per m] and
+  // per seam coefficient.
   drape_internal::DcDerivativeSet d_dc;
 };
 
@@ -779,13 +780,14 @@ void SettleSplit(const Material& material, const DrapeOptions& o, const DrapeSce
 // on; with a split rim the extrapolation's DC_split + (DC_split - DC_base)/2. The scene's radii
 // and the seam's coefficients too when the run takes them (TakesSceneParameters): the radii
 // through a morph of the rest mesh, the coefficients through the seams' own change.
-void SeedSensitivities(const Material& material, const DrapeOptions& o, bool scene_parameters,
+void SeedSensitivities(const Material& material, const DrapeOptions& o,
+                       drape_internal::SceneInputs scene_inputs,
                        const DrapeScene& scene, const DrapeResult& result,
                        const std::vector<std::string>& parameters, SeedState* st) {
   if (!o.sensitivity || !st->seed.converged) return;
   const auto derivatives = [&](ClothProblem* problem, const Vertices& x) {
     return drape_internal::DcDerivatives(problem, x, material, o, result, parameters,
-                                         scene_parameters);
+                                         scene_inputs);
   };
   if (!scene.split) {
     st->d_dc = derivatives(st->fine_problem.get(), st->seed.positions);
@@ -951,7 +953,7 @@ MorphedSeed SolveMorphedSeed(const Material& material, const DrapeOptions& optio
   scene.fine.pm.mesh.vertices += t * morph;
   DrapeOptions o = options;
   (which == SceneRadius::kSpecimen ? o.specimen_radius : o.support_radius) += t;
-  if (seam_profile) o.seam_profile = *seam_profile;  // on the mesh refined for options'
+  if (seam_profile) o.seam_profile = *seam_profile;  // the mesh stays refined for options'
   scene.seams = DrapeSeamList(o);  // diameters: moved with the rim (the support's morph keeps it)
   MorphedSeed m;
   m.mesh = scene.fine.pm.mesh;
@@ -970,7 +972,7 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& options)
   DrapeOptions o = options;
   if (o.monte_carlo_samples > 0) o.sensitivity = true;  // the linear σ beside the sampled one
   // The radii and the seam's coefficients: asked for, not implied by Monte Carlo.
-  const bool scene_parameters = drape_internal::TakesSceneParameters(options);
+  const drape_internal::SceneInputs scene_inputs = drape_internal::TakenSceneInputs(options);
   DrapeResult result;
   result.rim_turn_down = RimTurnDownLength(material, o);
   // Sensitivities and Monte Carlo draws: the names and the covariance checked before any work
@@ -990,7 +992,7 @@ DrapeResult SimulateDrape(const Material& material, const DrapeOptions& options)
     SettleSplit(material, o, scene, result, &st);
     MeasureSeed(o, scene, result, &st.seed);
     const auto sensitivity_start = std::chrono::steady_clock::now();
-    SeedSensitivities(material, o, scene_parameters, scene, result, parameters, &st);
+    SeedSensitivities(material, o, scene_inputs, scene, result, parameters, &st);
     if (!st.d_dc.material.empty() || !st.d_dc.radii.empty() || !st.d_dc.seam.empty()) {
       result.sensitivity_seconds +=
           std::chrono::duration<double>(std::chrono::steady_clock::now() - sensitivity_start).count();

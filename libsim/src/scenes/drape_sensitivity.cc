@@ -12,6 +12,7 @@
 #include "textile/sim/core/error.h"
 #include "textile/sim/core/units.h"
 #include "textile/sim/mesh/mesh.h"
+#include "textile/sim/law/input_influence.h"
 #include "textile/sim/law/material_parameters.h"
 #include "textile/sim/solve/sensitivity.h"
 
@@ -209,21 +210,17 @@ double RadiusDcDerivative(const EquilibriumSensitivity& sensitivity, const Verti
   return ((d_shadow - d_support) - dc * (d_specimen - d_support)) / span;
 }
 
-// The seam coefficient k's (0: a2, 1: a1, 2: a0) central-difference step [1/mm^(2-k)]: a
-// change of B_f by 1e-6 of B_f(0) at the influence distance d_max, where the term is largest.
-// B_f is linear in its coefficients, and S follows it but for its kink at 1 (SeamProfile).
-double SeamCoefficientStep(const SeamProfile& profile, int k) {
-  return 1e-6 * std::max(1.0, std::abs(profile.StiffnessFactor(0.0))) /
-         std::pow(profile.influence_mm, 2 - k);
-}
+// The seam coefficients' relative step (SeamCoefficientStep): B_f moves by 1e-6 of B_f(0) at
+// d_max. B_f is linear in its coefficients, and S follows it but for its kink at 1
+// (SeamProfile::Multiplier), which no Table 2 seam reaches within d_max.
+constexpr double kSeamCoefficientStep = 1e-6;
 
 // The drape's seams with coefficient k of their profile moved by t (a "fitted" profile then: a
 // preset's coefficients are Table 2's).
 EquilibriumSensitivity::SeamsAt SteppedSeams(int k, const DrapeOptions& o) {
   return [k, o](double t) {
     DrapeOptions stepped = o;
-    stepped.seam_profile.type = "fitted";
-    stepped.seam_profile.coefficients_mm[static_cast<size_t>(k)] += t;
+    stepped.seam_profile = SteppedSeamProfile(o.seam_profile, k, t);
     return DrapeSeamList(stepped);
   };
 }
@@ -235,52 +232,21 @@ double SeamCoefficientDcDerivative(const EquilibriumSensitivity& sensitivity,
                                    const Vertices& adjoint, int k, const DrapeOptions& o,
                                    const DrapeResult& result) {
   const Vertices still = Vertices::Zero(adjoint.rows(), 3);
-  const Vertices force =
-      sensitivity.RestShapeResidualChange(still, SeamCoefficientStep(o.seam_profile, k),
-                                          SteppedSeams(k, o), ClothProblem::kBendingPart);
+  const double h = SeamCoefficientStep(o.seam_profile, k, kSeamCoefficientStep);
+  const Vertices force = sensitivity.RestShapeResidualChange(still, h, SteppedSeams(k, o),
+                                                             ClothProblem::kBendingPart);
   return (adjoint.array() * force.array()).sum() / (result.specimen_area - result.support_area);
 }
 
-// The seam's uncertainty when its file carries no covariance (Table 2 gives none) [relative].
-constexpr double kSeamDefaultUncertainty = 0.1;
+}  // namespace
 
-// The seam rows: a2, a1, a0 as the seam file has them (mm units), then B_f scaled as a whole.
-std::vector<ParameterInfluence> SeamInfluences(const SeamProfile& profile,
-                                               const std::vector<double>& d_dc_d_a) {
-  static const std::array<const char*, kSeamCoefficients> kNames{"seam.a2", "seam.a1", "seam.a0"};
-  static const std::array<const char*, kSeamCoefficients> kUnits{"1/mm²", "1/mm", "-"};
-  std::vector<ParameterInfluence> rows;
-  double d_scale = 0.0;
-  for (int k = 0; k < kSeamCoefficients; ++k) {
-    const size_t i = static_cast<size_t>(k);
-    const double a = profile.coefficients_mm[i];
-    const bool fitted = profile.covariance.has_value();
-    const double sd = fitted ? std::sqrt(std::max(0.0, (*profile.covariance)(k, k)))
-                             : kSeamDefaultUncertainty * std::abs(a);
-    ParameterInfluence row;  // a measured seam (Table 2's, or the file's): not defaulted
-    row.parameter = kNames[i];
-    row.value = a;
-    row.unit = kUnits[i];
-    row.d_q_d_p = d_dc_d_a[i];
-    row.d_q_d_ln_p = a * d_dc_d_a[i];
-    row.uncertainty_ln = a != 0.0 ? sd / std::abs(a) : std::numeric_limits<double>::quiet_NaN();
-    row.uncertainty_source = fitted ? "the seam file's fit covariance"
-                                    : "default: ±10 % (the seam file carries no covariance)";
-    row.change = std::abs(d_dc_d_a[i]) * sd;
-    rows.push_back(std::move(row));
-    d_scale += a * d_dc_d_a[i];
-  }
-  ParameterInfluence scale;
-  scale.parameter = "seam.scale";
-  scale.value = 1.0;
-  scale.unit = "-";
-  scale.d_q_d_p = scale.d_q_d_ln_p = d_scale;
-  scale.uncertainty_ln = kSeamDefaultUncertainty;
-  scale.uncertainty_source = "default: B_f ±10 % as a whole";
-  scale.change = std::abs(d_scale) * kSeamDefaultUncertainty;
-  rows.push_back(std::move(scale));
-  return rows;
+SceneInputs TakenSceneInputs(const DrapeOptions& o) {
+  const SceneInputs taken{TakesSceneRadii(o), TakesSeamCoefficients(o)};
+  if (taken.seam) CheckSeamCoefficientSteps(o.seam_profile, kSeamCoefficientStep);
+  return taken;
 }
+
+namespace {
 
 // The mean over the seeds of one of their derivative lists (each as long as the first seed's).
 std::vector<double> SeedMean(const std::vector<DcDerivativeSet>& seeds,
@@ -293,20 +259,12 @@ std::vector<double> SeedMean(const std::vector<DcDerivativeSet>& seeds,
 }
 
 ParameterInfluence RadiusInfluence(SceneRadius which, const DrapeOptions& o, double d_dc_d_r) {
-  const bool specimen = which == SceneRadius::kSpecimen;
-  ParameterInfluence row;
-  row.parameter = specimen ? "specimen_radius" : "support_radius";
-  const double r = specimen ? o.specimen_radius : o.support_radius;
-  const double dr = specimen ? kSpecimenRadiusUncertainty : kSupportRadiusUncertainty;
-  row.value = units::MToMm(r);
-  row.unit = "mm";
-  row.d_q_d_p = d_dc_d_r;
-  row.d_q_d_ln_p = r * d_dc_d_r;
-  row.uncertainty_ln = dr / r;
-  row.uncertainty_source = specimen ? "default: a specimen cut to a template, ±1 mm"
-                                    : "default: a machined support disk, ±0.1 mm";
-  row.change = std::abs(d_dc_d_r) * dr;
-  return row;
+  return which == SceneRadius::kSpecimen
+             ? SceneInfluence("specimen_radius", o.specimen_radius, 1e3, "mm", d_dc_d_r,
+                              kSpecimenRadiusUncertainty,
+                              "default: a specimen cut to a template, ±1 mm")
+             : SceneInfluence("support_radius", o.support_radius, 1e3, "mm", d_dc_d_r,
+                              kSupportRadiusUncertainty, "default: a machined support disk, ±0.1 mm");
 }
 
 }  // namespace
@@ -314,7 +272,7 @@ ParameterInfluence RadiusInfluence(SceneRadius which, const DrapeOptions& o, dou
 DcDerivativeSet DcDerivatives(ClothProblem* problem, const Vertices& x,
                               const Material& material, const DrapeOptions& o,
                               const DrapeResult& result, const std::vector<std::string>& parameters,
-                              bool scene) {
+                              SceneInputs scene) {
   // The solve stops at o.solver.tolerance; a state 100 times further off is no equilibrium.
   const EquilibriumSensitivity sensitivity(problem, x, material,
                                            std::max(100.0 * o.solver.tolerance, 1e-6));
@@ -328,13 +286,13 @@ DcDerivativeSet DcDerivatives(ClothProblem* problem, const Vertices& x,
   DcDerivativeSet d;
   for (const std::string& p : parameters)
     d.material.push_back(sensitivity.QuantityDerivativePerUnit(adjoint, p) / scale);
-  if (!scene) return d;
+  if (!scene.radii && !scene.seam) return d;
   const auto start = std::chrono::steady_clock::now();
-  if (o.seams != DrapeSeams::kShifted)
+  if (scene.radii)
     for (SceneRadius which : {SceneRadius::kSpecimen, SceneRadius::kSupport})
       d.radii.push_back(RadiusDcDerivative(sensitivity, adjoint, area_gradient, outline, rest,
                                            which, o, result));
-  if (o.seams != DrapeSeams::kNone)
+  if (scene.seam)
     for (int k = 0; k < kSeamCoefficients; ++k)
       d.seam.push_back(SeamCoefficientDcDerivative(sensitivity, adjoint, k, o, result));
   d.scene_seconds =

@@ -9,6 +9,7 @@
 #include <optional>
 #include <vector>
 
+#include "textile/sim/law/input_influence.h"
 #include "textile/sim/scenes/drape.h"
 #include "textile/sim/solve/cloth_problem.h"
 #include "textile/sim/solve/static_solver.h"
@@ -72,8 +73,14 @@ constexpr int kSceneRadii = 2;
 bool TakesSceneRadii(const DrapeOptions& options);
 // The seam profile's coefficients a2, a1, a0 as parameters (docs/methods/sensitivity.md, "Seam
 // coefficients"): TakesSceneParameters, with seams.
-constexpr int kSeamCoefficients = 3;
 bool TakesSeamCoefficients(const DrapeOptions& options);
+// The scene's inputs a run takes (the two above), the seam's coefficient steps checked
+// (CheckSeamCoefficientSteps: InputError before any work).
+struct SceneInputs {
+  bool radii = false;
+  bool seam = false;
+};
+SceneInputs TakenSceneInputs(const DrapeOptions& options);
 // The rest disk's radial morph that moves one radius by a metre and keeps the other (#V×3
 // [m/m], z 0): u(r) r̂ with, R_s the support's radius and R the specimen's,
 //   specimen: u = 0 within R_s, (r − R_s)/(R − R_s) beyond;
@@ -98,8 +105,8 @@ MorphedSeed SolveMorphedSeed(const Material& material, const DrapeOptions& optio
                              const SeamProfile* seam_profile = nullptr);
 
 // ∂DC/∂p of one equilibrium x of `problem`: `material` for each parameter [per SI unit]; with
-// `scene`, for each SceneRadius [per m] unless the seams are shifted, and for each seam
-// coefficient a2, a1, a0 [per 1/mm², 1/mm, 1] when there are seams (else empty). Through the
+// scene.radii for each SceneRadius [per m], with scene.seam for each seam coefficient a2, a1,
+// a0 [per 1/mm², 1/mm, 1] (else empty). Through the
 // traced outline's area and its adjoint (EquilibriumSensitivity), with the specimen's and the
 // support's areas' own changes in DC = (A_shadow − A_support) / (A_specimen − A_support).
 // scene_seconds: the wall time of the radii and the coefficients [s].
@@ -112,7 +119,7 @@ struct DcDerivativeSet {
 DcDerivativeSet DcDerivatives(ClothProblem* problem, const Vertices& x,
                               const Material& material, const DrapeOptions& options,
                               const DrapeResult& result, const std::vector<std::string>& parameters,
-                              bool scene);
+                              SceneInputs scene);
 // result->sensitivities (means over the seeds' derivatives, with each parameter's uncertainty,
 // largest dc_change first), drape_coefficient_sigma and sigma_note; result->scene_sensitivities
 // when the seeds carry radii, result->seam_sensitivities when they carry seam coefficients.

@@ -98,11 +98,13 @@ ParameterUncertainty DefaultParameterUncertainty(const Material& material, const
 // One parameter's influence on a scalar result Q of a simulation (a drape's DC, an ACPM
 // crossing length), in Q's unit.
 struct ParameterInfluence {
-  std::string parameter;  // as the material file names it
+  std::string parameter;  // as the material file names it (a scene's or a seam's input:
+                          // input_influence.h)
   double value = 0.0;     // in `unit`
   std::string unit;
   bool defaulted = false;          // a documented default, not a measured value
-  double d_q_d_p = 0.0;            // ∂Q/∂p [per SI unit of p]
+  double d_q_d_p = 0.0;            // ∂Q/∂p [per SI unit of p; a seam coefficient's per its
+                                   // mm unit, as the seam file has it]
   double d_q_d_ln_p = 0.0;         // ∂Q/∂ln p = p ∂Q/∂p
   double uncertainty_ln = 0.0;     // Δp/p of DefaultParameterUncertainty (NaN for p = 0)
   std::string uncertainty_source;  // where Δp comes from

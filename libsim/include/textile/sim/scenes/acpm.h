@@ -77,6 +77,13 @@ struct AcpmResult {
   // [m]; the elastica's rays are cut together), the largest change first, and its 1-σ from the
   // fit's covariance (NaN with sigma_note when the material carries none).
   std::vector<ParameterInfluence> sensitivities;
+  // With options.sensitivity (not only implied by monte_carlo_samples) and no
+  // sensitivity_parameters: the crossing length's derivatives in the scene, "barrier_angle"
+  // (deg) and with a seam "seam_position" (mm, as AcpmSeam::position), and in the seam's
+  // coefficients (SeamInfluences: "seam.a2", "seam.a1", "seam.a0", "seam.scale"), by the same
+  // differences of whole runs. Not in the σ.
+  std::vector<ParameterInfluence> scene_sensitivities;
+  std::vector<ParameterInfluence> seam_sensitivities;
   double crossing_length_sigma = std::numeric_limits<double>::quiet_NaN();
   std::string sigma_note;
   // With options.monte_carlo_samples: the crossing length's spread over the samples [m],

@@ -251,6 +251,7 @@ void Run(const AcpmArgs& a) {
             << "device time " << Num(r.device_time, 4) << " s; computed in " << Num(ms, 3)
             << " ms (" << r.solves << " solves)\n";
   for (const Note& n : r.membrane_defaults) std::cout << "note: " << n.text << "\n";
+  if (!r.notes.empty()) std::cout << "note: " << r.notes << "\n";
   if (o.sensitivity || o.monte_carlo_samples > 0)
     PrintInfluences("L", "mm", 1e3, r.crossing_length_sigma, r.sigma_note, r.sensitivities);
   PrintInfluencesBesideSigma("scene", "mm", 1e3, r.scene_sensitivities);

@@ -468,20 +468,21 @@ TEST(Acpm, SceneAndSeamRowsMatchDifferencesOfWholeRuns) {
   EXPECT_TRUE(mc.seam_sensitivities.empty());
 }
 
-// Through a stand-in shell (a seam along): each ray's crossing L(z) = L0 (1 + 0.1 sin θ)
-// (1 + 0.01 |z − z_s| / mm) B_f(0)^(1/3); the rows are its derivatives, differences of runs
-// at ±1 % (one-sided where the seam's position leaves the sample).
+// Through a stand-in shell: each ray's crossing L(z) = L0 (1 + 0.1 sin θ) (1 + 10 |z − z_s| / m)
+// B_f(0)^(1/3), refusing (not converged) a scene that fails Check; the rows are its derivatives,
+// differences of runs at ±1 %. A seam along has no position row (the real shell's mesh follows
+// the seam), and a note says so; a seam across at the back edge takes a one-sided difference.
 TEST(Acpm, SceneRowsThroughTheShellModel) {
   AcpmOptions o;
   o.num_rays = 3;
   o.seam.direction = AcpmSeamDirection::kAlong;
   o.seam.profile = SeamPreset("B-plain");
-  o.seam.position = 0.2;  // at the right edge: the position's difference is one-sided
+  o.seam.position = 0.2;
   o.sensitivity = true;
   constexpr double kL0 = 0.05;
   o.shell_model = [](const Material&, const AcpmOptions& scene, const std::vector<double>& z) {
     AcpmCrossings c;
-    c.converged = true;
+    c.converged = scene.Check(&c.message);
     for (double zi : z)
       c.overhang.push_back(kL0 * (1.0 + 0.1 * std::sin(scene.barrier_angle)) *
                            (1.0 + 10.0 * std::abs(zi - scene.seam.position)) *
@@ -490,7 +491,8 @@ TEST(Acpm, SceneRowsThroughTheShellModel) {
   };
   const AcpmResult r = RunAcpm(Fig8(), o);
   ASSERT_EQ(r.model, AcpmModelKind::kShell);
-  ASSERT_EQ(r.scene_sensitivities.size(), 2u);
+  ASSERT_EQ(r.scene_sensitivities.size(), 1u);  // the barrier only
+  EXPECT_NE(r.notes.find("position of a seam along"), std::string::npos) << r.notes;
   const std::vector<double> z = o.RayPositions();
   double mean_factor = 0.0;  // the mean over the rays of (1 + 10 |z − z_s|)
   for (double zi : z) mean_factor += (1.0 + 10.0 * std::abs(zi - 0.2)) / 3.0;
@@ -498,14 +500,22 @@ TEST(Acpm, SceneRowsThroughTheShellModel) {
   const double common = kL0 * std::cbrt(a0);
   EXPECT_NEAR(r.scene_sensitivities[0].d_q_d_p, common * 0.1 * std::cos(theta) * mean_factor,
               1e-3 * common);
-  // Every ray lies left of the seam: dL/dz_s = 10 L0 (1 + 0.1 sin θ) a0^(1/3), exact.
-  EXPECT_NEAR(r.scene_sensitivities[1].d_q_d_p, 10.0 * common * (1.0 + 0.1 * std::sin(theta)),
-              1e-6 * common);
   // Only a0 moves B_f(0): dL/dln a0 = L/3; a2 and a1 nothing.
   const double length = common * (1.0 + 0.1 * std::sin(theta)) * mean_factor;
   EXPECT_NEAR(r.seam_sensitivities[2].d_q_d_ln_p, length / 3.0, 1e-3 * length);
   EXPECT_NEAR(r.seam_sensitivities[0].d_q_d_p, 0.0, 1e-9);
   EXPECT_NEAR(r.seam_sensitivities[3].d_q_d_ln_p, length / 3.0, 1e-3 * length);
+
+  // Across (the shell asked for), at the sample's back edge: z_s is then the seam's distance
+  // behind the front, 300 mm, which every ray lies below: dL/dz_s = 10 L0 (1 + 0.1 sin θ) a0^(1/3).
+  o.model = AcpmModelKind::kShell;
+  o.seam.direction = AcpmSeamDirection::kAcross;
+  o.seam.position = o.length;
+  const AcpmResult across = RunAcpm(Fig8(), o);
+  ASSERT_EQ(across.scene_sensitivities.size(), 2u);
+  EXPECT_NEAR(across.scene_sensitivities[1].d_q_d_p, 10.0 * common * (1.0 + 0.1 * std::sin(theta)),
+              1e-6 * common);
+  EXPECT_EQ(across.notes.find("position of a seam along"), std::string::npos);
 }
 
 // --monte-carlo: where the covariance is small the law is linear over it and the sampled σ is

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -39,18 +40,32 @@ TEST(InputInfluence, SeamStepsMoveOneCoefficient) {
   }
   EXPECT_THROW(SteppedSeamProfile(c, 3, 1.0), std::out_of_range);
   EXPECT_NO_THROW(CheckSeamCoefficientSteps(c, 1e-6));
-  // A fitted seam whose B_f just reaches 0 at d_max: a step down leaves its bounds.
-  SeamProfile edge = c;
-  edge.type = "fitted";
-  edge.coefficients_mm = {0.0, -0.09, 9.0 + 1e-9};
-  std::string why;
-  ASSERT_TRUE(edge.Check(&why)) << why;
-  try {
-    CheckSeamCoefficientSteps(edge, 1e-6);
-    FAIL() << "a step past the bounds was let through";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("--sensitivity-params"), std::string::npos) << e.what();
-  }
+  // A fitted seam of coefficients `a` is refused for steps of `relative`, saying `why`.
+  const auto expect_refused = [](const std::array<double, 3>& a, double relative,
+                                 const std::string& fragment) {
+    SeamProfile p = SeamPreset("C-plain");
+    p.type = "fitted";
+    p.coefficients_mm = a;
+    std::string why;
+    ASSERT_TRUE(p.Check(&why)) << why;
+    try {
+      CheckSeamCoefficientSteps(p, relative);
+      ADD_FAILURE() << "let through: " << fragment;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("--sensitivity-params"), std::string::npos);
+    }
+  };
+  // B_f just reaching 0 at d_max: a step down leaves its bounds.
+  expect_refused({0.0, -0.09, 9.0 + 1e-9}, 1e-6, "leaves their bounds");
+  // The fade beyond d_max at its switch (3 e0 + g = 0: e0 = 0.2, g = 20 × −0.03): a step either
+  // way changes the fade, and S jumps there.
+  expect_refused({0.0, -0.03, 4.2}, 1e-2, "switches the fade");
+  SeamProfile at_switch = c;
+  at_switch.type = "fitted";
+  at_switch.coefficients_mm = {0.0, -0.03, 4.2};
+  at_switch.coefficients_mm[2] = 4.5;  // 3 e0 + g = 0.9: far from it
+  EXPECT_NO_THROW(CheckSeamCoefficientSteps(at_switch, 1e-2));
 }
 
 // The seam's rows: without a covariance ±10 % of each coefficient (of a zero one, 10 % of

@@ -46,16 +46,37 @@ double SeamCoefficientStep(const SeamProfile& profile, int k, double relative) {
          std::pow(profile.influence_mm, 2 - k);
 }
 
+namespace {
+
+// How S fades beyond d_max (SeamProfile::Multiplier), from the multiplier itself with
+// e0 = S(d_max) − 1 and g the fade times its slope there: not at all (e0 = 0), by the cubic
+// (3 e0 + g ≥ 0) or by the exponential. S jumps where a profile switches between them.
+enum class Fade { kNone, kCubic, kExponential };
+Fade FadeOf(const SeamProfile& p) {
+  const double d = p.influence_mm, delta = 1e-3 * d;
+  const double e0 = p.Multiplier(d) - 1.0;
+  if (e0 <= 0.0) return Fade::kNone;
+  const double g = p.fade_mm * (p.Multiplier(d) - p.Multiplier(d - delta)) / delta;
+  return 3.0 * e0 + g >= 0.0 ? Fade::kCubic : Fade::kExponential;
+}
+
+}  // namespace
+
 void CheckSeamCoefficientSteps(const SeamProfile& profile, double relative) {
+  const auto refuse = [](const std::string& why) {
+    throw InputError("seam sensitivities: a difference step of the seam's coefficients " + why +
+                     "; name the material's parameters (--sensitivity-params) to leave the "
+                     "seam out");
+  };
+  const Fade fade = FadeOf(profile);
   for (int k = 0; k < kSeamCoefficients; ++k) {
     const double h = SeamCoefficientStep(profile, k, relative);
     for (const double t : {h, -h}) {
+      const SeamProfile stepped = SteppedSeamProfile(profile, k, t);
       std::string why;
-      if (!SteppedSeamProfile(profile, k, t).Check(&why))
-        throw InputError("seam sensitivities: the seam's coefficients are within a difference "
-                         "step of their bounds (" + why +
-                         "); name the material's parameters (--sensitivity-params) to leave "
-                         "the seam out");
+      if (!stepped.Check(&why)) refuse("leaves their bounds (" + why + ")");
+      if (FadeOf(stepped) != fade)
+        refuse("switches the fade beyond the influence distance, where S jumps");
     }
   }
 }

@@ -310,6 +310,25 @@ double MeanOverhang(const AcpmCrossings& c) {
 // The crossings of a material by the run's model (the elastica or the shell).
 using CrossingsOf = std::function<AcpmCrossings(const Material&)>;
 
+// (L(up) − L(down)) / span for one input's two stepped runs, run(+1) and run(−1): a run that
+// does not converge, or a stepped scene the model refuses (a barrier no longer reached within
+// the sample), fails the sensitivity naming the input (ComputeError).
+double LengthDifference(const std::function<AcpmCrossings(int side)>& run, double span,
+                        const std::string& name) {
+  double length[2];
+  for (const int side : {1, -1}) {
+    AcpmCrossings c;
+    try {
+      c = run(side);
+    } catch (const InputError& e) {
+      throw ComputeError("sensitivity of " + name + ": a stepped run failed: " + e.what());
+    }
+    if (!c.converged) throw ComputeError("sensitivity of " + name + ": " + c.message);
+    length[side > 0 ? 0 : 1] = MeanOverhang(c);
+  }
+  return (length[0] - length[1]) / span;
+}
+
 // ∂L/∂p by central differences of whole runs of the model at p ± `step` of its scale
 // (one-sided at the edge of its range); the influence table and σ into *result.
 void AcpmSensitivities(const Material& material, const CrossingsOf& model, double step_size,
@@ -317,13 +336,8 @@ void AcpmSensitivities(const Material& material, const CrossingsOf& model, doubl
   std::vector<double> d;
   for (const std::string& name : parameters) {
     const ParameterStep step = DifferenceStep(material, name, step_size);
-    double length[2];
-    for (int side = 0; side < 2; ++side) {
-      const AcpmCrossings c = model(side ? step.down : step.up);
-      if (!c.converged) throw ComputeError("sensitivity of " + name + ": " + c.message);
-      length[side] = MeanOverhang(c);
-    }
-    d.push_back((length[0] - length[1]) / step.span);
+    d.push_back(LengthDifference(
+        [&](int side) { return model(side > 0 ? step.up : step.down); }, step.span, name));
   }
   InfluenceTable table = MakeInfluenceTable(material, parameters, d);
   result->sensitivities = std::move(table.rows);
@@ -339,55 +353,65 @@ using CrossingsIn = std::function<AcpmCrossings(const AcpmOptions&)>;
 constexpr double kBarrierAngleUncertainty = 0.5 * kDegree;  // [rad]
 constexpr double kSeamPositionUncertainty = 1e-3;          // [m]
 
-// ∂L/∂t by a central difference of whole runs in the scenes set(t ± h), one-sided where t ± h
-// leaves [lo, hi].
-double SceneDerivative(const CrossingsIn& model, const AcpmOptions& o, double t, double h,
-                       double lo, double hi, const std::function<void(AcpmOptions*, double)>& set,
-                       const std::string& name) {
-  const double up = std::min(t + h, hi), down = std::max(t - h, lo);
-  double length[2];
-  for (int side = 0; side < 2; ++side) {
-    AcpmOptions stepped = o;
-    set(&stepped, side ? down : up);
-    const AcpmCrossings c = model(stepped);
-    if (!c.converged) throw ComputeError("sensitivity of " + name + ": " + c.message);
-    length[side] = MeanOverhang(c);
-  }
-  return (length[0] - length[1]) / (up - down);
+// One scene input: its value t in `o`, how a scene takes another value, and its range.
+struct SceneInput {
+  std::string name;
+  double value = 0.0;
+  std::function<void(AcpmOptions*, double)> set;
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+};
+
+// ∂L/∂t by a central difference of whole runs at t ± h, one-sided where that leaves [lo, hi].
+double SceneDerivative(const CrossingsIn& model, const AcpmOptions& o, const SceneInput& input,
+                       double h) {
+  const double up = std::min(input.value + h, input.hi);
+  const double down = std::max(input.value - h, input.lo);
+  return LengthDifference(
+      [&](int side) {
+        AcpmOptions stepped = o;
+        input.set(&stepped, side > 0 ? up : down);
+        return model(stepped);
+      },
+      up - down, input.name);
 }
 
-// The scene's rows (the barrier's angle; with a seam its position) and the seam's (its
-// coefficients, SeamInfluences) into *result, at the same relative step as the material's.
+// The scene's rows (the barrier's angle; with a seam across its position) and the seam's (its
+// coefficients, SeamInfluences) into *result, at the same relative step as the material's. A
+// seam along has no position row: the shell's mesh follows the seam (a grid line moved onto
+// it), so a step of its position may move another line, and the difference compares two meshes;
+// result->notes says so.
 void AcpmSceneSensitivities(const CrossingsIn& model, const AcpmOptions& o, double step_size,
                             AcpmResult* result) {
   const double angle = o.barrier_angle;
-  const double d_angle = SceneDerivative(
-      model, o, angle, step_size * angle, 0.0, std::nextafter(std::numbers::pi / 2.0, 0.0),
-      [](AcpmOptions* s, double t) { s->barrier_angle = t; }, "barrier_angle");
-  result->scene_sensitivities.push_back(
-      SceneInfluence("barrier_angle", angle, 1.0 / kDegree, "deg", d_angle,
-                     kBarrierAngleUncertainty, "default: the barrier's alignment, ±0.5°"));
+  const SceneInput barrier{"barrier_angle", angle,
+                           [](AcpmOptions* s, double t) { s->barrier_angle = t; }, 0.0,
+                           std::nextafter(std::numbers::pi / 2.0, 0.0)};
+  result->scene_sensitivities.push_back(SceneInfluence(
+      "barrier_angle", angle, 1.0 / kDegree, "deg", SceneDerivative(model, o, barrier, step_size * angle),
+      kBarrierAngleUncertainty, "default: the barrier's alignment, ±0.5°"));
   if (o.seam.direction == AcpmSeamDirection::kNone) return;
-  const bool along = o.seam.direction == AcpmSeamDirection::kAlong;
-  const double span = along ? o.width : o.length, at = o.seam.position;
-  const double d_at = SceneDerivative(
-      model, o, at, step_size * span, 0.0, span,
-      [](AcpmOptions* s, double t) { s->seam.position = t; }, "seam_position");
-  result->scene_sensitivities.push_back(
-      SceneInfluence("seam_position", at, 1e3, "mm", d_at, kSeamPositionUncertainty,
-                     "default: a seam sewn along a marked line, ±1 mm"));
-  std::vector<double> d_a;
-  for (int k = 0; k < kSeamCoefficients; ++k) {
-    const SeamProfile& profile = o.seam.profile;
-    d_a.push_back(SceneDerivative(
-        model, o, 0.0, SeamCoefficientStep(profile, k, step_size),
-        -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
-        [k, &profile](AcpmOptions* s, double t) {
-          s->seam.profile = SteppedSeamProfile(profile, k, t);
-        },
-        "the seam's coefficients"));
+  if (o.seam.direction == AcpmSeamDirection::kAcross) {
+    const SceneInput at{"seam_position", o.seam.position,
+                        [](AcpmOptions* s, double t) { s->seam.position = t; }, 0.0, o.length};
+    result->scene_sensitivities.push_back(SceneInfluence(
+        "seam_position", at.value, units::MToMm(1.0), "mm",
+        SceneDerivative(model, o, at, step_size * o.length), kSeamPositionUncertainty,
+        "default: a seam sewn along a marked line, ±1 mm"));
+  } else {
+    result->notes += std::string(result->notes.empty() ? "" : "; ") +
+                     "no sensitivity in the position of a seam along the push: the shell's mesh "
+                     "follows the seam, so a stepped position compares two meshes";
   }
-  result->seam_sensitivities = SeamInfluences(o.seam.profile, d_a);
+  std::vector<double> d_a;
+  const SeamProfile& profile = o.seam.profile;
+  for (int k = 0; k < kSeamCoefficients; ++k) {
+    const SceneInput a{"the seam's coefficients", 0.0, [k, &profile](AcpmOptions* s, double t) {
+                         s->seam.profile = SteppedSeamProfile(profile, k, t);
+                       }};
+    d_a.push_back(SceneDerivative(model, o, a, SeamCoefficientStep(profile, k, step_size)));
+  }
+  result->seam_sensitivities = SeamInfluences(profile, d_a);
 }
 
 // The mean crossing length's spread over materials drawn from the fit's covariance, each
@@ -540,7 +564,9 @@ AcpmResult RunAcpm(const Material& material, const AcpmOptions& options) {
   result.profile_x = crossings.profile_x;
   result.profile_y = crossings.profile_y;
   result.solves = crossings.solves;
-  result.notes = crossings.notes;
+  // The model's notes first, then the sensitivities' (AcpmSceneSensitivities).
+  if (!crossings.notes.empty())
+    result.notes = crossings.notes + (result.notes.empty() ? "" : "; " + result.notes);
   if (result.model == AcpmModelKind::kShell)
     result.membrane_defaults = MaterialDefaultNotes(material);
   result.shape = std::move(crossings.shape);

@@ -778,7 +778,7 @@ void SettleSplit(const Material& material, const DrapeOptions& o, const DrapeSce
 
 // Stage 5 (sensitivity): ∂DC/∂p of a converged seed, through each equilibrium it was measured
 // on; with a split rim the extrapolation's DC_split + (DC_split - DC_base)/2. The scene's radii
-// and the seam's coefficients too when the run takes them (TakesSceneParameters): the radii
+// and the seam's coefficients too when the run takes them (SceneInputs): the radii
 // through a morph of the rest mesh, the coefficients through the seams' own change.
 void SeedSensitivities(const Material& material, const DrapeOptions& o,
                        drape_internal::SceneInputs scene_inputs,

@@ -4,7 +4,6 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <numbers>
 #include <utility>
 
@@ -260,10 +259,10 @@ std::vector<double> SeedMean(const std::vector<DcDerivativeSet>& seeds,
 
 ParameterInfluence RadiusInfluence(SceneRadius which, const DrapeOptions& o, double d_dc_d_r) {
   return which == SceneRadius::kSpecimen
-             ? SceneInfluence("specimen_radius", o.specimen_radius, 1e3, "mm", d_dc_d_r,
+             ? SceneInfluence("specimen_radius", o.specimen_radius, units::MToMm(1.0), "mm", d_dc_d_r,
                               kSpecimenRadiusUncertainty,
                               "default: a specimen cut to a template, ±1 mm")
-             : SceneInfluence("support_radius", o.support_radius, 1e3, "mm", d_dc_d_r,
+             : SceneInfluence("support_radius", o.support_radius, units::MToMm(1.0), "mm", d_dc_d_r,
                               kSupportRadiusUncertainty, "default: a machined support disk, ±0.1 mm");
 }
 

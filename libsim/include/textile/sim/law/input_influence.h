@@ -36,7 +36,9 @@ SeamProfile SteppedSeamProfile(const SeamProfile& profile, int k, double t);
 // |B_f(0)| (at least 1) at the influence distance d_max, where the term is largest.
 double SeamCoefficientStep(const SeamProfile& profile, int k, double relative);
 // Throws InputError, before a run, when a ±step of `relative` (SeamCoefficientStep) of some
-// coefficient makes a profile that fails SeamProfile::Check (one at the edge of its bounds).
+// coefficient makes a profile that fails SeamProfile::Check (one at the edge of its bounds), or
+// one that fades beyond d_max by the other of SeamProfile::Multiplier's two fades (S jumps
+// between them: the difference would be meaningless).
 void CheckSeamCoefficientSteps(const SeamProfile& profile, double relative);
 // The seam's rows from ∂Q/∂a_k (kSeamCoefficients values, per 1/mm², 1/mm, 1): "seam.a2",
 // "seam.a1", "seam.a0" with the values and units of the seam file (1/mm², 1/mm, -), then

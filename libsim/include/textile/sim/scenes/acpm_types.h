@@ -90,7 +90,9 @@ struct AcpmOptions {
   // The crossing length's sensitivities (docs/methods/sensitivity.md, "ACPM"): for each of
   // sensitivity_parameters (empty: every parameter the model takes: the elastica the `bending`
   // law's constants, beta and areal_density_gsm; the shell every parameter of the material),
-  // by central differences of whole runs.
+  // by central differences of whole runs; with none named, the scene's and the seam's inputs
+  // too (AcpmResult::scene_sensitivities, seam_sensitivities; a seam too near its bounds for
+  // the differences is refused before any work).
   bool sensitivity = false;
   std::vector<std::string> sensitivity_parameters;
   // Monte Carlo check of the σ (law/monte_carlo.h): this many materials drawn from the fit's

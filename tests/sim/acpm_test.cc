@@ -415,7 +415,7 @@ double MeanLength(const Material& m, AcpmOptions o) {
 }
 
 // The scene's and the seam's rows of the elastica (a seam across) against central differences
-// of whole runs at steps 20-100 times the rows' own: the barrier ±0.2°, the seam ±0.5 mm, B_f
+// of whole runs at steps 17-50 times the rows' own: the barrier ±0.2°, the seam ±0.5 mm, B_f
 // scaled by e^(±0.005); within 1 %. A list of parameters, or Monte Carlo alone, leaves them out.
 TEST(Acpm, SceneAndSeamRowsMatchDifferencesOfWholeRuns) {
   AcpmOptions o;
@@ -438,7 +438,8 @@ TEST(Acpm, SceneAndSeamRowsMatchDifferencesOfWholeRuns) {
     set(&down, -h);
     return (MeanLength(m, up) - MeanLength(m, down)) / (2.0 * h);
   };
-  const double angle = fd([](AcpmOptions* s, double t) { s->barrier_angle += t; }, 0.2 * kOneDegree);
+  const double angle =
+      fd([](AcpmOptions* s, double t) { s->barrier_angle += t; }, 0.2 * kOneDegree);
   const double at = fd([](AcpmOptions* s, double t) { s->seam.position += t; }, 5e-4);
   const double scale = fd(
       [](AcpmOptions* s, double t) {
@@ -507,7 +508,8 @@ TEST(Acpm, SceneRowsThroughTheShellModel) {
   EXPECT_NEAR(r.seam_sensitivities[3].d_q_d_ln_p, length / 3.0, 1e-3 * length);
 
   // Across (the shell asked for), at the sample's back edge: z_s is then the seam's distance
-  // behind the front, 300 mm, which every ray lies below: dL/dz_s = 10 L0 (1 + 0.1 sin θ) a0^(1/3).
+  // behind the front, 300 mm, which every ray lies below:
+  // dL/dz_s = 10 L0 (1 + 0.1 sin θ) a0^(1/3).
   o.model = AcpmModelKind::kShell;
   o.seam.direction = AcpmSeamDirection::kAcross;
   o.seam.position = o.length;

@@ -61,11 +61,14 @@ TEST(InputInfluence, SeamStepsMoveOneCoefficient) {
   // The fade beyond d_max at its switch (3 e0 + g = 0: e0 = 0.2, g = 20 × −0.03): a step either
   // way changes the fade, and S jumps there.
   expect_refused({0.0, -0.03, 4.2}, 1e-2, "switches the fade");
-  SeamProfile at_switch = c;
-  at_switch.type = "fitted";
-  at_switch.coefficients_mm = {0.0, -0.03, 4.2};
-  at_switch.coefficients_mm[2] = 4.5;  // 3 e0 + g = 0.9: far from it
-  EXPECT_NO_THROW(CheckSeamCoefficientSteps(at_switch, 1e-2));
+  // Let through: far from the switch (3 e0 + g = 0.9), and an exponential fade that a step
+  // turns into none (B_f(100 mm) = 1.01 falling 0.05 a mm: S shrinks to 1 continuously).
+  SeamProfile fitted = c;
+  fitted.type = "fitted";
+  fitted.coefficients_mm = {0.0, -0.03, 4.5};
+  EXPECT_NO_THROW(CheckSeamCoefficientSteps(fitted, 1e-2));
+  fitted.coefficients_mm = {0.0, -0.05, 6.01};
+  EXPECT_NO_THROW(CheckSeamCoefficientSteps(fitted, 1e-2));
 }
 
 // The seam's rows: without a covariance ±10 % of each coefficient (of a zero one, 10 % of

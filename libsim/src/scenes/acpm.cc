@@ -322,6 +322,8 @@ double LengthDifference(const std::function<AcpmCrossings(int side)>& run, doubl
       c = run(side);
     } catch (const InputError& e) {
       throw ComputeError("sensitivity of " + name + ": a stepped run failed: " + e.what());
+    } catch (const ComputeError& e) {
+      throw ComputeError("sensitivity of " + name + ": a stepped run failed: " + e.what());
     }
     if (!c.converged) throw ComputeError("sensitivity of " + name + ": " + c.message);
     length[side > 0 ? 0 : 1] = MeanOverhang(c);
@@ -387,9 +389,10 @@ void AcpmSceneSensitivities(const CrossingsIn& model, const AcpmOptions& o, doub
   const SceneInput barrier{"barrier_angle", angle,
                            [](AcpmOptions* s, double t) { s->barrier_angle = t; }, 0.0,
                            std::nextafter(std::numbers::pi / 2.0, 0.0)};
-  result->scene_sensitivities.push_back(SceneInfluence(
-      "barrier_angle", angle, 1.0 / kDegree, "deg", SceneDerivative(model, o, barrier, step_size * angle),
-      kBarrierAngleUncertainty, "default: the barrier's alignment, ±0.5°"));
+  const double d_angle = SceneDerivative(model, o, barrier, step_size * angle);
+  result->scene_sensitivities.push_back(
+      SceneInfluence("barrier_angle", angle, 1.0 / kDegree, "deg", d_angle,
+                     kBarrierAngleUncertainty, "default: the barrier's alignment, ±0.5°"));
   if (o.seam.direction == AcpmSeamDirection::kNone) return;
   if (o.seam.direction == AcpmSeamDirection::kAcross) {
     const SceneInput at{"seam_position", o.seam.position,

@@ -258,12 +258,14 @@ std::vector<double> SeedMean(const std::vector<DcDerivativeSet>& seeds,
 }
 
 ParameterInfluence RadiusInfluence(SceneRadius which, const DrapeOptions& o, double d_dc_d_r) {
+  const double mm = units::MToMm(1.0);
   return which == SceneRadius::kSpecimen
-             ? SceneInfluence("specimen_radius", o.specimen_radius, units::MToMm(1.0), "mm", d_dc_d_r,
+             ? SceneInfluence("specimen_radius", o.specimen_radius, mm, "mm", d_dc_d_r,
                               kSpecimenRadiusUncertainty,
                               "default: a specimen cut to a template, ±1 mm")
-             : SceneInfluence("support_radius", o.support_radius, units::MToMm(1.0), "mm", d_dc_d_r,
-                              kSupportRadiusUncertainty, "default: a machined support disk, ±0.1 mm");
+             : SceneInfluence("support_radius", o.support_radius, mm, "mm", d_dc_d_r,
+                              kSupportRadiusUncertainty,
+                              "default: a machined support disk, ±0.1 mm");
 }
 
 }  // namespace
@@ -304,7 +306,8 @@ void SummariseSensitivities(const Material& material, const std::vector<std::str
                             const DrapeOptions& o, DrapeResult* result) {
   if (seed_derivatives.empty()) return;
   InfluenceTable table =
-      MakeInfluenceTable(material, parameters, SeedMean(seed_derivatives, &DcDerivativeSet::material));
+      MakeInfluenceTable(material, parameters,
+                         SeedMean(seed_derivatives, &DcDerivativeSet::material));
   result->sensitivities = std::move(table.rows);
   result->drape_coefficient_sigma = table.sigma;
   result->sigma_note = std::move(table.sigma_note);
@@ -314,7 +317,8 @@ void SummariseSensitivities(const Material& material, const std::vector<std::str
       result->scene_sensitivities.push_back(
           RadiusInfluence(static_cast<SceneRadius>(k), o, radii[static_cast<size_t>(k)]));
   const std::vector<double> seam = SeedMean(seed_derivatives, &DcDerivativeSet::seam);
-  if (seam.size() == kSeamCoefficients) result->seam_sensitivities = SeamInfluences(o.seam_profile, seam);
+  if (seam.size() == kSeamCoefficients)
+    result->seam_sensitivities = SeamInfluences(o.seam_profile, seam);
 }
 
 }  // namespace drape_internal
